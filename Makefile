@@ -1,0 +1,30 @@
+# One-command entry points. Both create ./.venv on a fresh machine (only Python 3.11 + pip needed).
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: setup demo test bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+setup: $(STAMP)
+
+demo: $(STAMP)
+	mkdir -p out
+	$(BIN)/polyfold info examples/bunny-128.obj
+	$(BIN)/polyfold unfold examples/bunny-128.obj -o out/bunny-128.fold --svg out/bunny-128.svg --png out/bunny-128.png --seed 1
+	@echo "wrote out/bunny-128.fold, out/bunny-128.svg, out/bunny-128.png"
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+bench: $(STAMP)
+	$(BIN)/python bench/bench_unfold.py
+
+clean:
+	rm -rf out .pytest_cache
