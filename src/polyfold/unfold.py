@@ -1,0 +1,608 @@
+"""Edge unfolding: spanning trees of the dual graph from heuristics and a genetic algorithm.
+
+In: a manifold, consistently oriented `Mesh` (one edge-connected component, closed or open).
+Out: a `Net` — a spanning forest of the dual graph with its planar layout, one tree per piece,
+overlap-free (checked with the exact test of `overlap.py`).
+
+Genome (ALGORITHMS.md 5.1, 5.5): one weight in [0, 1] per mesh edge; Prim's algorithm from the base
+face keeps light edges as creases. Fitness = -(G + 100 L), G = overlapping face pairs, L = overlaps
+at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time or
+generation budget runs out, the best tree is split into the fewest overlap-free pieces found by a
+set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from . import _unfold_kernels as K
+from .mesh import Mesh
+from .overlap import overlapping_pairs
+
+METHODS = ("auto", "ga", "steepest-edge", "flat-tree", "unflat-tree", "min-perimeter", "max-perimeter", "random")
+
+
+@dataclass(frozen=True, eq=False)
+class Net:
+    """A net of one mesh component: a spanning forest of its dual graph laid out in the plane.
+
+    parent (F,): parent face in the tree, -1 for the root of each piece; parent_edge (F,): the mesh
+    edge (crease) joining a face to its parent, -1 for roots; order (F,): faces with parents first;
+    coords (F, 3, 2): 2D position of each face's corners (same corner order as mesh.faces, CCW seen
+    from +z, outer side up); piece (F,): piece label (0..pieces-1).
+    """
+
+    mesh: Mesh
+    parent: np.ndarray
+    parent_edge: np.ndarray
+    order: np.ndarray
+    coords: np.ndarray
+    piece: np.ndarray
+
+    @property
+    def n_pieces(self) -> int:
+        return int(self.piece.max()) + 1 if len(self.piece) else 0
+
+    @property
+    def crease_mask(self) -> np.ndarray:
+        """(E,) True for mesh edges that are creases of the net."""
+        mask = np.zeros(self.mesh.topology.n_edges, dtype=bool)
+        pe = self.parent_edge[self.parent_edge >= 0]
+        mask[pe] = True
+        return mask
+
+
+@dataclass(frozen=True)
+class UnfoldStats:
+    seconds: float
+    generations: int
+    evaluations: int
+    method: str
+    pieces: int
+    timed_out: bool
+    best_overlaps: int = 0
+
+
+@dataclass(frozen=True, eq=False)
+class UnfoldProblem:
+    """Arrays the kernels need, derived once per mesh component."""
+
+    mesh: Mesh
+    adj_ptr: np.ndarray
+    adj_face: np.ndarray
+    adj_edge: np.ndarray
+    local: np.ndarray
+    hyperbolic: np.ndarray
+    tol: float
+    base: int = 0
+    interior_edges: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    @classmethod
+    def from_mesh(cls, mesh: Mesh, base: int = 0) -> "UnfoldProblem":
+        topo = mesh.topology
+        inner = np.flatnonzero(topo.interior)
+        f0, f1 = topo.edge_faces[inner, 0], topo.edge_faces[inner, 1]
+        src = np.concatenate([f0, f1])
+        dst = np.concatenate([f1, f0])
+        eid = np.concatenate([inner, inner])
+        srt = np.argsort(src, kind="stable")
+        adj_ptr = np.zeros(mesh.n_faces + 1, dtype=np.int64)
+        np.add.at(adj_ptr, src + 1, 1)
+        adj_ptr = np.cumsum(adj_ptr)
+        return cls(
+            mesh=mesh,
+            adj_ptr=adj_ptr,
+            adj_face=dst[srt].astype(np.int64),
+            adj_edge=eid[srt].astype(np.int64),
+            local=local_frames(mesh.vertices, mesh.faces),
+            hyperbolic=mesh.hyperbolic.copy(),
+            tol=1e-9 * max(mesh.bbox_diagonal, 1e-300),
+            base=base,
+            interior_edges=inner,
+        )
+
+    def evaluate(self, weights: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Overlap counts (G, L) of a batch of genomes (B, E)."""
+        mesh = self.mesh
+        cap = 4 * mesh.n_faces if max_pairs is None else max_pairs
+        return K.evaluate_batch(
+            np.ascontiguousarray(weights, dtype=np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            mesh.faces, mesh.topology.face_edges, mesh.topology.edges, self.hyperbolic, self.local, self.tol, cap,
+        )
+
+    def decode(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Genome -> (parent, parent_edge, order, coords) of the spanning tree."""
+        n = self.mesh.n_faces
+        parent = np.empty(n, np.int64)
+        parent_edge = np.empty(n, np.int64)
+        order = np.empty(n, np.int64)
+        reached = K.prim_tree(np.ascontiguousarray(weights, np.float64), self.base, self.adj_ptr, self.adj_face,
+                              self.adj_edge, parent, parent_edge, order)
+        if reached != n:
+            raise ValueError(f"dual graph is not connected ({reached} of {n} faces reached)")
+        coords = np.empty((n, 3, 2))
+        K.layout_tree(order, parent, parent_edge, self.mesh.faces, self.mesh.topology.face_edges, self.local, coords)
+        return parent, parent_edge, order, coords
+
+    def overlaps(self, coords: np.ndarray, parent: np.ndarray) -> np.ndarray:
+        """All overlapping face pairs (k, 2) of a layout (crease pairs skipped)."""
+        count, _ = overlapping_pairs(coords, parent, self.tol, 0)
+        _, pairs = overlapping_pairs(coords, parent, self.tol, int(count))
+        return pairs
+
+
+def local_frames(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Each triangle in its own 2D frame (F, 3, 2): corner 0 at the origin, corner 1 on +x, CCW."""
+    tri = vertices[faces]
+    e1 = tri[:, 1] - tri[:, 0]
+    e2 = tri[:, 2] - tri[:, 0]
+    l1 = np.linalg.norm(e1, axis=1)
+    x2 = np.einsum("ij,ij->i", e2, e1) / l1
+    y2 = np.linalg.norm(np.cross(e1, e2), axis=1) / l1
+    out = np.zeros((len(faces), 3, 2))
+    out[:, 1, 0] = l1
+    out[:, 2, 0] = x2
+    out[:, 2, 1] = y2
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Heuristic edge weights (ALGORITHMS.md 5.3). Low weight = keep as crease.
+
+
+def _random_direction(rng: np.random.Generator) -> np.ndarray:
+    c = rng.normal(size=3)
+    return c / np.linalg.norm(c)
+
+
+def _edge_vectors(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    e = mesh.topology.edges
+    d = mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]]
+    return d, np.linalg.norm(d, axis=1)
+
+
+def flat_tree_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    """Edges orthogonal to a random direction are kept, edges along it are cut."""
+    d, length = _edge_vectors(mesh)
+    return np.abs(d @ _random_direction(rng)) / length
+
+
+def unflat_tree_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    w = flat_tree_weights(mesh, rng)
+    return np.where(w > 0, 1.0 - w, w)
+
+
+def min_perimeter_weights(mesh: Mesh, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Long edges kept: short total cut length."""
+    _, length = _edge_vectors(mesh)
+    span = max(length.max() - length.min(), 1e-300)
+    return 1.0 - (length - length.min()) / span
+
+
+def max_perimeter_weights(mesh: Mesh, rng: np.random.Generator | None = None) -> np.ndarray:
+    _, length = _edge_vectors(mesh)
+    span = max(length.max() - length.min(), 1e-300)
+    return (length - length.min()) / span
+
+
+def _steepest(mesh: Mesh, rng: np.random.Generator, un: bool) -> np.ndarray:
+    """Every vertex but the top one cuts its steepest upward edge (un=True: the least steep)."""
+    c = _random_direction(rng)
+    e = mesh.topology.edges
+    d, length = _edge_vectors(mesh)
+    slope = (d @ c) / length  # from e0 toward e1
+    # directed edges v -> w with score; each vertex picks its best
+    v = np.concatenate([e[:, 0], e[:, 1]])
+    score = np.concatenate([slope, -slope])
+    if un:
+        score = 1.0 - np.abs(score)
+    eid = np.concatenate([np.arange(len(e)), np.arange(len(e))])
+    height = mesh.vertices @ c
+    top = int(np.argmax(height))
+    order = np.lexsort((-score, v))  # per vertex, best score first
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = v[order][1:] != v[order][:-1]
+    pick = order[first]
+    pick = pick[v[pick] != top]
+    w = np.zeros(len(e))
+    w[eid[pick]] = 1.0
+    return w
+
+
+def steepest_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(mesh, rng, un=False)
+
+
+def unsteepest_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(mesh, rng, un=True)
+
+
+def random_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    return rng.random(mesh.topology.n_edges) + 0.01
+
+
+def random_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+    """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none."""
+    topo = mesh.topology
+    n_e = topo.n_edges
+    w = np.full(n_e, 0.01)
+    inner = topo.interior
+    # incident interior edges per vertex, in CSR form
+    e_ids = np.flatnonzero(inner)
+    ends = topo.edges[e_ids]
+    v = np.concatenate([ends[:, 0], ends[:, 1]])
+    ee = np.concatenate([e_ids, e_ids])
+    srt = np.argsort(v, kind="stable")
+    v, ee = v[srt], ee[srt]
+    starts = np.searchsorted(v, np.arange(mesh.n_vertices))
+    stops = np.searchsorted(v, np.arange(mesh.n_vertices), side="right")
+    hyper = mesh.hyperbolic
+    for vert in np.flatnonzero(hyper):
+        inc = ee[starts[vert]:stops[vert]]
+        if len(inc) >= 2:
+            w[rng.choice(inc, 2, replace=False)] = 1.0
+    chosen = np.zeros(mesh.n_vertices, dtype=bool)
+    cut = w >= 1.0
+    chosen[topo.edges[cut, 0]] = True
+    chosen[topo.edges[cut, 1]] = True
+    for vert in np.flatnonzero(~chosen & ~hyper):
+        inc = ee[starts[vert]:stops[vert]]
+        if len(inc):
+            w[rng.choice(inc)] = 1.0
+    return w
+
+
+HEURISTICS: dict[str, Callable[[Mesh, np.random.Generator], np.ndarray]] = {
+    "steepest-edge": steepest_edge_weights,
+    "unsteepest-edge": unsteepest_edge_weights,
+    "flat-tree": flat_tree_weights,
+    "unflat-tree": unflat_tree_weights,
+    "min-perimeter": min_perimeter_weights,
+    "max-perimeter": max_perimeter_weights,
+    "random": random_weights,
+    "random-edge": random_edge_weights,
+}
+
+# The GA's initial population draws from these creators (ALGORITHMS.md 5.5).
+GA_CREATORS = ("steepest-edge", "flat-tree", "unflat-tree", "random-edge")
+
+
+# --------------------------------------------------------------------------------------------
+# Search
+
+
+@dataclass
+class _Budget:
+    deadline: float
+    max_generations: int
+
+    def exhausted(self, generation: int) -> bool:
+        return generation >= self.max_generations or time.perf_counter() >= self.deadline
+
+
+def _fitness(G: np.ndarray, L: np.ndarray) -> np.ndarray:
+    return -(G + 100 * L).astype(np.float64)
+
+
+def run_ga(
+    problem: UnfoldProblem,
+    rng: np.random.Generator,
+    budget: _Budget,
+    population: int = 400,
+    children: int = 50,
+    tournament: int = 7,
+    p_cross: float = 0.4,
+    p_mut: float = 0.01,
+    sigma: float = 0.3,
+    progress: Callable[[int, float], None] | None = None,
+) -> tuple[np.ndarray, float, int, int, str]:
+    """Genetic algorithm of ALGORITHMS.md 5.5, seeded with the heuristics.
+
+    Returns (best genome, best fitness, generations, evaluations, creator of the best). Stops at
+    the first valid net (fitness 0) or when the budget runs out.
+    """
+    mesh = problem.mesh
+    n_e = mesh.topology.n_edges
+    pop = np.empty((population, n_e))
+    creators = rng.integers(0, len(GA_CREATORS), size=population)
+    fit = np.empty(population)
+    evaluations = 0
+    # Evaluate the seeds in small batches so a valid heuristic net stops the search at once.
+    batch = 25
+    for start in range(0, population, batch):
+        stop = min(start + batch, population)
+        for i in range(start, stop):
+            pop[i] = HEURISTICS[GA_CREATORS[creators[i]]](mesh, rng)
+        G, L = problem.evaluate(pop[start:stop])
+        fit[start:stop] = _fitness(G, L)
+        evaluations += stop - start
+        hit = np.flatnonzero(fit[start:stop] == 0)
+        if len(hit):
+            i = start + int(hit[0])
+            return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
+        if time.perf_counter() >= budget.deadline:
+            fit[stop:] = -np.inf
+            pop[stop:] = pop[:1]
+            break
+    origin = np.array([GA_CREATORS[c] for c in creators], dtype=object)
+    best = float(fit.max())
+    stall = 0
+    generation = 0
+    while not budget.exhausted(generation):
+        generation += 1
+        pm = p_mut if stall <= 100 else min(1.0, p_mut * 1.25 ** (stall / 100))
+        pc = p_cross if stall <= 100 else min(1.0, p_cross * 1.1 ** (stall / 100))
+        # tournament selection, two parents per child
+        draws = rng.integers(0, population, size=(children, 2, tournament))
+        winners = np.take_along_axis(draws, np.argmax(fit[draws], axis=2)[..., None], axis=2)[..., 0]
+        a = pop[winners[:, 0]]
+        b = pop[winners[:, 1]]
+        swap = rng.random((children, n_e)) < pc
+        kids = np.where(swap, b, a)
+        mutate = rng.random((children, n_e)) < pm
+        if mutate.any():
+            idx = np.nonzero(mutate)
+            vals = kids[idx] + rng.normal(0.0, sigma, size=len(idx[0]))
+            bad = (vals < 0) | (vals > 1)
+            while bad.any():  # redraw until inside [0, 1]
+                vals[bad] = kids[idx][bad] + rng.normal(0.0, sigma, size=int(bad.sum()))
+                bad = (vals < 0) | (vals > 1)
+            kids[idx] = vals
+        G, L = problem.evaluate(kids)
+        evaluations += children
+        kid_fit = _fitness(G, L)
+        worst = np.argsort(fit)[:children]
+        pop[worst] = kids
+        fit[worst] = kid_fit
+        origin[worst] = "ga"
+        top = float(kid_fit.max())
+        if top > best:
+            best = top
+            stall = 0
+        else:
+            stall += 1
+        if progress is not None and generation % 20 == 0:
+            progress(generation, best)
+        if best == 0:
+            break
+    i = int(np.argmax(fit))
+    return pop[i].copy(), float(fit[i]), generation, evaluations, str(origin[i])
+
+
+def _genome_of_tree(crease: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Weights that make Prim's algorithm rebuild exactly this tree (creases light, cuts heavy)."""
+    return np.where(crease, 0.0, 0.5) + 0.5 * rng.random(len(crease)) * np.where(crease, 0.0, 1.0)
+
+
+def run_memetic(
+    problem: UnfoldProblem,
+    rng: np.random.Generator,
+    budget: _Budget,
+    population: int = 400,
+    tournament: int = 7,
+    p_cross: float = 0.4,
+    temperature: float = 0.5,
+    progress: Callable[[int, float], None] | None = None,
+) -> tuple[np.ndarray, float, int, int, str]:
+    """GA of ALGORITHMS.md 5.5 with a Lamarckian tree local search ("auto").
+
+    Same heuristic-seeded population, tournament selection and uniform crossover as `run_ga`; each
+    generation breeds one child, improves it with edge-swap local search (a crease on the tree path
+    between two overlapping faces is swapped for a cut edge that reconnects the halves), and writes
+    the improved tree back into the population in place of the worst individual. Returns the same
+    tuple as `run_ga`.
+    """
+    mesh = problem.mesh
+    topo = mesh.topology
+    n_e = topo.n_edges
+    pop = np.empty((population, n_e))
+    creators = rng.integers(0, len(GA_CREATORS), size=population)
+    fit = np.full(population, -np.inf)
+    evaluations = 0
+    filled = 0
+    for start in range(0, population, 25):
+        stop = min(start + 25, population)
+        for i in range(start, stop):
+            pop[i] = HEURISTICS[GA_CREATORS[creators[i]]](mesh, rng)
+        G, L = problem.evaluate(pop[start:stop])
+        fit[start:stop] = _fitness(G, L)
+        evaluations += stop - start
+        filled = stop
+        hit = np.flatnonzero(fit[start:stop] == 0)
+        if len(hit):
+            i = start + int(hit[0])
+            return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
+        if time.perf_counter() >= budget.deadline:
+            break
+    pop, fit = pop[:filled], fit[:filled]
+    n_pop = filled
+    # Local-search effort per generation: enough to finish most nets, small enough to restart
+    # from a fresh child when the search is stuck in a local minimum.
+    chunk_iters = max(1000, 4 * mesh.n_faces)
+    step = 200
+    cap = 4 * mesh.n_faces
+    generation = 0
+    crease = np.zeros(n_e, dtype=np.bool_)
+    while not budget.exhausted(generation):
+        generation += 1
+        if generation == 1:
+            child = pop[int(np.argmax(fit))].copy()
+        else:
+            draws = rng.integers(0, n_pop, size=(2, tournament))
+            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
+            swap = rng.random(n_e) < p_cross
+            child = np.where(swap, pop[winners[1]], pop[winners[0]])
+        parent, parent_edge, _, _ = problem.decode(child)
+        crease[:] = False
+        crease[parent_edge[parent_edge >= 0]] = True
+        done_iters, score = 0, None
+        while done_iters < chunk_iters:
+            score, it = K.local_search(
+                crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
+                mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, cap,
+                step, int(rng.integers(2**31)), temperature,
+            )
+            done_iters += max(it, 1)
+            if score == 0 or time.perf_counter() >= budget.deadline:
+                break
+        evaluations += done_iters
+        genome = _genome_of_tree(crease, rng)
+        worst = int(np.argmin(fit))
+        pop[worst] = genome
+        fit[worst] = -float(score)
+        if progress is not None:
+            progress(generation, float(fit.max()))
+        if score == 0:
+            return genome, 0.0, generation, evaluations, "ga+local-search"
+    i = int(np.argmax(fit))
+    return pop[i].copy(), float(fit[i]), generation, evaluations, "ga+local-search"
+
+
+def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator, budget: _Budget) -> tuple[np.ndarray, float, int]:
+    """Plain heuristic mode: fresh random direction per try, keep the best (fewest overlaps)."""
+    best_w, best_fit, tries = None, -np.inf, 0
+    make = HEURISTICS[name]
+    while tries < 100 and (tries == 0 or time.perf_counter() < budget.deadline):
+        w = make(problem.mesh, rng)[None, :]
+        G, L = problem.evaluate(w)
+        tries += 1
+        f = float(_fitness(G, L)[0])
+        if f > best_fit:
+            best_w, best_fit = w[0], f
+        if f == 0 or name in ("min-perimeter", "max-perimeter"):  # deterministic rules: one try
+            break
+    return best_w, best_fit, tries
+
+
+def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Cut the fewest creases so no overlapping pair stays in one piece (ALGORITHMS.md 5.6).
+
+    Greedy set cover of the tree paths between overlapping faces (crease on most uncovered paths
+    first), refined by an exact ILP when it is small. Returns a boolean mask (F,) of faces whose
+    crease to their parent is cut.
+    """
+    n = len(parent)
+    depth = np.zeros(n, dtype=np.int64)
+    for f in order[1:]:
+        depth[f] = depth[parent[f]] + 1
+    paths = []
+    for f, g in pairs:
+        path = []
+        a, b = int(f), int(g)
+        while a != b:  # climb to the lowest common ancestor; a crease is named by its child face
+            if depth[a] >= depth[b]:
+                path.append(a)
+                a = int(parent[a])
+            else:
+                path.append(b)
+                b = int(parent[b])
+        paths.append(path)
+    cut = np.zeros(n, dtype=bool)
+    if not paths:
+        return cut
+    candidates = sorted({c for p in paths for c in p})
+    col = {c: i for i, c in enumerate(candidates)}
+    rows = [[col[c] for c in p] for p in paths]
+    uncovered = set(range(len(rows)))
+    by_col: dict[int, list[int]] = {}
+    for r, cols in enumerate(rows):
+        for c in cols:
+            by_col.setdefault(c, []).append(r)
+    greedy = []
+    while uncovered:
+        c_best = max(by_col, key=lambda c: sum(1 for r in by_col[c] if r in uncovered))
+        greedy.append(c_best)
+        uncovered -= set(by_col[c_best])
+    chosen = greedy
+    if len(greedy) > 1 and len(candidates) <= 2000:
+        try:
+            from scipy.optimize import Bounds, LinearConstraint, milp
+            from scipy.sparse import lil_matrix
+
+            A = lil_matrix((len(rows), len(candidates)))
+            for r, cols in enumerate(rows):
+                for c in cols:
+                    A[r, c] = 1
+            res = milp(np.ones(len(candidates)), constraints=LinearConstraint(A.tocsr(), lb=1, ub=np.inf),
+                       integrality=np.ones(len(candidates)), bounds=Bounds(0, 1), options={"time_limit": 5})
+            if res.x is not None and res.success:
+                exact = [i for i in range(len(candidates)) if res.x[i] > 0.5]
+                if len(exact) < len(greedy):
+                    chosen = exact
+        except Exception:  # ILP is only a refinement of the greedy cover
+            pass
+    cut[[candidates[i] for i in chosen]] = True
+    return cut
+
+
+def _net_from_tree(problem: UnfoldProblem, parent, parent_edge, order, coords, cut: np.ndarray | None = None) -> Net:
+    parent = parent.copy()
+    parent_edge = parent_edge.copy()
+    if cut is not None and cut.any():
+        parent[cut] = -1
+        parent_edge[cut] = -1
+    piece = np.full(len(parent), -1, dtype=np.int64)
+    n_pieces = 0
+    for f in order:
+        if parent[f] < 0:
+            piece[f] = n_pieces
+            n_pieces += 1
+        else:
+            piece[f] = piece[parent[f]]
+    return Net(mesh=problem.mesh, parent=parent, parent_edge=parent_edge, order=order.copy(), coords=coords, piece=piece)
+
+
+def unfold(
+    mesh: Mesh,
+    method: str = "auto",
+    seed: int = 0,
+    time_limit: float = 60.0,
+    max_pieces: int | None = None,
+    max_generations: int = 15000,
+    progress: Callable[[int, float], None] | None = None,
+) -> tuple[Net, UnfoldStats]:
+    """Unfold one edge-connected component into a net (one piece when one is found in time).
+
+    method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
+    raises `NoNetFound` instead of falling back to several pieces. Deterministic for a given seed
+    (the time limit can only make it stop earlier).
+    """
+    from .errors import NoNetFound
+
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    budget = _Budget(deadline=t0 + time_limit, max_generations=max_generations)
+    problem = UnfoldProblem.from_mesh(mesh)
+    if mesh.n_faces == 1:
+        weights = np.zeros(mesh.topology.n_edges)
+        fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
+    elif method == "auto":
+        weights, fitness, generations, evaluations, winner = run_memetic(problem, rng, budget, progress=progress)
+    elif method == "ga":
+        weights, fitness, generations, evaluations, winner = run_ga(problem, rng, budget, progress=progress)
+    else:
+        weights, fitness, evaluations = run_heuristic(problem, method, rng, budget)
+        generations, winner = 0, method
+    parent, parent_edge, order, coords = problem.decode(weights)
+    pairs = problem.overlaps(coords, parent)
+    timed_out = len(pairs) > 0
+    cut = None
+    if len(pairs):
+        if max_pieces == 1:
+            raise NoNetFound(
+                f"no single-piece net found in {time.perf_counter() - t0:.1f} s "
+                f"({generations} generations, best net has {len(pairs)} overlapping face pairs)"
+            )
+        cut = split_into_pieces(parent, parent_edge, order, pairs)
+    net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
+    stats = UnfoldStats(
+        seconds=time.perf_counter() - t0, generations=generations, evaluations=evaluations, method=winner,
+        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs),
+    )
+    return net, stats
