@@ -247,6 +247,10 @@ def concavity(mesh: Mesh, samples_per_face: int = 3, seed: int = 0) -> float:
     except (QhullError, ValueError):
         return 0.0  # flat or degenerate point set: no volume, the surface is its own hull
     eq = hull.equations
-    depth = -(pts @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, per facet
-    dist = np.clip(depth.min(axis=1), 0.0, None)
-    return float(dist.max() / diag) if diag > 0 else 0.0
+    # Chunked so points x facets stays small on large meshes (~8 MB per chunk).
+    rows = max(1, 1_000_000 // len(eq))
+    dist = 0.0
+    for start in range(0, len(pts), rows):
+        depth = -(pts[start:start + rows] @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, per facet
+        dist = max(dist, float(np.clip(depth.min(axis=1), 0.0, None).max()))
+    return dist / diag if diag > 0 else 0.0

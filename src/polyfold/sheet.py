@@ -20,7 +20,6 @@ import colorsys
 import logging
 import math
 import os
-import secrets
 import struct
 import zlib
 from collections import defaultdict
@@ -30,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import PolyfoldError
+from .io import atomic_write
 
 log = logging.getLogger(__name__)
 
@@ -413,7 +413,7 @@ def write_svg(fold: dict, path, *, size_mm: float = 150.0, labels: bool = True, 
     One closed cut path per piece (class "cut", id "cut-{piece}", subpaths for holes), one path per
     mountain/valley crease (classes "mountain"/"valley"; flat creases are omitted), glue labels
     (class "label", the mesh-edge number, on both twins of each cut edge), glue tabs (class "tab",
-    base class "tab-fold") and a title. Logs a warning if the sheet exceeds 300 x 300 mm.
+    base class "tab-fold") and a title. `sheet_layout(fold, size_mm).oversize` tells whether it exceeds 300 x 300 mm.
     """
     import svgwrite
 
@@ -478,10 +478,8 @@ def write_svg(fold: dict, path, *, size_mm: float = 150.0, labels: bool = True, 
              f"sheet {W:.0f} x {H:.0f} mm")
     dwg.add(dwg.text(title, insert=(2, 3.5), class_="title", font_size=3, font_family="sans-serif", fill="#404040"))
 
-    if lay.oversize:
-        log.warning("cut sheet is %.0f x %.0f mm, larger than %.0f x %.0f mm: reduce the size or split the print",
-                    W, H, MAX_SHEET_MM, MAX_SHEET_MM)
-    _atomic_write(path, dwg.tostring())
+    # Oversize sheets are the caller's to report (see `sheet_layout(...).oversize`).
+    atomic_write(path, dwg.tostring())
 
 
 # ----------------------------------------------------------------------------------------------
@@ -597,30 +595,4 @@ def write_png(fold: dict, path, *, width_px: int = 1200) -> None:
         sel = [e for e, kk in enumerate(net.kind) if kk == k]
         if sel:
             _draw_segments(img, xy[net.edges[sel]], _PNG_COLORS[k], thick)
-    _atomic_write(path, _png_bytes(img))
-
-
-# ----------------------------------------------------------------------------------------------
-# files
-
-
-def _atomic_write(path, data: bytes | str) -> None:
-    """Write data to path atomically: temp file in the same directory, fsync, then os.replace."""
-    path = Path(path)
-    if isinstance(data, str):
-        data = data.encode("utf-8")
-    directory = path.parent if str(path.parent) else Path(".")
-    tmp = directory / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp"
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    atomic_write(path, _png_bytes(img))
