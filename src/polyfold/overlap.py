@@ -40,9 +40,23 @@ def _separated_on_axes_of(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     return False
 
 
+@njit(cache=True, inline="always")
+def _is_sliver(t: np.ndarray, tol: float) -> bool:
+    ux = t[1, 0] - t[0, 0]
+    uy = t[1, 1] - t[0, 1]
+    vx = t[2, 0] - t[0, 0]
+    vy = t[2, 1] - t[0, 1]
+    wx = t[2, 0] - t[1, 0]
+    wy = t[2, 1] - t[1, 1]
+    longest = np.sqrt(max(ux * ux + uy * uy, vx * vx + vy * vy, wx * wx + wy * wy))
+    return abs(ux * vy - uy * vx) <= tol * longest  # height over the longest side <= tol
+
+
 @njit(cache=True)
 def triangles_overlap(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     """Exact interior-overlap test of two 2D triangles (3, 2) with noise tolerance `tol`."""
+    if _is_sliver(a, tol) or _is_sliver(b, tol):
+        return False  # no interior (all corners within tol of one line)
     if _separated_on_axes_of(a, b, tol):
         return False
     if _separated_on_axes_of(b, a, tol):
