@@ -17,7 +17,7 @@ setup: $(STAMP)
 demo: $(STAMP)
 	mkdir -p out
 	$(BIN)/polyfold info examples/bunny-128.obj
-	$(BIN)/polyfold unfold examples/bunny-128.obj -o out/bunny-128.fold --svg out/bunny-128.svg --png out/bunny-128.png --seed 1
+	$(BIN)/polyfold unfold examples/bunny-128.obj -o out/bunny-128.fold --svg out/bunny-128.svg --png out/bunny-128.png --seed 1 --size 80
 	@echo "wrote out/bunny-128.fold, out/bunny-128.svg, out/bunny-128.png"
 
 test: $(STAMP)
