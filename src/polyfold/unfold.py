@@ -65,6 +65,7 @@ class UnfoldStats:
     pieces: int
     timed_out: bool
     best_overlaps: int = 0
+    accepted: bool | None = None  # passed the caller's `accept` test (None: no test asked)
 
 
 @dataclass(frozen=True, eq=False)
@@ -387,6 +388,7 @@ def run_memetic(
     p_cross: float = 0.4,
     temperature: float = 0.5,
     progress: Callable[[int, float], None] | None = None,
+    accept: Callable[[np.ndarray], bool] | None = None,
 ) -> tuple[np.ndarray, float, int, int, str]:
     """GA of ALGORITHMS.md 5.5 with a Lamarckian tree local search ("auto").
 
@@ -395,7 +397,19 @@ def run_memetic(
     between two overlapping faces is swapped for a cut edge that reconnects the halves), and writes
     the improved tree back into the population in place of the worst individual. Returns the same
     tuple as `run_ga`.
+
+    accept: optional extra test of a valid (overlap-free) genome; the search goes on, within the
+    budget, until a valid genome passes it, and falls back to the first valid one otherwise.
     """
+    fallback: list[np.ndarray] = []
+
+    def finished(genome: np.ndarray) -> bool:
+        if accept is None or accept(genome):
+            return True
+        if not fallback:
+            fallback.append(genome.copy())
+        return False
+
     mesh = problem.mesh
     topo = mesh.topology
     n_e = topo.n_edges
@@ -412,10 +426,10 @@ def run_memetic(
         fit[start:stop] = _fitness(G, L)
         evaluations += stop - start
         filled = stop
-        hit = np.flatnonzero(fit[start:stop] == 0)
-        if len(hit):
-            i = start + int(hit[0])
-            return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
+        for i in start + np.flatnonzero(fit[start:stop] == 0):
+            if finished(pop[i]):
+                return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
+            fit[i] = -0.5  # valid but not accepted: a good parent, not an answer
         if time.perf_counter() >= budget.deadline:
             break
     pop, fit = pop[:filled], fit[:filled]
@@ -457,7 +471,11 @@ def run_memetic(
         if progress is not None:
             progress(generation, float(fit.max()))
         if score == 0:
-            return genome, 0.0, generation, evaluations, "ga+local-search"
+            if finished(genome):
+                return genome, 0.0, generation, evaluations, "ga+local-search"
+            fit[worst] = -0.5
+    if fallback:
+        return fallback[0], 0.0, generation, evaluations, "ga+local-search"
     i = int(np.argmax(fit))
     return pop[i].copy(), float(fit[i]), generation, evaluations, "ga+local-search"
 
@@ -564,12 +582,15 @@ def unfold(
     max_pieces: int | None = None,
     max_generations: int = 15000,
     progress: Callable[[int, float], None] | None = None,
+    accept: Callable[[Net], bool] | None = None,
 ) -> tuple[Net, UnfoldStats]:
     """Unfold one edge-connected component into a net (one piece when one is found in time).
 
     method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
     raises `NoNetFound` instead of falling back to several pieces. Deterministic for a given seed
-    (the time limit can only make it stop earlier).
+    (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
+    within the time limit, for a valid net that also passes this test (e.g. linear foldability);
+    `UnfoldStats.accepted` says whether one did.
     """
     from .errors import NoNetFound
 
@@ -583,7 +604,12 @@ def unfold(
         weights = np.zeros(mesh.topology.n_edges)
         fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
     elif method == "auto":
-        weights, fitness, generations, evaluations, winner = run_memetic(problem, rng, budget, progress=progress)
+        accept_genome = None
+        if accept is not None:
+            def accept_genome(genome: np.ndarray) -> bool:
+                return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
+        weights, fitness, generations, evaluations, winner = run_memetic(
+            problem, rng, budget, progress=progress, accept=accept_genome)
     elif method == "ga":
         weights, fitness, generations, evaluations, winner = run_ga(problem, rng, budget, progress=progress)
     else:
@@ -601,8 +627,11 @@ def unfold(
             )
         cut = split_into_pieces(parent, parent_edge, order, pairs)
     net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
+    accepted = None
+    if accept is not None:
+        accepted = net.n_pieces == 1 and bool(accept(net))
     stats = UnfoldStats(
         seconds=time.perf_counter() - t0, generations=generations, evaluations=evaluations, method=winner,
-        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs),
+        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs), accepted=accepted,
     )
     return net, stats
