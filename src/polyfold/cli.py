@@ -23,6 +23,17 @@ app = typer.Typer(
 )
 
 
+class Planner(str, Enum):
+    auto = "auto"
+    linear = "linear"
+    lazy_prm = "lazy-prm"
+
+
+class Strategy(str, Enum):
+    discrete = "discrete"
+    continuous = "continuous"
+
+
 class Method(str, Enum):
     auto = "auto"
     ga = "ga"
@@ -115,6 +126,10 @@ def unfold(
     labels: bool = typer.Option(True, "--labels/--no-labels", help="Print matching edge labels on the SVG."),
     tabs: bool = typer.Option(True, "--tabs/--no-tabs", help="Add glue tabs on the SVG."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
+    fold: bool = typer.Option(False, "--fold", help="Also plan a collision-free folding path (see `polyfold fold`)."),
+    prefer_linear: bool = typer.Option(False, "--prefer-linear", help="Keep searching (within the time limit) for a net whose straight-line fold is collision-free."),
+    planner: Planner = typer.Option(Planner.auto, "--planner", help="With --fold: folding planner."),
+    resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="With --fold: collision-check step along path segments, degrees."),
 ) -> None:
     """Unfold a mesh into overlap-free nets: one piece per component when one is found in time."""
     if max_pieces not in ("auto", "1"):
@@ -138,9 +153,16 @@ def unfold(
             if show:
                 print(f"\rpolyfold: {_label}generation {gen}, best overlaps {-best:.0f}   ", end="", file=sys.stderr, flush=True)
 
+        accept = None
+        if prefer_linear:
+            def accept(candidate, _res=resolution_deg) -> bool:
+                from .fold import is_linearly_foldable
+                from .kinematics import fold_tree
+
+                return is_linearly_foldable(fold_tree(net_to_fold([candidate])), _res)
         try:
             net, st = unfold_mesh(comp, method=method.value, seed=seed + i, time_limit=budget,
-                                  max_pieces=1 if max_pieces == "1" else None, progress=progress)
+                                  max_pieces=1 if max_pieces == "1" else None, progress=progress, accept=accept)
         except NoNetFound as exc:
             if show:
                 print(file=sys.stderr)
@@ -149,18 +171,35 @@ def unfold(
             print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
         nets.append(net)
         stats.append(st)
-    fold = net_to_fold(nets, title=mesh.stem)
-    atomic_write(output, dumps(fold))
+    fold_dict = net_to_fold(nets, title=mesh.stem)
+    path_note = ""
+    if fold:
+        from .fold import plan_fold, with_path
+        from .kinematics import fold_tree
+
+        remaining = max(1.0, time_limit - (time.perf_counter() - t0))
+        path = plan_fold(fold_tree(fold_dict), planner=planner.value, resolution_deg=resolution_deg,
+                         time_limit=remaining, seed=seed)
+        if path is None:
+            atomic_write(output, dumps(fold_dict))
+            raise NoNetFound(f"{mesh.name}: no folding path found within the time limit "
+                             f"(the flat net was written to {output.name})")
+        fold_dict = with_path(fold_dict, path, resolution_deg)
+        path_note = f", folding path {len(path.frames)} frames ({path.planner}, {path.seconds:.2f} s)"
+    if prefer_linear:
+        lc = all(s.accepted for s in stats)
+        path_note += ", linearly foldable" if lc else ", no linearly foldable net found in time"
+    atomic_write(output, dumps(fold_dict))
     if svg is not None or png is not None:
         from .sheet import sheet_layout, write_png, write_svg
 
         if svg is not None:
-            layout = sheet_layout(fold, size)
+            layout = sheet_layout(fold_dict, size)
             if layout.oversize and not quiet:
                 _say(f"warning: sheet is {layout.width:.0f} x {layout.height:.0f} mm, larger than 300 x 300 mm; lower --size")
-            write_svg(fold, svg, size_mm=size, labels=labels, tabs=tabs)
+            write_svg(fold_dict, svg, size_mm=size, labels=labels, tabs=tabs)
         if png is not None:
-            write_png(fold, png)
+            write_png(fold_dict, png)
     pieces = sum(s.pieces for s in stats)
     gens = sum(s.generations for s in stats)
     methods = ",".join(sorted({s.method for s in stats}))
@@ -169,7 +208,54 @@ def unfold(
     if any(s.timed_out for s in stats):
         note = " (no single net within the time limit: fell back to several overlap-free pieces)"
     _say(f"{mesh.name}: {pieces} piece{'s' if pieces != 1 else ''}, {seconds:.2f} s, {gens} generations, "
-         f"method {methods}{note}")
+         f"method {methods}{path_note}{note}")
+
+
+@app.command("fold")
+@_guard
+def fold_cmd(
+    net: Path = typer.Argument(..., help="Net as a FOLD file (from `polyfold unfold`)."),
+    output: Path = typer.Option(..., "-o", "--output", help="FOLD file with the path added as polyfold:path."),
+    planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then Lazy PRM."),
+    resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="Collision-check step along path segments, degrees."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
+    seed: int = typer.Option(1, "--seed", help="Random seed of the sampling planner."),
+) -> None:
+    """Plan a continuous, collision-free folding path from the flat net to the folded shape."""
+    from .errors import NoNetFound
+    from .fold import plan_fold, with_path
+    from .foldfile import dumps, read_fold
+    from .io import atomic_write
+    from .kinematics import fold_tree
+
+    fold = read_fold(net)
+    tree = fold_tree(fold)
+    path = plan_fold(tree, planner=planner.value, resolution_deg=resolution_deg, time_limit=time_limit, seed=seed)
+    if path is None:
+        raise NoNetFound(f"{net.name}: no folding path found in {time_limit:g} s with planner {planner.value} "
+                         f"({len(tree.creases)} DOF); the flat net itself is still valid")
+    atomic_write(output, dumps(with_path(fold, path, resolution_deg)))
+    _say(f"{net.name}: {len(tree.creases)} DOF, {'linearly foldable' if path.linear else 'not linearly foldable'}, "
+         f"path {len(path.frames)} frames, {path.seconds:.2f} s, planner {path.planner}, "
+         f"{path.edges_checked} segments / {path.configs_checked} configurations checked")
+
+
+@app.command()
+@_guard
+def cspace(
+    net: Path = typer.Argument(..., help="Net as a FOLD file."),
+    samples: int = typer.Option(1000, "--samples", min=1, help="Configurations to sample."),
+    strategy: Strategy = typer.Option(Strategy.discrete, "--strategy", help="discrete: each crease flat or at its goal; continuous: uniform between."),
+    seed: int = typer.Option(1, "--seed"),
+) -> None:
+    """Print the valid configuration ratio |C_valid| / |C_sampled| of a net (paper Fig. 5)."""
+    from .fold import sample_ratio
+    from .foldfile import read_fold
+    from .kinematics import fold_tree
+
+    tree = fold_tree(read_fold(net))
+    valid, total = sample_ratio(tree, samples, strategy.value, seed)
+    print(f"{net.name}: DOF {len(tree.creases)}, strategy {strategy.value}, valid {valid} / {total} = {valid / total:.6g}")
 
 
 def main() -> None:

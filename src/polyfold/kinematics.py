@@ -1,0 +1,638 @@
+"""Folding a net in 3D: forward kinematics of the crease tree and the self-intersection test.
+
+A configuration q (E,) holds one fold angle per net edge (radians, internal convention rho:
+positive = mountain / convex, ALGORITHMS.md 1.2); only the tree creases are read. Forward
+kinematics (ALGORITHMS.md 6.1): piece roots stay where the flat net puts them (plane z = 0, outer
+side facing +z); every other face is its parent's transform followed by a rotation by
+q[crease] about the crease, directed along the parent's CCW order (right-hand rule), so a positive
+angle moves the child below the parent's plane. Folding to `goal` rebuilds the foldedForm up to one
+rigid motion per piece.
+
+Self-intersection (ALGORITHMS.md 6.2): two faces collide when their relative interiors cross
+(within the tolerance `tol`); touching is allowed: sharing a vertex or an edge, a vertex or an
+edge resting on the other face, coplanar faces side by side. Coplanar faces whose interiors overlap
+collide (paper cannot pass through paper). Every pair of faces of one piece is tested except the
+crease pairs (parent, child), including faces that share a net vertex and twins of a cut edge.
+
+The numba kernels take plain arrays so a planner can call them inside its own @njit loops:
+`forward_kinematics`, `triangles_collide`, `first_collision`, `config_collides`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .errors import PolyfoldError
+
+CONTACT_TOL = 1e-7  # contact tolerance, as a fraction of the model's bounding-box diagonal
+_AXIS_EPS2 = 1e-24  # a candidate axis is skipped when |axis| < 1e-12 * (product of the lengths crossed)
+_CUT = ("B", "C")  # assignments that do not join faces (FOLD 1.2 adds C = cut)
+_CREASE = ("M", "V", "F", "U", "J")
+
+
+# --------------------------------------------------------------------------------------------------
+# numba kernels
+# --------------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def forward_kinematics(q, order, parent, crease, axis, flat, R, T, out):
+    """Fold the net: out[f] = R[f] @ flat[f, k] + T[f] for every face (allocation-free).
+
+    q (E,) fold angles (rho); order (F,) parents first; parent/crease (F,) (-1 at roots);
+    axis (F, 2) corners of the parent at the crease ends, a -> b in the parent's CCW order;
+    flat (F, 3, 3) flat corners (z = 0). R (F, 3, 3), T (F, 3), out (F, 3, 3) are overwritten.
+    """
+    for ii in range(order.shape[0]):
+        f = order[ii]
+        p = parent[f]
+        if p < 0:
+            for i in range(3):
+                for j in range(3):
+                    R[f, i, j] = 1.0 if i == j else 0.0
+                T[f, i] = 0.0
+                for k in range(3):
+                    out[f, k, i] = flat[f, k, i]
+            continue
+        ax = out[p, axis[f, 0], 0]
+        ay = out[p, axis[f, 0], 1]
+        az = out[p, axis[f, 0], 2]
+        ux = out[p, axis[f, 1], 0] - ax
+        uy = out[p, axis[f, 1], 1] - ay
+        uz = out[p, axis[f, 1], 2] - az
+        norm = math.sqrt(ux * ux + uy * uy + uz * uz)
+        angle = q[crease[f]]
+        if norm > 0.0:
+            ux /= norm
+            uy /= norm
+            uz /= norm
+        else:
+            angle = 0.0  # zero-length crease (rejected by fold_tree): no rotation
+        c = math.cos(angle)
+        s = math.sin(angle)
+        t = 1.0 - c
+        # Rodrigues: rotation by `angle` about unit u (right-hand rule)
+        r00 = c + t * ux * ux
+        r01 = t * ux * uy - s * uz
+        r02 = t * ux * uz + s * uy
+        r10 = t * uy * ux + s * uz
+        r11 = c + t * uy * uy
+        r12 = t * uy * uz - s * ux
+        r20 = t * uz * ux - s * uy
+        r21 = t * uz * uy + s * ux
+        r22 = c + t * uz * uz
+        # M_f = Rot(A, u, angle) o M_p:  R_f = Rr R_p,  T_f = Rr (T_p - A) + A
+        for j in range(3):
+            p0 = R[p, 0, j]
+            p1 = R[p, 1, j]
+            p2 = R[p, 2, j]
+            R[f, 0, j] = r00 * p0 + r01 * p1 + r02 * p2
+            R[f, 1, j] = r10 * p0 + r11 * p1 + r12 * p2
+            R[f, 2, j] = r20 * p0 + r21 * p1 + r22 * p2
+        dx = T[p, 0] - ax
+        dy = T[p, 1] - ay
+        dz = T[p, 2] - az
+        T[f, 0] = r00 * dx + r01 * dy + r02 * dz + ax
+        T[f, 1] = r10 * dx + r11 * dy + r12 * dz + ay
+        T[f, 2] = r20 * dx + r21 * dy + r22 * dz + az
+        for k in range(3):
+            x = flat[f, k, 0]
+            y = flat[f, k, 1]
+            z = flat[f, k, 2]
+            for i in range(3):
+                out[f, k, i] = R[f, i, 0] * x + R[f, i, 1] * y + R[f, i, 2] * z + T[f, i]
+    return out
+
+
+@njit(cache=True, inline="always")
+def _edge(t, k):
+    k1 = (k + 1) % 3
+    return (t[k1, 0] - t[k, 0], t[k1, 1] - t[k, 1], t[k1, 2] - t[k, 2])
+
+
+@njit(cache=True, inline="always")
+def _dot(u, v):
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+@njit(cache=True, inline="always")
+def _cross(u, v):
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+@njit(cache=True, inline="always")
+def _is_sliver(n2, l2, tol):
+    """Degenerate triangle: |n| = 2 area ~ 0 relative to its sides, or height over the longest side
+    <= tol (as `overlap.triangles_overlap`); n2 = |n|^2, l2 = squared side lengths."""
+    longest2 = max(l2[0], l2[1], l2[2])
+    return not (n2 > _AXIS_EPS2 * longest2 * longest2) or n2 <= tol * tol * longest2
+
+
+@njit(cache=True, inline="always")
+def _no_contact_on(a, b, ox, oy, oz, n, ref2, tol):
+    """True when axis n proves the triangles do not cross: a gap > tol, or a touching witness
+    (depth <= tol, unless both projections are thinner than tol). Near-zero axes prove nothing."""
+    nx, ny, nz = n
+    l2 = nx * nx + ny * ny + nz * nz
+    if not (l2 > _AXIS_EPS2 * ref2):
+        return False
+    inv = 1.0 / math.sqrt(l2)
+    nx *= inv
+    ny *= inv
+    nz *= inv
+    amin = np.inf
+    amax = -np.inf
+    bmin = np.inf
+    bmax = -np.inf
+    for k in range(3):
+        s = nx * (a[k, 0] - ox) + ny * (a[k, 1] - oy) + nz * (a[k, 2] - oz)
+        t = nx * (b[k, 0] - ox) + ny * (b[k, 1] - oy) + nz * (b[k, 2] - oz)
+        amin = min(amin, s)
+        amax = max(amax, s)
+        bmin = min(bmin, t)
+        bmax = max(bmax, t)
+    depth = min(amax - bmin, bmax - amin)
+    if depth < -tol:
+        return True  # strictly apart
+    if depth <= tol and (amax - amin > tol or bmax - bmin > tol):
+        return True  # touching witness (a common normal of coplanar faces is no witness)
+    return False
+
+
+@njit(cache=True)
+def triangles_collide(a, b, tol):
+    """True if 3D triangles a, b (3, 3) cross each other (relative interiors meet, beyond tol).
+
+    Separating-axis test on the 17 candidate axes (2 normals, 6 in-plane edge normals, 9 edge x
+    edge; in that order, likeliest verdicts first). Touching (shared vertex or edge, contact
+    without crossing) is not a collision; coplanar overlapping interiors are. Degenerate triangles (zero area, or every corner within tol
+    of the line of the longest side) never collide.
+    """
+    ox = a[0, 0]
+    oy = a[0, 1]
+    oz = a[0, 2]
+    # edges e_k = v_{k+1} - v_k as tuples (no heap allocation in the hot loop)
+    ea = (_edge(a, 0), _edge(a, 1), _edge(a, 2))
+    eb = (_edge(b, 0), _edge(b, 1), _edge(b, 2))
+    la = (_dot(ea[0], ea[0]), _dot(ea[1], ea[1]), _dot(ea[2], ea[2]))
+    lb = (_dot(eb[0], eb[0]), _dot(eb[1], eb[1]), _dot(eb[2], eb[2]))
+    na = _cross(ea[0], ea[1])
+    nb = _cross(eb[0], eb[1])
+    na2 = _dot(na, na)
+    nb2 = _dot(nb, nb)
+    if _is_sliver(na2, la, tol) or _is_sliver(nb2, lb, tol):
+        return False  # (near) zero-area triangle: no interior
+    if _no_contact_on(a, b, ox, oy, oz, na, la[0] * la[1], tol):
+        return False
+    if _no_contact_on(a, b, ox, oy, oz, nb, lb[0] * lb[1], tol):
+        return False
+    for k in range(3):
+        # in-plane edge normals n_A x e_A and n_B x e_B
+        if _no_contact_on(a, b, ox, oy, oz, _cross(na, ea[k]), na2 * la[k], tol):
+            return False
+        if _no_contact_on(a, b, ox, oy, oz, _cross(nb, eb[k]), nb2 * lb[k], tol):
+            return False
+    for i in range(3):
+        for j in range(3):
+            if _no_contact_on(a, b, ox, oy, oz, _cross(ea[i], eb[j]), la[i] * lb[j], tol):
+                return False
+    return True
+
+
+@njit(cache=True)
+def _boxes(tris):
+    n = tris.shape[0]
+    lo = np.empty((n, 3))
+    hi = np.empty((n, 3))
+    for f in range(n):
+        for i in range(3):
+            lo[f, i] = min(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
+            hi[f, i] = max(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
+    return lo, hi
+
+
+@njit(cache=True)
+def _sweep(tris, parent, piece, tol, max_pairs, pairs):
+    """Sort-and-sweep on x over the faces' AABBs; a pair is a candidate unless its boxes are apart
+    by more than tol on x, y or z; same piece, not a crease pair. Stops after max_pairs hits
+    (writing them to pairs); returns the number of hits found."""
+    n = tris.shape[0]
+    lo, hi = _boxes(tris)
+    xs = np.argsort(lo[:, 0])
+    count = 0
+    for ii in range(n):
+        i = xs[ii]
+        for jj in range(ii + 1, n):
+            j = xs[jj]
+            if lo[j, 0] - hi[i, 0] > tol:
+                break
+            if lo[j, 1] - hi[i, 1] > tol or lo[i, 1] - hi[j, 1] > tol:
+                continue
+            if lo[j, 2] - hi[i, 2] > tol or lo[i, 2] - hi[j, 2] > tol:
+                continue
+            if piece[i] != piece[j] or parent[i] == j or parent[j] == i:
+                continue
+            if triangles_collide(tris[i], tris[j], tol):
+                if count < pairs.shape[0]:
+                    pairs[count, 0] = min(i, j)
+                    pairs[count, 1] = max(i, j)
+                count += 1
+                if count >= max_pairs:
+                    return count
+    return count
+
+
+@njit(cache=True)
+def first_collision(tris, parent, piece, tol):
+    """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1)."""
+    pairs = np.empty((1, 2), dtype=np.int64)
+    if _sweep(tris, parent, piece, tol, 1, pairs) > 0:
+        return pairs[0, 0], pairs[0, 1]
+    return -1, -1
+
+
+@njit(cache=True)
+def all_collisions(tris, parent, piece, tol, max_pairs):
+    """(count, pairs): all colliding pairs (count), the first min(count, max_pairs) of them."""
+    pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
+    count = _sweep(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs])
+    return count, pairs[: min(count, max_pairs)]
+
+
+@njit(cache=True)
+def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+    """forward_kinematics into (R, T, out), then first_collision: True if q self-intersects."""
+    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
+    i, _ = first_collision(out, parent, piece, tol)
+    return i >= 0
+
+
+# --------------------------------------------------------------------------------------------------
+# the tree of a FOLD net
+# --------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class FoldTree:
+    """Arrays of a FOLD net for the kernels (see the module docstring for the conventions).
+
+    flat (F, 3, 3) flat corners (x, y, 0) in faces_vertices order; faces (F, 3) net vertex ids;
+    order (F,) parents first; parent / crease (F,) parent face and crease edge index, -1 at roots;
+    axis (F, 2) the parent's corners at the crease ends, a -> b in the parent's CCW order;
+    piece (F,); goal (E,) goal angle per edge (rho, radians; 0 for cuts); creases (n,) the tree
+    creases (the DOF), ascending; scale = bounding-box diagonal (foldedForm, else flat net);
+    tol = contact tolerance (CONTACT_TOL * scale); folded (V, 3) foldedForm coords or None.
+    """
+
+    flat: np.ndarray
+    faces: np.ndarray
+    order: np.ndarray
+    parent: np.ndarray
+    crease: np.ndarray
+    axis: np.ndarray
+    piece: np.ndarray
+    goal: np.ndarray
+    creases: np.ndarray
+    scale: float
+    tol: float
+    folded: np.ndarray | None
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.goal)
+
+    def buffers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Fresh (R, T, out) work arrays for forward_kinematics / config_collides."""
+        n = self.n_faces
+        return np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3, 3))
+
+
+def _fail(message: str) -> PolyfoldError:
+    return PolyfoldError(f"malformed net: {message}")
+
+
+def _int_array(fold: dict, key: str, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
+    try:
+        arr = np.asarray(fold[key])
+        if arr.size == 0:
+            arr = arr.reshape((0,) + shape_tail)
+        if arr.dtype == object or arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
+            raise ValueError
+        if not np.issubdtype(arr.dtype, np.integer):
+            if not np.issubdtype(arr.dtype, np.floating) or not np.all(arr == np.round(arr)):
+                raise ValueError
+        return arr.astype(np.int64)
+    except (ValueError, TypeError):
+        raise _fail(f"{key!r} is not a list of {what}") from None
+
+
+def _float_array(value, key: str, n_cols: tuple[int, ...]) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (ValueError, TypeError):
+        raise _fail(f"{key!r} is not a list of coordinates") from None
+    if arr.ndim != 2 or arr.shape[1] not in n_cols:
+        raise _fail(f"{key!r} must hold {' or '.join(map(str, n_cols))} coordinates per vertex")
+    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
+    if len(bad):
+        raise _fail(f"{key!r}: vertex {bad[0]} has a non-finite coordinate")
+    return arr
+
+
+def _bbox_diagonal(pts: np.ndarray) -> float:
+    return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
+
+
+def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
+    frames = fold.get("file_frames")
+    if not frames:
+        return None
+    frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frames[0])
+    if not isinstance(frame, dict) or "vertices_coords" not in frame:
+        return None
+    coords = _float_array(frame["vertices_coords"], "file_frames[0].vertices_coords", (3,))
+    if len(coords) != n_v:
+        raise _fail(f"the foldedForm frame has {len(coords)} vertices, the net has {n_v}")
+    return coords
+
+
+def _bfs_tree(n_f: int, neighbours: list[list[tuple[int, int]]], piece_in: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Parent and crease of every face: BFS over creases from the lowest unvisited face."""
+    parent = np.full(n_f, -1, dtype=np.int64)
+    crease = np.full(n_f, -1, dtype=np.int64)
+    seen = np.zeros(n_f, dtype=bool)
+    for root in range(n_f):
+        if seen[root]:
+            continue
+        seen[root] = True
+        queue = deque([root])
+        while queue:
+            f = queue.popleft()
+            for g, e in neighbours[f]:
+                if seen[g]:
+                    continue
+                if piece_in is not None and piece_in[g] != piece_in[f]:
+                    raise _fail(f"crease edge {e} joins face {f} (piece {piece_in[f]}) to face {g} (piece {piece_in[g]})")
+                seen[g] = True
+                parent[g] = f
+                crease[g] = e
+                queue.append(g)
+    return parent, crease
+
+
+def _goal_angles(fold: dict, assign: list[str], edges: np.ndarray, edge_faces: np.ndarray, faces: np.ndarray, folded: np.ndarray | None) -> np.ndarray:
+    n_e = len(edges)
+    is_cut = np.array([a in _CUT for a in assign], dtype=bool)
+    if "edges_foldAngle" in fold:
+        try:
+            deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
+        except (ValueError, TypeError):
+            raise _fail("'edges_foldAngle' is not a list of numbers") from None
+        if deg.shape != (n_e,):
+            raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
+        for e in range(n_e):
+            if is_cut[e]:
+                continue
+            d = deg[e]
+            if not np.isfinite(d) or abs(d) > 180.0:
+                raise _fail(f"edge {e} has fold angle {d} (must be within [-180, 180] degrees)")
+            if (assign[e] == "M" and d > 0) or (assign[e] == "V" and d < 0):
+                raise _fail(f"edge {e} is a {'mountain' if assign[e] == 'M' else 'valley'} with fold angle {d} "
+                            "(FOLD: valley positive, mountain negative)")
+        return np.where(is_cut, 0.0, -np.radians(deg))
+    goal = np.zeros(n_e)
+    for e in range(n_e):
+        if is_cut[e]:
+            continue
+        if folded is not None and edge_faces[e, 1] >= 0:
+            f0, f1 = edge_faces[e]
+            u, v = edges[e]
+            k = int(np.flatnonzero(faces[f0] == u)[0])
+            a, b = (u, v) if faces[f0][(k + 1) % 3] == v else (v, u)
+            n0 = np.cross(*(folded[faces[f0][1:]] - folded[faces[f0][0]]))
+            n1 = np.cross(*(folded[faces[f1][1:]] - folded[faces[f1][0]]))
+            n0 /= max(np.linalg.norm(n0), 1e-300)
+            n1 /= max(np.linalg.norm(n1), 1e-300)
+            goal[e] = math.atan2(float(np.cross(n0, n1) @ (folded[b] - folded[a])) / max(np.linalg.norm(folded[b] - folded[a]), 1e-300),
+                                 float(n0 @ n1))
+        elif assign[e] in ("M", "V"):
+            goal[e] = math.pi if assign[e] == "M" else -math.pi
+    return goal
+
+
+def fold_tree(fold: dict) -> FoldTree:
+    """The FoldTree of a FOLD net (as written by `foldfile.net_to_fold`).
+
+    Uses `polyfold:faces_parent` when present, else a BFS over the crease (non-B) edges from the
+    lowest-index face of each piece. Raises PolyfoldError (one line naming the face / edge) when the
+    net cannot be folded: non-triangular faces, bad indices, clockwise faces, a parent that is not
+    joined by a crease, cycles, pieces inconsistent with the tree, zero-length creases, ...
+    """
+    if not isinstance(fold, dict):
+        raise _fail("not a FOLD dict")
+    for key in ("vertices_coords", "faces_vertices", "edges_vertices", "edges_assignment"):
+        if key not in fold:
+            raise _fail(f"no {key!r}")
+    xy = _float_array(fold["vertices_coords"], "vertices_coords", (2, 3))
+    n_v = len(xy)
+    folded = _folded_coords(fold, n_v)
+    scale = _bbox_diagonal(folded if folded is not None else xy)
+    if not scale > 0:
+        raise _fail("the net has zero size")
+    if xy.shape[1] == 3:
+        bad = np.flatnonzero(np.abs(xy[:, 2]) > 1e-9 * scale)
+        if len(bad):
+            raise _fail(f"vertex {bad[0]} of the crease pattern is not in the plane z = 0")
+        xy = xy[:, :2]
+    for f, corners in enumerate(fold["faces_vertices"]):
+        if not isinstance(corners, (list, tuple, np.ndarray)) or len(corners) != 3:
+            raise _fail(f"face {f} is not a triangle (only triangulated nets can be folded)")
+    faces = _int_array(fold, "faces_vertices", (3,), "vertex triples")
+    n_f = len(faces)
+    if n_f == 0:
+        raise _fail("no faces")
+    bad = np.flatnonzero(((faces < 0) | (faces >= n_v)).any(axis=1))
+    if len(bad):
+        raise _fail(f"face {bad[0]} refers to a vertex outside 0..{n_v - 1}")
+    bad = np.flatnonzero((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0]))
+    if len(bad):
+        raise _fail(f"face {bad[0]} repeats a vertex")
+    edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
+    n_e = len(edges)
+    assign = fold["edges_assignment"]
+    if not isinstance(assign, (list, tuple)) or len(assign) != n_e:
+        raise _fail(f"'edges_assignment' must have one entry per edge ({n_e})")
+    assign = [str(a).upper() for a in assign]
+    for e, a in enumerate(assign):
+        if a not in _CUT + _CREASE:
+            raise _fail(f"edge {e} has unknown assignment {a!r}")
+    bad = np.flatnonzero(((edges < 0) | (edges >= n_v)).any(axis=1) | (edges[:, 0] == edges[:, 1]))
+    if len(bad):
+        raise _fail(f"edge {bad[0]} has invalid vertices {edges[bad[0]].tolist()}")
+    edge_of: dict[tuple[int, int], int] = {}
+    for e, (u, v) in enumerate(edges.tolist()):
+        key = (min(u, v), max(u, v))
+        if key in edge_of:
+            raise _fail(f"edges {edge_of[key]} and {e} join the same vertices {list(key)}")
+        edge_of[key] = e
+
+    # faces' sides -> edges; edge -> faces
+    face_edges = np.empty((n_f, 3), dtype=np.int64)
+    edge_faces = np.full((n_e, 2), -1, dtype=np.int64)
+    for f, (v0, v1, v2) in enumerate(faces.tolist()):
+        for k, (u, v) in enumerate(((v0, v1), (v1, v2), (v2, v0))):
+            e = edge_of.get((min(u, v), max(u, v)))
+            if e is None:
+                raise _fail(f"side {u}-{v} of face {f} is not in 'edges_vertices'")
+            face_edges[f, k] = e
+            if edge_faces[e, 0] < 0:
+                edge_faces[e, 0] = f
+            elif edge_faces[e, 1] < 0:
+                edge_faces[e, 1] = f
+            else:
+                raise _fail(f"edge {e} borders more than two faces")
+    flat2 = xy[faces]
+    area2 = ((flat2[:, 1, 0] - flat2[:, 0, 0]) * (flat2[:, 2, 1] - flat2[:, 0, 1])
+             - (flat2[:, 1, 1] - flat2[:, 0, 1]) * (flat2[:, 2, 0] - flat2[:, 0, 0]))
+    bad = np.flatnonzero(area2 < -1e-12 * scale * scale)
+    if len(bad):
+        raise _fail(f"face {bad[0]} is clockwise seen from +z (faces must be CCW, outer side up)")
+
+    piece_in = None
+    if "polyfold:faces_piece" in fold:
+        piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
+        if len(piece_in) != n_f:
+            raise _fail(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
+
+    # the tree
+    if "polyfold:faces_parent" in fold:
+        parent = _int_array(fold, "polyfold:faces_parent", (), "integers")
+        if len(parent) != n_f:
+            raise _fail(f"'polyfold:faces_parent' has {len(parent)} entries for {n_f} faces")
+        crease = np.full(n_f, -1, dtype=np.int64)
+        for f in range(n_f):
+            p = int(parent[f])
+            if p < -1 or p >= n_f or p == f:
+                raise _fail(f"face {f} has invalid parent {p}")
+            if p < 0:
+                continue
+            common = [e for e in face_edges[f] if e in face_edges[p]]
+            if not common:
+                raise _fail(f"face {f} shares no edge with its parent face {p}")
+            e = int(common[0])
+            if assign[e] in _CUT:
+                raise _fail(f"face {f} is joined to its parent face {p} by cut edge {e} (assignment {assign[e]})")
+            crease[f] = e
+    else:
+        neighbours: list[list[tuple[int, int]]] = [[] for _ in range(n_f)]
+        for e in range(n_e):
+            f0, f1 = edge_faces[e]
+            if f1 >= 0 and assign[e] not in _CUT:
+                neighbours[f0].append((int(f1), e))
+                neighbours[f1].append((int(f0), e))
+        parent, crease = _bfs_tree(n_f, neighbours, piece_in)
+
+    # order: BFS from the roots, parents first
+    children: list[list[int]] = [[] for _ in range(n_f)]
+    for f in range(n_f):
+        if parent[f] >= 0:
+            children[parent[f]].append(f)
+    order = []
+    tree_of = np.full(n_f, -1, dtype=np.int64)
+    for root in np.flatnonzero(parent < 0).tolist():
+        tree_of[root] = root
+        queue = deque([root])
+        while queue:
+            f = queue.popleft()
+            order.append(f)
+            for g in children[f]:
+                tree_of[g] = root
+                queue.append(g)
+    if len(order) != n_f:
+        stuck = int(np.flatnonzero(tree_of < 0)[0])
+        raise _fail(f"face {stuck} is on a cycle of 'polyfold:faces_parent' (no path to a root)")
+    order = np.asarray(order, dtype=np.int64)
+
+    # pieces: one tree each
+    if piece_in is not None:
+        piece = piece_in
+        child = np.flatnonzero(parent >= 0)
+        bad = child[piece[child] != piece[parent[child]]]
+        if len(bad):
+            f = int(bad[0])
+            raise _fail(f"face {f} (piece {piece[f]}) has its parent face {parent[f]} in piece {piece[parent[f]]}")
+        roots = np.flatnonzero(parent < 0)
+        ids, counts = np.unique(piece[roots], return_counts=True)
+        if (counts > 1).any():
+            k = ids[np.argmax(counts > 1)]
+            r = roots[piece[roots] == k]
+            raise _fail(f"piece {k} is not connected by creases (faces {r[0]} and {r[1]} are both roots)")
+    else:
+        roots = np.flatnonzero(parent < 0)
+        label = np.full(n_f, -1, dtype=np.int64)
+        label[roots] = np.arange(len(roots))
+        piece = label[tree_of]
+
+    # crease axes in the parent, a -> b along the parent's CCW order
+    axis = np.full((n_f, 2), -1, dtype=np.int64)
+    for f in np.flatnonzero(parent >= 0).tolist():
+        p, e = int(parent[f]), int(crease[f])
+        u, v = edges[e]
+        k = int(np.flatnonzero(faces[p] == u)[0])
+        kv = int(np.flatnonzero(faces[p] == v)[0])
+        axis[f] = (k, kv) if (k + 1) % 3 == kv else (kv, k)
+        if not np.linalg.norm(xy[u] - xy[v]) > 1e-12 * scale:
+            raise _fail(f"crease edge {e} (between faces {p} and {f}) has zero length")
+
+    goal = _goal_angles(fold, assign, edges, edge_faces, faces, folded)
+    creases = np.sort(crease[crease >= 0])
+    flat = np.zeros((n_f, 3, 3))
+    flat[:, :, :2] = flat2
+    return FoldTree(
+        flat=flat, faces=faces, order=order, parent=parent.astype(np.int64), crease=crease, axis=axis,
+        piece=np.ascontiguousarray(piece, dtype=np.int64), goal=goal, creases=creases, scale=scale,
+        tol=CONTACT_TOL * scale, folded=folded,
+    )
+
+
+# --------------------------------------------------------------------------------------------------
+# wrappers
+# --------------------------------------------------------------------------------------------------
+
+
+def _config(tree: FoldTree, q) -> np.ndarray:
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    if q.shape != (tree.n_edges,):
+        raise ValueError(f"q must have one angle per net edge: shape ({tree.n_edges},), got {q.shape}")
+    return q
+
+
+def fold_positions(tree: FoldTree, q: np.ndarray) -> np.ndarray:
+    """Folded face corners (F, 3, 3) at configuration q (E,) (radians, rho convention)."""
+    R, T, out = tree.buffers()
+    return forward_kinematics(_config(tree, q), tree.order, tree.parent, tree.crease, tree.axis, tree.flat, R, T, out)
+
+
+def collides(tree: FoldTree, q: np.ndarray) -> bool:
+    """True if the net folded to q self-intersects."""
+    R, T, out = tree.buffers()
+    return bool(config_collides(_config(tree, q), tree.order, tree.parent, tree.crease, tree.axis, tree.flat,
+                                tree.piece, tree.tol, R, T, out))
+
+
+def colliding_pairs(tree: FoldTree, q: np.ndarray) -> np.ndarray:
+    """All colliding face pairs (k, 2), i < j, sorted, of the net folded to q."""
+    tris = fold_positions(tree, q)
+    count, _ = all_collisions(tris, tree.parent, tree.piece, tree.tol, 0)
+    _, pairs = all_collisions(tris, tree.parent, tree.piece, tree.tol, int(count))
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
