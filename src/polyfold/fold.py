@@ -12,7 +12,6 @@ re-validated at half the resolution before it is reported.
 
 from __future__ import annotations
 
-import heapq
 import math
 import time
 from dataclasses import dataclass
@@ -20,7 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .kinematics import FoldTree, config_collides
+from .kinematics import FoldTree, config_collides, config_collides_moving
+
+COARSE_SAMPLES = 7  # bisection levels 1-3 of a segment: the cheap first look of the Lazy PRM
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,22 +67,34 @@ def _bisection_order(m: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, R, T, out, q) -> tuple:
+def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, R, T, out, q, max_samples) -> tuple:
     """Check the straight segment qa -> qb at interior samples k/m, m = ceil(max|qb - qa| / step).
 
-    Endpoints are assumed valid. Returns (free, configurations checked).
+    Samples go in bisection order; only the first `max_samples` are checked (a cheap coarse test
+    when small; pass a huge number for the full check). Endpoints are assumed valid. Returns
+    (free, configurations checked).
     """
     span = 0.0
     for i in range(qa.shape[0]):
         span = max(span, abs(qb[i] - qa[i]))
     m = int(math.ceil(span / step - 1e-12))
+    # Rigid groups: faces joined through creases that do not move on this segment keep their
+    # relative pose, and both endpoints are valid, so pairs inside one group are skipped.
+    rigid = np.empty(order.shape[0], dtype=np.int64)
+    for f in order:
+        if parent[f] < 0 or qa[crease[f]] != qb[crease[f]]:
+            rigid[f] = f
+        else:
+            rigid[f] = rigid[parent[f]]
     checked = 0
     for k in _bisection_order(m):
+        if checked >= max_samples:
+            break
         t = k / m
         for i in range(qa.shape[0]):
             q[i] = qa[i] + t * (qb[i] - qa[i])
         checked += 1
-        if config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+        if config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out):
             return False, checked
     return True, checked
 
@@ -105,11 +118,11 @@ class _Checker:
         self.configs += 1
         return not config_collides(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, self.R, self.T, self.out)
 
-    def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None) -> bool:
+    def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
         t = self.tree
         self.edges += 1
         free, n = segment_free(qa, qb, self.step if step is None else step, t.order, t.parent, t.crease, t.axis,
-                               t.flat, t.piece, t.tol, self.R, self.T, self.out, self.q)
+                               t.flat, t.piece, t.tol, self.R, self.T, self.out, self.q, max_samples)
         self.configs += n
         return bool(free)
 
@@ -177,8 +190,145 @@ def plan_fold(
     return done(frames, len(frames) == 2, "lazy-prm", nodes)
 
 
+@njit(cache=True)
+def _astar(indptr, nbr, eid, weight, blocked, h, start, goal):
+    """A* on the roadmap (CSR; edges with blocked[e] skipped). Returns the node path or empty."""
+    n = indptr.shape[0] - 1
+    g = np.full(n, np.inf)
+    prev = np.full(n, -1, dtype=np.int64)
+    closed = np.zeros(n, dtype=np.bool_)
+    cap = nbr.shape[0] + 1
+    hk = np.empty(cap)
+    hn = np.empty(cap, dtype=np.int64)
+    size = 0
+    g[start] = 0.0
+    hk[0] = h[start]
+    hn[0] = start
+    size = 1
+    while size > 0:
+        # pop min
+        u = hn[0]
+        size -= 1
+        hk[0] = hk[size]
+        hn[0] = hn[size]
+        i = 0
+        while True:
+            c = 2 * i + 1
+            if c >= size:
+                break
+            if c + 1 < size and hk[c + 1] < hk[c]:
+                c += 1
+            if hk[i] <= hk[c]:
+                break
+            hk[i], hk[c] = hk[c], hk[i]
+            hn[i], hn[c] = hn[c], hn[i]
+            i = c
+        if closed[u]:
+            continue
+        if u == goal:
+            length = 1
+            x = u
+            while prev[x] >= 0:
+                x = prev[x]
+                length += 1
+            path = np.empty(length, dtype=np.int64)
+            x = u
+            for m in range(length - 1, -1, -1):
+                path[m] = x
+                x = prev[x]
+            return path
+        closed[u] = True
+        for k in range(indptr[u], indptr[u + 1]):
+            if blocked[eid[k]]:
+                continue
+            v = nbr[k]
+            ng = g[u] + weight[eid[k]]
+            if ng < g[v]:
+                g[v] = ng
+                prev[v] = u
+                if size >= cap:
+                    continue
+                i = size
+                hk[i] = ng + h[v]
+                hn[i] = v
+                size += 1
+                while i > 0:
+                    par = (i - 1) >> 1
+                    if hk[par] <= hk[i]:
+                        break
+                    hk[par], hk[i] = hk[i], hk[par]
+                    hn[par], hn[i] = hn[i], hn[par]
+                    i = par
+    return np.empty(0, dtype=np.int64)
+
+
+class _Roadmap:
+    """Nodes (bit vectors) and lazily checked edges; CSR adjacency rebuilt when nodes are added."""
+
+    UNKNOWN, COARSE_OK, FREE, BLOCKED = 0, 1, 2, 3
+
+    def __init__(self, n_bits: int, weight_scale: np.ndarray):
+        self.bits: list[np.ndarray] = []
+        self.weight_scale = weight_scale
+        self.n_bits = n_bits
+        self.edge_id: dict[tuple[int, int], int] = {}
+        self.eu: list[int] = []
+        self.ev: list[int] = []
+        self.ew: list[float] = []
+        self.state = np.zeros(0, dtype=np.int8)
+
+    def add_nodes(self, new: list[np.ndarray], k: int) -> None:
+        first = len(self.bits)
+        self.bits.extend(new)
+        B = np.array(self.bits)
+        W = B * self.weight_scale
+        rows = np.arange(first, len(self.bits))
+        if len(rows):
+            ham = (B[rows, None, :] != B[None, :, :]).sum(axis=2)  # (new, all) Hamming distances
+            ham[np.arange(len(rows)), rows] = self.n_bits + 1
+            kk = min(k, len(self.bits) - 1)
+            nearest = np.argsort(ham, axis=1, kind="stable")[:, :kk]
+            r_near, c_near = np.repeat(np.arange(len(rows)), kk), nearest.ravel()
+            r_one, c_one = np.nonzero(ham == 1)  # every neighbour at Hamming distance 1
+            r = np.concatenate([r_near, r_one])
+            c = np.concatenate([c_near, c_one])
+            i, j = rows[r], c
+            keys = np.unique(np.stack([np.minimum(i, j), np.maximum(i, j)], axis=1), axis=0)
+            keys = keys[keys[:, 0] != keys[:, 1]]
+            weights = np.linalg.norm(W[keys[:, 0]] - W[keys[:, 1]], axis=1)  # Euclidean distance of the q's
+            for (a, b), w in zip(keys.tolist(), weights.tolist()):
+                if (a, b) not in self.edge_id:
+                    self.edge_id[(a, b)] = len(self.eu)
+                    self.eu.append(a)
+                    self.ev.append(b)
+                    self.ew.append(w)
+        state = np.zeros(len(self.eu), dtype=np.int8)
+        state[: len(self.state)] = self.state
+        self.state = state
+        eu, ev = np.array(self.eu, dtype=np.int64), np.array(self.ev, dtype=np.int64)
+        src = np.concatenate([eu, ev])
+        dst = np.concatenate([ev, eu])
+        ids = np.concatenate([np.arange(len(eu)), np.arange(len(eu))])
+        order = np.argsort(src, kind="stable")
+        self.indptr = np.searchsorted(src[order], np.arange(len(self.bits) + 1)).astype(np.int64)
+        self.nbr = dst[order]
+        self.eid = ids[order]
+        self.weight = np.array(self.ew)
+        goal = self.bits[1] * self.weight_scale
+        self.h = np.linalg.norm(W - goal, axis=1)
+
+    def shortest_path(self) -> np.ndarray:
+        return _astar(self.indptr, self.nbr, self.eid, self.weight, self.state == self.BLOCKED, self.h, 0, 1)
+
+
 def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator, n0: int, k: int):
-    """Lazy PRM over discrete configurations b in {0,1}^n, q = b * goal (ALGORITHMS.md 6.5)."""
+    """Lazy PRM over discrete configurations b in {0,1}^n, q = b * goal (ALGORITHMS.md 6.5).
+
+    Node 0 is the flat net, node 1 the goal. Edges are checked only when A* puts them on a
+    candidate path: first a coarse look at every edge of the path (the first bisection samples),
+    then the full check; blocked edges are dropped and A* runs again. More samples (doubling
+    batches) when the start and goal are disconnected.
+    """
     creases = tree.creases
     n = len(creases)
     goal_c = tree.goal[creases]
@@ -188,108 +338,59 @@ def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.G
         q[creases] = bits * goal_c
         return q
 
-    bits = [np.zeros(n, dtype=bool), np.ones(n, dtype=bool)]
-    seen = {bits[0].tobytes(), bits[1].tobytes()}
-    adj: list[dict[int, float]] = [{}, {}]
-    edge_state: dict[tuple[int, int], bool] = {}  # checked edges: True free, False blocked
-    weight_scale = np.abs(goal_c)
+    rm = _Roadmap(n, np.abs(goal_c))
+    seen = set()
+    start_bits, goal_bits = np.zeros(n, dtype=bool), np.ones(n, dtype=bool)
+    seen.update((start_bits.tobytes(), goal_bits.tobytes()))
+    rm.add_nodes([start_bits, goal_bits], k)
+
+    def check_edge(e: int, coarse: bool) -> bool:
+        st = rm.state[e]
+        if st == rm.BLOCKED:
+            return False
+        if st == rm.FREE or (coarse and st == rm.COARSE_OK):
+            return True
+        qa, qb = config(rm.bits[rm.eu[e]]), config(rm.bits[rm.ev[e]])
+        ok = check.segment(qa, qb, max_samples=COARSE_SAMPLES) if coarse else check.segment(qa, qb)
+        rm.state[e] = (rm.COARSE_OK if coarse else rm.FREE) if ok else rm.BLOCKED
+        return ok
+
     batch = n0
-    S, G = 0, 1
-
-    def dist(i: int, j: int) -> float:
-        return float(np.linalg.norm((bits[i] != bits[j]) * weight_scale))
-
-    def connect(new_ids: list[int]) -> None:
-        B = np.array(bits)
-        for i in new_ids:
-            ham = (B != B[i]).sum(axis=1)
-            ham[i] = n + 1
-            near = set(np.argsort(ham, kind="stable")[:k].tolist()) | set(np.flatnonzero(ham == 1).tolist())
-            for j in near:
-                if j == i or ham[j] > n:
-                    continue
-                key = (min(i, j), max(i, j))
-                if edge_state.get(key) is False:
-                    continue
-                w = dist(i, j)
-                adj[i][j] = w
-                adj[j][i] = w
-
-    def astar() -> list[int] | None:
-        h = lambda i: dist(i, G)
-        best = {S: 0.0}
-        prev = {S: -1}
-        heap = [(h(S), 0.0, S)]
-        closed = set()
-        while heap:
-            _, g, u = heapq.heappop(heap)
-            if u in closed:
-                continue
-            if u == G:
-                path = [u]
-                while prev[path[-1]] >= 0:
-                    path.append(prev[path[-1]])
-                return path[::-1]
-            closed.add(u)
-            for v, w in adj[u].items():
-                ng = g + w
-                if ng < best.get(v, math.inf):
-                    best[v] = ng
-                    prev[v] = u
-                    heapq.heappush(heap, (ng + h(v), ng, v))
-        return None
-
-    def edge_free(i: int, j: int) -> bool:
-        key = (min(i, j), max(i, j))
-        state = edge_state.get(key)
-        if state is None:
-            state = check.segment(config(bits[i]), config(bits[j]))
-            edge_state[key] = state
-        return state
-
-    connect([S, G])
     while time.perf_counter() < deadline:
-        new_ids = []
+        new = []
         tries = 0
-        while len(new_ids) < batch and tries < 20 * batch and time.perf_counter() < deadline:
+        while len(new) < batch and tries < 20 * batch and time.perf_counter() < deadline:
             tries += 1
-            p = rng.random()
-            b = rng.random(n) < p
+            b = rng.random(n) < rng.random()  # Hamming level p ~ U(0, 1), then bits ~ Bernoulli(p)
             key = b.tobytes()
             if key in seen:
                 continue
             seen.add(key)
-            if not check.valid(config(b)):
-                continue
-            bits.append(b)
-            adj.append({})
-            new_ids.append(len(bits) - 1)
-        connect(new_ids)
+            if check.valid(config(b)):
+                new.append(b)
+        rm.add_nodes(new, k)
         while time.perf_counter() < deadline:
-            path = astar()
-            if path is None:
+            path = rm.shortest_path()
+            if len(path) == 0:
                 break
-            blocked = False
-            for a, b in zip(path[:-1], path[1:]):
-                if not edge_free(a, b):
-                    adj[a].pop(b, None)
-                    adj[b].pop(a, None)
-                    blocked = True
-                    break
-            if blocked:
+            edges = [rm.edge_id[(min(a, b), max(a, b))] for a, b in zip(path[:-1].tolist(), path[1:].tolist())]
+            # Coarse pass over every edge of the path first: most blocked edges show up within a
+            # few samples, and dropping all of them at once saves A* runs and full checks of edges
+            # on paths that are blocked elsewhere anyway.
+            if not all([check_edge(e, True) for e in edges]):
                 continue
-            frames = _shortcut([config(bits[i]) for i in path], check, deadline)
-            bad = _path_free(check, frames, check.step / 2)  # re-validate at half the resolution
-            if bad < 0:
-                return frames, len(bits)
-            # A segment that only fails the finer check: drop the roadmap edge it came from.
-            for a, b in zip(path[:-1], path[1:]):
-                key = (min(a, b), max(a, b))
-                fa, fb = config(bits[a]), config(bits[b])
-                if not check.segment(fa, fb, check.step / 2):
-                    edge_state[key] = False
-                    adj[a].pop(b, None)
-                    adj[b].pop(a, None)
+            if not all(check_edge(e, False) for e in edges):
+                continue
+            raw = np.stack([config(rm.bits[i]) for i in path.tolist()])
+            frames = _shortcut(list(raw), check, deadline)
+            if _path_free(check, frames, check.step / 2) < 0:  # re-validate at half the resolution
+                return frames, len(rm.bits)
+            if _path_free(check, raw, check.step / 2) < 0:  # only a shortcut failed the finer check
+                return raw, len(rm.bits)
+            # Some roadmap edge fails only the finer check: block the ones that do.
+            for e in edges:
+                if not check.segment(config(rm.bits[rm.eu[e]]), config(rm.bits[rm.ev[e]]), check.step / 2):
+                    rm.state[e] = rm.BLOCKED
         batch *= 2
     return None
 

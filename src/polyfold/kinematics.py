@@ -217,10 +217,11 @@ def _boxes(tris):
 
 
 @njit(cache=True)
-def _sweep(tris, parent, piece, tol, max_pairs, pairs):
+def _sweep(tris, parent, piece, tol, max_pairs, pairs, rigid):
     """Sort-and-sweep on x over the faces' AABBs; a pair is a candidate unless its boxes are apart
-    by more than tol on x, y or z; same piece, not a crease pair. Stops after max_pairs hits
-    (writing them to pairs); returns the number of hits found."""
+    by more than tol on x, y or z; same piece, not a crease pair, and not in the same rigid group
+    (rigid[i] == rigid[j] >= 0: their relative pose is fixed, see `config_collides_moving`).
+    Stops after max_pairs hits (writing them to pairs); returns the number of hits found."""
     n = tris.shape[0]
     lo, hi = _boxes(tris)
     xs = np.argsort(lo[:, 0])
@@ -237,6 +238,8 @@ def _sweep(tris, parent, piece, tol, max_pairs, pairs):
                 continue
             if piece[i] != piece[j] or parent[i] == j or parent[j] == i:
                 continue
+            if rigid[i] >= 0 and rigid[i] == rigid[j]:
+                continue
             if triangles_collide(tris[i], tris[j], tol):
                 if count < pairs.shape[0]:
                     pairs[count, 0] = min(i, j)
@@ -251,7 +254,7 @@ def _sweep(tris, parent, piece, tol, max_pairs, pairs):
 def first_collision(tris, parent, piece, tol):
     """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1)."""
     pairs = np.empty((1, 2), dtype=np.int64)
-    if _sweep(tris, parent, piece, tol, 1, pairs) > 0:
+    if _sweep(tris, parent, piece, tol, 1, pairs, np.full(tris.shape[0], -1, dtype=np.int64)) > 0:
         return pairs[0, 0], pairs[0, 1]
     return -1, -1
 
@@ -260,7 +263,8 @@ def first_collision(tris, parent, piece, tol):
 def all_collisions(tris, parent, piece, tol, max_pairs):
     """(count, pairs): all colliding pairs (count), the first min(count, max_pairs) of them."""
     pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
-    count = _sweep(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs])
+    count = _sweep(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs],
+                   np.full(tris.shape[0], -1, dtype=np.int64))
     return count, pairs[: min(count, max_pairs)]
 
 
@@ -270,6 +274,19 @@ def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out)
     forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
     i, _ = first_collision(out, parent, piece, tol)
     return i >= 0
+
+
+@njit(cache=True)
+def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out):
+    """Like `config_collides`, but pairs with rigid[i] == rigid[j] >= 0 are not tested.
+
+    Along a segment on which only some creases move, faces joined by non-moving creases keep
+    their relative pose; if both endpoints are collision-free such pairs never collide, so a
+    planner can label those rigid groups once per segment and skip them.
+    """
+    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
+    pairs = np.empty((1, 2), dtype=np.int64)
+    return _sweep(out, parent, piece, tol, 1, pairs, rigid) > 0
 
 
 # --------------------------------------------------------------------------------------------------

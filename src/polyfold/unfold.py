@@ -226,34 +226,35 @@ def random_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
     return rng.random(mesh.topology.n_edges) + 0.01
 
 
+def _pick_random_incident(ends: np.ndarray, edge_ids: np.ndarray, vertices: np.ndarray, count: int,
+                          rng: np.random.Generator) -> np.ndarray:
+    """Up to `count` distinct random incident edges (from edge_ids, endpoints ends) per vertex in
+    `vertices`, vectorized: random keys sorted within each vertex."""
+    v = np.concatenate([ends[:, 0], ends[:, 1]])
+    e = np.concatenate([edge_ids, edge_ids])
+    want = np.zeros(int(v.max(initial=-1)) + 1 if len(v) else 0, dtype=bool)
+    want[vertices[vertices < len(want)]] = True
+    keep = want[v]
+    v, e = v[keep], e[keep]
+    order = np.lexsort((rng.random(len(v)), v))
+    v, e = v[order], e[order]
+    rank = np.arange(len(v)) - np.searchsorted(v, v)  # position within the vertex's group
+    return e[rank < count]
+
+
 def random_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
     """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none."""
     topo = mesh.topology
-    n_e = topo.n_edges
-    w = np.full(n_e, 0.01)
-    inner = topo.interior
-    # incident interior edges per vertex, in CSR form
-    e_ids = np.flatnonzero(inner)
+    w = np.full(topo.n_edges, 0.01)
+    e_ids = np.flatnonzero(topo.interior)
     ends = topo.edges[e_ids]
-    v = np.concatenate([ends[:, 0], ends[:, 1]])
-    ee = np.concatenate([e_ids, e_ids])
-    srt = np.argsort(v, kind="stable")
-    v, ee = v[srt], ee[srt]
-    starts = np.searchsorted(v, np.arange(mesh.n_vertices))
-    stops = np.searchsorted(v, np.arange(mesh.n_vertices), side="right")
     hyper = mesh.hyperbolic
-    for vert in np.flatnonzero(hyper):
-        inc = ee[starts[vert]:stops[vert]]
-        if len(inc) >= 2:
-            w[rng.choice(inc, 2, replace=False)] = 1.0
+    w[_pick_random_incident(ends, e_ids, np.flatnonzero(hyper), 2, rng)] = 1.0
     chosen = np.zeros(mesh.n_vertices, dtype=bool)
     cut = w >= 1.0
     chosen[topo.edges[cut, 0]] = True
     chosen[topo.edges[cut, 1]] = True
-    for vert in np.flatnonzero(~chosen & ~hyper):
-        inc = ee[starts[vert]:stops[vert]]
-        if len(inc):
-            w[rng.choice(inc)] = 1.0
+    w[_pick_random_incident(ends, e_ids, np.flatnonzero(~chosen & ~hyper), 1, rng)] = 1.0
     return w
 
 

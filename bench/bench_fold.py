@@ -1,0 +1,97 @@
+"""Folding benchmark (not a test): nets + collision-free folding paths for the paper's parts.
+
+For every part in ../shared/models/paper-parts and for periscope-28, periscope2-44 and bunny-128
+(whole meshes): DOF, linearly foldable?, net seconds, path seconds, frames. Targets (issue 3):
+every paper part gets a verified path; the 7 horse parts <= 0.25 s total net + path (paper:
+12.75 s); bunny-128 whole net + path <= 10 s (paper: 490 s); fish parts <= 2.5 s total (paper:
+119 s). Times are wall-clock seconds in one process with the numba kernels already compiled.
+
+    .venv/bin/python bench/bench_fold.py [--seeds 1] [--time-limit 60] [--prefer-linear]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from polyfold.errors import PolyfoldError
+from polyfold.fold import is_linearly_foldable, plan_fold
+from polyfold.foldfile import net_to_fold
+from polyfold.io import load_mesh
+from polyfold.kinematics import collides, fold_tree
+from polyfold.unfold import unfold
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
+
+
+def cases() -> list[tuple[str, str, Path]]:
+    out = []
+    for group in ("horse", "fish", "bunny-128"):
+        for p in sorted((MODELS / "paper-parts" / group).glob("part-*.obj")):
+            out.append((group, f"{group}/{p.stem}", p))
+    for name in ("periscope-28", "periscope2-44", "bunny-128"):
+        out.append(("whole", name, MODELS / f"{name}.obj"))
+    return out
+
+
+def run(path: Path, seed: int, time_limit: float, prefer_linear: bool) -> dict:
+    (mesh,) = load_mesh(path).components
+    accept = (lambda net: is_linearly_foldable(fold_tree(net_to_fold([net])))) if prefer_linear else None
+    t0 = time.perf_counter()
+    net, st = unfold(mesh, seed=seed, time_limit=time_limit, accept=accept)
+    t1 = time.perf_counter()
+    tree = fold_tree(net_to_fold([net]))
+    row = {"dof": len(tree.creases), "pieces": net.n_pieces, "net_s": t1 - t0}
+    if collides(tree, tree.goal):
+        row.update(path_s=float("nan"), frames=0, lc=None, note="goal shape itself self-intersects (input data)")
+        return row
+    try:
+        path = plan_fold(tree, resolution_deg=1.0, time_limit=time_limit, seed=seed)
+    except PolyfoldError as exc:
+        row.update(path_s=float("nan"), frames=0, lc=None, note=str(exc))
+        return row
+    t2 = time.perf_counter()
+    if path is None:
+        row.update(path_s=t2 - t1, frames=0, lc=False, note="no path within the time limit")
+    else:
+        row.update(path_s=t2 - t1, frames=len(path.frames), lc=path.linear, note=path.planner)
+    return row
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=1)
+    ap.add_argument("--time-limit", type=float, default=60.0)
+    ap.add_argument("--prefer-linear", action="store_true")
+    args = ap.parse_args()
+    run(MODELS / "tetrahedron-4.obj", 0, 10, False)  # compile / load the numba caches first
+    print(f"{'part':<22} {'seed':>4} {'DOF':>4} {'pcs':>3} {'LC':>5} {'net s':>7} {'path s':>7} {'total':>7} {'frames':>6}  planner / note")
+    totals: dict[tuple[str, int], float] = {}
+    failures = 0
+    for group, name, path in cases():
+        for seed in range(1, args.seeds + 1):
+            r = run(path, seed, args.time_limit, args.prefer_linear)
+            total = r["net_s"] + (0.0 if np.isnan(r["path_s"]) else r["path_s"])
+            key = (f"{name} (whole)" if group == "whole" else f"{group} parts", seed)
+            totals[key] = totals.get(key, 0.0) + total
+            failures += r["frames"] == 0
+            lc = "-" if r["lc"] is None else ("yes" if r["lc"] else "no")
+            print(f"{name:<22} {seed:>4} {r['dof']:>4} {r['pieces']:>3} {lc:>5} {r['net_s']:>7.3f} {r['path_s']:>7.3f} "
+                  f"{total:>7.3f} {r['frames']:>6}  {r['note']}", flush=True)
+    print()
+    targets = {"horse parts": 0.25, "fish parts": 2.5, "bunny-128 (whole)": 10.0}
+    print(f"{'group':<22} {'seed':>4} {'net+path s':>10}  target")
+    for (group, seed), total in totals.items():
+        t = targets.get(group)
+        verdict = f"<= {t:g} s: {'MET' if total <= t else 'MISSED'}" if t else ""
+        print(f"{group:<22} {seed:>4} {total:>10.3f}  {verdict}")
+    print(f"\nparts without a verified path: {failures}")
+
+
+if __name__ == "__main__":
+    main()
