@@ -321,6 +321,30 @@ class _Roadmap:
         return _astar(self.indptr, self.nbr, self.eid, self.weight, self.state == self.BLOCKED, self.h, 0, 1)
 
 
+def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
+    """Discrete states (bits per crease of tree.creases) folding the outer part of the tree first
+    or last: thresholds on the depth and on the subtree size of each crease's child face."""
+    n_f = len(tree.order)
+    depth = np.zeros(n_f, dtype=np.int64)
+    size = np.ones(n_f, dtype=np.int64)
+    for f in tree.order:
+        if tree.parent[f] >= 0:
+            depth[f] = depth[tree.parent[f]] + 1
+    for f in tree.order[::-1]:
+        if tree.parent[f] >= 0:
+            size[tree.parent[f]] += size[f]
+    child = np.full(len(tree.goal), -1, dtype=np.int64)
+    has = tree.crease >= 0
+    child[tree.crease[has]] = np.flatnonzero(has)
+    kids = child[tree.creases]
+    states = []
+    for key in (depth[kids], -size[kids]):
+        for thr in np.unique(np.quantile(key, np.linspace(0, 1, levels + 2)[1:-1], method="nearest")):
+            outer = key >= thr
+            states.extend([outer, ~outer])
+    return states
+
+
 def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator, n0: int, k: int):
     """Lazy PRM over discrete configurations b in {0,1}^n, q = b * goal (ALGORITHMS.md 6.5).
 
@@ -343,6 +367,16 @@ def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.G
     start_bits, goal_bits = np.zeros(n, dtype=bool), np.ones(n, dtype=bool)
     seen.update((start_bits.tobytes(), goal_bits.tobytes()))
     rm.add_nodes([start_bits, goal_bits], k)
+    # Natural folding orders as extra nodes: fold the outer branches first (by tree depth or by
+    # subtree size), or the inner ones first. Cheap, and they often give a 3-frame path at once.
+    seeded = []
+    for b in _ordered_states(tree):
+        key = b.tobytes()
+        if key not in seen:
+            seen.add(key)
+            if check.valid(config(b)):
+                seeded.append(b)
+    rm.add_nodes(seeded, k)
 
     def check_edge(e: int, coarse: bool) -> bool:
         st = rm.state[e]
