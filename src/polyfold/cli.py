@@ -130,11 +130,12 @@ def unfold(
     prefer_linear: bool = typer.Option(False, "--prefer-linear", help="Keep searching (within the time limit) for a net whose straight-line fold is collision-free."),
     planner: Planner = typer.Option(Planner.auto, "--planner", help="With --fold: folding planner."),
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="With --fold: collision-check step along path segments, degrees."),
+    contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
 ) -> None:
     """Unfold a mesh into overlap-free nets: one piece per component when one is found in time."""
     if max_pieces not in ("auto", "1"):
         _fail(f"--max-pieces must be 'auto' or '1', not {max_pieces!r}", 2)
-    from .errors import NoNetFound
+    from .errors import NoNetFound, PolyfoldError
     from .foldfile import dumps, net_to_fold
     from .io import atomic_write
     from .unfold import unfold as unfold_mesh
@@ -155,11 +156,17 @@ def unfold(
 
         accept = None
         if prefer_linear:
+            hopeless = []
+
             def accept(candidate, _res=resolution_deg) -> bool:
                 from .fold import is_linearly_foldable
-                from .kinematics import fold_tree
+                from .kinematics import collides, fold_tree
 
-                return is_linearly_foldable(fold_tree(net_to_fold([candidate])), _res)
+                tree = fold_tree(net_to_fold([candidate]), contact_tol)
+                if hopeless or collides(tree, tree.goal):
+                    hopeless.append(True)  # the shape itself intersects: no net can fold, stop looking
+                    return True
+                return is_linearly_foldable(tree, _res)
         try:
             net, st = unfold_mesh(comp, method=method.value, seed=seed + i, time_limit=budget,
                                   max_pieces=1 if max_pieces == "1" else None, progress=progress, accept=accept)
@@ -178,16 +185,23 @@ def unfold(
         from .kinematics import fold_tree
 
         remaining = max(1.0, time_limit - (time.perf_counter() - t0))
-        path = plan_fold(fold_tree(fold_dict), planner=planner.value, resolution_deg=resolution_deg,
-                         time_limit=remaining, seed=seed)
+        try:
+            path = plan_fold(fold_tree(fold_dict, contact_tol), planner=planner.value, resolution_deg=resolution_deg,
+                             time_limit=remaining, seed=seed)
+        except PolyfoldError as exc:  # e.g. the goal shape itself intersects: keep the valid flat net
+            atomic_write(output, dumps(fold_dict))
+            raise NoNetFound(f"{mesh.name}: {exc} (the flat net was written to {output.name})") from None
         if path is None:
             atomic_write(output, dumps(fold_dict))
             raise NoNetFound(f"{mesh.name}: no folding path found within the time limit "
                              f"(the flat net was written to {output.name})")
-        fold_dict = with_path(fold_dict, path, resolution_deg)
+        fold_dict = with_path(fold_dict, path, resolution_deg, contact_tol)
         path_note = f", folding path {len(path.frames)} frames ({path.planner}, {path.seconds:.2f} s)"
     if prefer_linear:
-        lc = all(s.accepted for s in stats)
+        from .fold import is_linearly_foldable
+        from .kinematics import fold_tree
+
+        lc = is_linearly_foldable(fold_tree(fold_dict, contact_tol), resolution_deg)
         path_note += ", linearly foldable" if lc else ", no linearly foldable net found in time"
     atomic_write(output, dumps(fold_dict))
     if svg is not None or png is not None:
@@ -220,6 +234,7 @@ def fold_cmd(
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="Collision-check step along path segments, degrees."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
     seed: int = typer.Option(1, "--seed", help="Random seed of the sampling planner."),
+    contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
 ) -> None:
     """Plan a continuous, collision-free folding path from the flat net to the folded shape."""
     from .errors import NoNetFound
@@ -229,12 +244,12 @@ def fold_cmd(
     from .kinematics import fold_tree
 
     fold = read_fold(net)
-    tree = fold_tree(fold)
+    tree = fold_tree(fold, contact_tol)
     path = plan_fold(tree, planner=planner.value, resolution_deg=resolution_deg, time_limit=time_limit, seed=seed)
     if path is None:
         raise NoNetFound(f"{net.name}: no folding path found in {time_limit:g} s with planner {planner.value} "
                          f"({len(tree.creases)} DOF); the flat net itself is still valid")
-    atomic_write(output, dumps(with_path(fold, path, resolution_deg)))
+    atomic_write(output, dumps(with_path(fold, path, resolution_deg, contact_tol)))
     _say(f"{net.name}: {len(tree.creases)} DOF, {'linearly foldable' if path.linear else 'not linearly foldable'}, "
          f"path {len(path.frames)} frames, {path.seconds:.2f} s, planner {path.planner}, "
          f"{path.edges_checked} segments / {path.configs_checked} configurations checked")
@@ -247,13 +262,14 @@ def cspace(
     samples: int = typer.Option(1000, "--samples", min=1, help="Configurations to sample."),
     strategy: Strategy = typer.Option(Strategy.discrete, "--strategy", help="discrete: each crease flat or at its goal; continuous: uniform between."),
     seed: int = typer.Option(1, "--seed"),
+    contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
 ) -> None:
     """Print the valid configuration ratio |C_valid| / |C_sampled| of a net (paper Fig. 5)."""
     from .fold import sample_ratio
     from .foldfile import read_fold
     from .kinematics import fold_tree
 
-    tree = fold_tree(read_fold(net))
+    tree = fold_tree(read_fold(net), contact_tol)
     valid, total = sample_ratio(tree, samples, strategy.value, seed)
     print(f"{net.name}: DOF {len(tree.creases)}, strategy {strategy.value}, valid {valid} / {total} = {valid / total:.6g}")
 

@@ -171,7 +171,14 @@ def plan_fold(
     if not check.valid(zero):
         raise PolyfoldError("the flat net overlaps itself: not a valid net")
     if not check.valid(goal):
-        raise PolyfoldError("the folded goal shape intersects itself: no folding path can exist")
+        from .kinematics import colliding_pairs
+
+        pairs = colliding_pairs(tree, goal)
+        raise PolyfoldError(
+            f"the folded goal shape intersects itself (net faces {pairs[0, 0]} and {pairs[0, 1]} cross, "
+            f"{len(pairs)} pair{'s' if len(pairs) != 1 else ''} in all, beyond the contact tolerance "
+            f"{tree.tol / tree.scale:.0e} of the model size): no folding path can exist; if that is within "
+            f"the paper's thickness, raise --contact-tol")
 
     def done(frames: np.ndarray, linear: bool, name: str, nodes: int) -> FoldPath:
         return FoldPath(frames=frames, linear=linear, planner=name, seconds=time.perf_counter() - t0,
@@ -462,9 +469,10 @@ def sample_ratio(tree: FoldTree, samples: int = 1000, strategy: str = "discrete"
     return valid, samples
 
 
-def with_path(fold: dict, path: FoldPath, resolution_deg: float) -> dict:
+def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float) -> dict:
     """A copy of the FOLD dict with the path: `polyfold:path` (frames of FOLD fold angles in
-    degrees, one per edge, 0 for B edges; first all 0, last = edges_foldAngle) and its facts."""
+    degrees, one per edge, 0 for B edges; first all 0, last = edges_foldAngle) and its facts
+    (planner, linear, resolution in degrees, contact tolerance relative to the model size)."""
     out = dict(fold)
     frames = path.degrees_fold()
     # The last frame is the goal itself: write the file's own angles so it matches bit for bit.
@@ -474,4 +482,5 @@ def with_path(fold: dict, path: FoldPath, resolution_deg: float) -> dict:
     out["polyfold:path_planner"] = path.planner
     out["polyfold:path_linear"] = bool(path.linear)
     out["polyfold:path_resolutionDeg"] = float(resolution_deg)
+    out["polyfold:path_contactTol"] = float(contact_tol)
     return out

@@ -446,7 +446,7 @@ def _goal_angles(fold: dict, assign: list[str], edges: np.ndarray, edge_faces: n
     return goal
 
 
-def fold_tree(fold: dict) -> FoldTree:
+def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     """The FoldTree of a FOLD net (as written by `foldfile.net_to_fold`).
 
     Uses `polyfold:faces_parent` when present, else a BFS over the crease (non-B) edges from the
@@ -617,7 +617,7 @@ def fold_tree(fold: dict) -> FoldTree:
     return FoldTree(
         flat=flat, faces=faces, order=order, parent=parent.astype(np.int64), crease=crease, axis=axis,
         piece=np.ascontiguousarray(piece, dtype=np.int64), goal=goal, creases=creases, scale=scale,
-        tol=CONTACT_TOL * scale, folded=folded,
+        tol=contact_tol * scale, folded=folded,
     )
 
 
