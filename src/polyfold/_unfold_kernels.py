@@ -324,3 +324,80 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
             tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
     crease[:] = best_crease
     return best, it
+
+
+@njit(cache=True)
+def tree_paths(parent, order, pairs):
+    """Tree paths between the faces of each pair, as CSR (ptr, members); a crease is named by its
+    child face. Parents must precede children in `order`."""
+    n = parent.shape[0]
+    depth = np.zeros(n, dtype=np.int64)
+    for idx in range(1, n):
+        f = order[idx]
+        if parent[f] >= 0:
+            depth[f] = depth[parent[f]] + 1
+    ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
+    total = 0
+    for r in range(pairs.shape[0]):
+        a = pairs[r, 0]
+        b = pairs[r, 1]
+        while a != b:
+            if depth[a] >= depth[b]:
+                a = parent[a]
+            else:
+                b = parent[b]
+            total += 1
+        ptr[r + 1] = total
+    members = np.empty(total, dtype=np.int64)
+    k = 0
+    for r in range(pairs.shape[0]):
+        a = pairs[r, 0]
+        b = pairs[r, 1]
+        while a != b:
+            if depth[a] >= depth[b]:
+                members[k] = a
+                a = parent[a]
+            else:
+                members[k] = b
+                b = parent[b]
+            k += 1
+    return ptr, members
+
+
+@njit(cache=True)
+def greedy_cover(ptr, members, n):
+    """Greedy set cover: repeatedly cut the crease on the most uncovered paths. Returns (n,) bool."""
+    n_rows = ptr.shape[0] - 1
+    count = np.zeros(n, dtype=np.int64)
+    for k in range(members.shape[0]):
+        count[members[k]] += 1
+    # crease -> rows (CSR)
+    cptr = np.zeros(n + 1, dtype=np.int64)
+    for k in range(members.shape[0]):
+        cptr[members[k] + 1] += 1
+    for c in range(n):
+        cptr[c + 1] += cptr[c]
+    fill = cptr[:-1].copy()
+    rows_of = np.empty(members.shape[0], dtype=np.int64)
+    for r in range(n_rows):
+        for k in range(ptr[r], ptr[r + 1]):
+            c = members[k]
+            rows_of[fill[c]] = r
+            fill[c] += 1
+    covered = np.zeros(n_rows, dtype=np.bool_)
+    chosen = np.zeros(n, dtype=np.bool_)
+    left = n_rows
+    while left > 0:
+        best = np.argmax(count)
+        if count[best] <= 0:
+            break
+        chosen[best] = True
+        for k in range(cptr[best], cptr[best + 1]):
+            r = rows_of[k]
+            if covered[r]:
+                continue
+            covered[r] = True
+            left -= 1
+            for m in range(ptr[r], ptr[r + 1]):
+                count[members[m]] -= 1
+    return chosen

@@ -438,7 +438,7 @@ def run_memetic(
     # Local-search effort per generation: enough to finish most nets, small enough to restart
     # from a fresh child when the search is stuck in a local minimum.
     chunk_iters = max(1000, 4 * mesh.n_faces)
-    step = 200
+    step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
     cap = 4 * mesh.n_faces
     generation = 0
     crease = np.zeros(n_e, dtype=np.bool_)
@@ -497,64 +497,41 @@ def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator, b
     return best_w, best_fit, tries
 
 
-def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray,
+                      exact_limit: int = 2000, exact_seconds: float = 5.0) -> np.ndarray:
     """Cut the fewest creases so no overlapping pair stays in one piece (ALGORITHMS.md 5.6).
 
     Greedy set cover of the tree paths between overlapping faces (crease on most uncovered paths
-    first), refined by an exact ILP when it is small. Returns a boolean mask (F,) of faces whose
-    crease to their parent is cut.
+    first, numba), refined by an exact ILP when the instance is small (at most `exact_limit`
+    candidate creases). Returns a boolean mask (F,) of faces whose crease to their parent is cut.
     """
     n = len(parent)
-    depth = np.zeros(n, dtype=np.int64)
-    for f in order[1:]:
-        depth[f] = depth[parent[f]] + 1
-    paths = []
-    for f, g in pairs:
-        path = []
-        a, b = int(f), int(g)
-        while a != b:  # climb to the lowest common ancestor; a crease is named by its child face
-            if depth[a] >= depth[b]:
-                path.append(a)
-                a = int(parent[a])
-            else:
-                path.append(b)
-                b = int(parent[b])
-        paths.append(path)
     cut = np.zeros(n, dtype=bool)
-    if not paths:
+    if len(pairs) == 0:
         return cut
-    candidates = sorted({c for p in paths for c in p})
-    col = {c: i for i, c in enumerate(candidates)}
-    rows = [[col[c] for c in p] for p in paths]
-    uncovered = set(range(len(rows)))
-    by_col: dict[int, list[int]] = {}
-    for r, cols in enumerate(rows):
-        for c in cols:
-            by_col.setdefault(c, []).append(r)
-    greedy = []
-    while uncovered:
-        c_best = max(by_col, key=lambda c: sum(1 for r in by_col[c] if r in uncovered))
-        greedy.append(c_best)
-        uncovered -= set(by_col[c_best])
-    chosen = greedy
-    if len(greedy) > 1 and len(candidates) <= 2000:
+    ptr, members = K.tree_paths(parent, order, np.ascontiguousarray(pairs, dtype=np.int64))
+    greedy = K.greedy_cover(ptr, members, n)
+    chosen = np.flatnonzero(greedy)
+    candidates = np.unique(members)
+    if len(chosen) > 1 and len(candidates) <= exact_limit:
         try:
             from scipy.optimize import Bounds, LinearConstraint, milp
-            from scipy.sparse import lil_matrix
+            from scipy.sparse import csr_matrix
 
-            A = lil_matrix((len(rows), len(candidates)))
-            for r, cols in enumerate(rows):
-                for c in cols:
-                    A[r, c] = 1
-            res = milp(np.ones(len(candidates)), constraints=LinearConstraint(A.tocsr(), lb=1, ub=np.inf),
-                       integrality=np.ones(len(candidates)), bounds=Bounds(0, 1), options={"time_limit": 5})
+            col = np.searchsorted(candidates, members)
+            rows = np.repeat(np.arange(len(ptr) - 1), np.diff(ptr))
+            A = csr_matrix((np.ones(len(members)), (rows, col)), shape=(len(ptr) - 1, len(candidates)))
+            A.data[:] = 1.0  # a crease listed twice on one path still counts once
+            res = milp(np.ones(len(candidates)), constraints=LinearConstraint(A, lb=1, ub=np.inf),
+                       integrality=np.ones(len(candidates)), bounds=Bounds(0, 1),
+                       options={"time_limit": exact_seconds})
             if res.x is not None and res.success:
-                exact = [i for i in range(len(candidates)) if res.x[i] > 0.5]
-                if len(exact) < len(greedy):
+                exact = candidates[res.x > 0.5]
+                if len(exact) < len(chosen):
                     chosen = exact
-        except Exception:  # ILP is only a refinement of the greedy cover
+        except Exception:  # the ILP is only a refinement of the greedy cover
             pass
-    cut[[candidates[i] for i in chosen]] = True
+    cut[chosen] = True
     return cut
 
 
@@ -609,8 +586,10 @@ def unfold(
         if accept is not None:
             def accept_genome(genome: np.ndarray) -> bool:
                 return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
+        # Large meshes: a smaller seed population, so the local search gets the time budget.
+        population = int(np.clip(200_000 // mesh.n_faces, 50, 400))
         weights, fitness, generations, evaluations, winner = run_memetic(
-            problem, rng, budget, progress=progress, accept=accept_genome)
+            problem, rng, budget, population=population, progress=progress, accept=accept_genome)
     elif method == "ga":
         weights, fitness, generations, evaluations, winner = run_ga(problem, rng, budget, progress=progress)
     else:
@@ -626,7 +605,7 @@ def unfold(
                 f"no single-piece net found in {time.perf_counter() - t0:.1f} s "
                 f"({generations} generations, best net has {len(pairs)} overlapping face pairs)"
             )
-        cut = split_into_pieces(parent, parent_edge, order, pairs)
+        cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5))
     net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
     accepted = None
     if accept is not None:
