@@ -54,6 +54,8 @@ class Report:
     configs_checked: int = 0
     step_deg: float = 1.0
     resolution_deg: float | None = None  # as stated in the file (polyfold:path_resolutionDeg)
+    tol_rel: float = 1e-7  # contact tolerance used, relative to the bounding-box diagonal
+    stated_tol_rel: float | None = None  # as stated in the file (polyfold:path_contactTol)
     first_collision: tuple[int, float, int, int] | None = None  # (segment, t, face i, face j)
     fold_error: float = 0.0  # last frame vs foldedForm after per-piece alignment, relative to the diagonal
     problems: list[str] = field(default_factory=list)
@@ -74,6 +76,7 @@ class Report:
             f"frames: {self.frames}",
             f"segments: {self.segments}",
             f"step: {self.step_deg:g} deg (file states {self.resolution_deg})",
+            f"contact tolerance: {self.tol_rel:g} of the diagonal (file states {self.stated_tol_rel})",
             f"configurations checked: {self.configs_checked}",
             f"fold error: {self.fold_error:.3g}",
             f"first collision: {hit}",
@@ -143,22 +146,52 @@ def _edges_through(X, Y, d, nY, tol):
 
 def _chord(X, d, direction, tol):
     """Interval (lo, hi) along `direction` of X's intersection with the other plane (d: signed
-    distances of X's corners to it): corners within tol of it and edge crossings."""
+    distances of X's corners to it): corners within tol of it and edge crossings; and a point of
+    that intersection (K, 3) with its parameter (K,), to place the line."""
     lo = np.full(len(X), np.inf)
     hi = np.full(len(X), -np.inf)
+    anchor = np.zeros((len(X), 3))
+    at = np.zeros(len(X))
     for i in range(3):
         on = np.abs(d[:, i]) <= tol
-        t = _dot(X[:, i], direction)
-        lo = np.where(on, np.minimum(lo, t), lo)
-        hi = np.where(on, np.maximum(hi, t), hi)
         dp, dq = d[:, i], d[:, (i + 1) % 3]
         through = ((dp > tol) & (dq < -tol)) | ((dp < -tol) & (dq > tol))
         s = np.where(through, dp / np.where(through, dp - dq, 1.0), 0.0)
         p = X[:, i] + s[:, None] * (X[:, (i + 1) % 3] - X[:, i])
-        t = _dot(p, direction)
-        lo = np.where(through, np.minimum(lo, t), lo)
-        hi = np.where(through, np.maximum(hi, t), hi)
-    return lo, hi
+        for mask, point in ((on, X[:, i]), (through, p)):
+            t = _dot(point, direction)
+            anchor = np.where(mask[:, None], point, anchor)
+            at = np.where(mask, t, at)
+            lo = np.where(mask, np.minimum(lo, t), lo)
+            hi = np.where(mask, np.maximum(hi, t), hi)
+    return lo, hi, anchor, at
+
+
+def _inward(T, n):
+    """Unit in-plane inward normals (K, 3, 3) of the sides of triangles T (unit normals n)."""
+    return np.stack([_unit(np.cross(n, T[:, (j + 1) % 3] - T[:, j]))[0] for j in range(3)], axis=1)
+
+
+def _deepest_on_segment(anchor, at, direction, s0, s1, tris, inward):
+    """max over s in [s0, s1] of the depth of the point anchor + (s - at) direction inside every
+    triangle of `tris` (depth: least in-plane distance to the triangle's sides; negative outside).
+    The depth is a minimum of affine functions of s: its maximum is at an end or a crossing."""
+    c, g = [], []
+    for T, m in zip(tris, inward):
+        for j in range(3):
+            c.append(_dot(anchor - at[:, None] * direction - T[:, j], m[:, j]))
+            g.append(_dot(direction, m[:, j]))
+    c, g = np.array(c).T, np.array(g).T  # (K, 6): depth_k(s) = c_k + g_k s
+    cand = [s0, s1]
+    n = c.shape[1]
+    for a in range(n):
+        for b in range(a + 1, n):
+            dg = g[:, b] - g[:, a]
+            s = np.where(np.abs(dg) > 1e-300, (c[:, a] - c[:, b]) / np.where(np.abs(dg) > 1e-300, dg, 1.0), s0)
+            cand.append(np.clip(s, s0, s1))
+    cand = np.array(cand).T  # (K, candidates)
+    depth = (c[:, None, :] + g[:, None, :] * cand[:, :, None]).min(axis=2)
+    return depth.max(axis=1)
 
 
 def _coplanar_overlap(base, other, n, tol, longest):
@@ -184,7 +217,8 @@ def triangles_cross(A: np.ndarray, B: np.ndarray, tol: float) -> np.ndarray:
     A pair crosses when (a) an edge of one passes through the interior of the other, farther than
     tol from its boundary (both ways), or (b) they are coplanar within tol and overlap in area, or
     (c) each straddles the other's plane by more than tol and their chords on the planes'
-    intersection line overlap by more than tol (catches crossings through a shared corner).
+    intersection line overlap in a segment reaching deeper than tol into both triangles (catches
+    crossings through a shared corner, where the crossing points of (a) lie on the boundaries).
     Degenerate triangles (height over the longest side <= tol) never cross.
     """
     A = np.asarray(A, dtype=float).reshape(-1, 3, 3)
@@ -207,17 +241,22 @@ def triangles_cross(A: np.ndarray, B: np.ndarray, tol: float) -> np.ndarray:
         if len(idx):
             hit[idx] |= _coplanar_overlap(base[idx], other[idx], n[idx], tol, longest[idx])
 
-    # (c) chords on the line where the planes meet
+    # (c) chords on the line where the planes meet: they overlap, and the overlap reaches deeper
+    # than tol into both triangles (an overlap along a side of one is touching, not crossing)
     straddle = ((dA.max(axis=1) > tol) & (dA.min(axis=1) < -tol)
                 & (dB.max(axis=1) > tol) & (dB.min(axis=1) < -tol))
     idx = np.flatnonzero(straddle & solid & ~hit)
     if len(idx):
         line, size = _unit(np.cross(nA[idx], nB[idx]))
-        ok = size > 1e-12
-        loA, hiA = _chord(A[idx], dA[idx], line, tol)
-        loB, hiB = _chord(B[idx], dB[idx], line, tol)
-        overlap = np.minimum(hiA, hiB) - np.maximum(loA, loB)
-        hit[idx] |= ok & (overlap > tol)
+        loA, hiA, anchor, at = _chord(A[idx], dA[idx], line, tol)
+        loB, hiB, _, _ = _chord(B[idx], dB[idx], line, tol)
+        s0, s1 = np.maximum(loA, loB), np.minimum(hiA, hiB)
+        ok = (size > 1e-12) & (s1 - s0 > tol)
+        if ok.any():
+            k = np.flatnonzero(ok)
+            deep = _deepest_on_segment(anchor[k], at[k], line[k], s0[k], s1[k], (A[idx[k]], B[idx[k]]),
+                                       (_inward(A[idx[k]], nA[idx[k]]), _inward(B[idx[k]], nB[idx[k]])))
+            hit[idx[k]] |= deep > tol
     return hit & solid
 
 
@@ -388,10 +427,15 @@ def _load(fold_path_or_dict) -> dict:
         return json.load(fh)
 
 
-def check_path(fold_path_or_dict, step_deg: float = 1.0, tol_rel: float = 1e-7) -> Report:
-    """Check the `polyfold:path` of a FOLD file (path or dict); see the module docstring."""
-    report = Report(step_deg=step_deg)
+def check_path(fold_path_or_dict, step_deg: float = 1.0, tol_rel: float | None = 1e-7) -> Report:
+    """Check the `polyfold:path` of a FOLD file (path or dict); see the module docstring.
+
+    tol_rel None: the contact tolerance the file states (polyfold:path_contactTol), else 1e-7."""
     fold = _load(fold_path_or_dict)
+    stated = fold.get("polyfold:path_contactTol")
+    if tol_rel is None:
+        tol_rel = float(stated) if stated is not None else 1e-7
+    report = Report(step_deg=step_deg, tol_rel=tol_rel, stated_tol_rel=stated)
     try:
         net = FoldNet(fold, tol_rel)
     except (KeyError, ValueError, TypeError, IndexError) as exc:
@@ -467,9 +511,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="Check the folding path (polyfold:path) of a FOLD file.")
     parser.add_argument("fold")
     parser.add_argument("--step-deg", type=float, default=1.0)
-    parser.add_argument("--tol-rel", type=float, default=1e-7)
+    parser.add_argument("--tol-rel", type=float, default=1e-7,
+                        help="contact tolerance relative to the bounding-box diagonal (0 or less: as the file states)")
     args = parser.parse_args(argv)
-    report = check_path(args.fold, step_deg=args.step_deg, tol_rel=args.tol_rel)
+    report = check_path(args.fold, step_deg=args.step_deg, tol_rel=args.tol_rel if args.tol_rel > 0 else None)
     print(report)
     return 0 if report.ok else 1
 

@@ -79,6 +79,7 @@ def test_unfold_fold_gives_a_checked_path(folded_parts, name):
     assert net_report.ok, str(net_report)
     fold = json.loads(net.read_text())
     assert fold["polyfold:path_resolutionDeg"] == 1.0
+    assert fold.get("polyfold:path_contactTol", 1e-7) == 1e-7
     assert fold["polyfold:path_planner"] in ("linear", "lazy-prm")
     assert fold["polyfold:path_linear"] == (len(fold["polyfold:path"]) == 2)
     report = check_path(net)
@@ -126,7 +127,7 @@ SEARCH = [(m, s) for m in ("auto", "random", "unflat-tree", "steepest-edge", "fl
 
 @pytest.fixture(scope="module")
 def lazy_case(tmp_path_factory):
-    """(name, FOLD dict, net file, FoldPath): the first net, in a fixed search order, that is not
+    """(name, mesh, FOLD dict, net file, FoldPath): the first net, in a fixed search order, that is not
     linearly foldable but for which the planner finds a Lazy PRM path with an intermediate frame.
     First a hand-made L-shaped prism (written here), then benchmark meshes if they are around."""
     from conftest import models_path
@@ -148,13 +149,15 @@ def lazy_case(tmp_path_factory):
             if path is not None and path.planner == "lazy-prm" and len(path.frames) > 2:
                 net = root / f"{mesh.stem}-{method}-{seed}.fold"
                 net.write_text(dumps(fold))
-                return f"{mesh.name} --method {method} --seed {seed}", fold, net, path
+                return f"{mesh.name} --method {method} --seed {seed}", mesh, fold, net, path
     pytest.fail("no net needing the Lazy PRM found")
 
 
 def test_lazy_prm_path_where_the_straight_line_collides(lazy_case):
-    name, fold, _, path = lazy_case
+    name, mesh, fold, net, path = lazy_case
     assert name.startswith("l-prism-hand.obj"), name  # the hand-made mesh suffices
+    net_report = check_fold(net, mesh)
+    assert net_report.ok, str(net_report)
     tree = fold_tree(fold)
     assert plan_fold(tree, planner="linear") is None
     assert not is_linearly_foldable(tree)
@@ -170,7 +173,7 @@ def test_lazy_prm_path_where_the_straight_line_collides(lazy_case):
 
 
 def test_fold_cli_plans_around_the_collision(lazy_case, tmp_path):
-    name, _, net, _ = lazy_case
+    name, _, _, net, _ = lazy_case
     out = tmp_path / "out.fold"
     proc = run_cli("fold", net, "-o", out, "--seed", 1, "--time-limit", 30)
     assert proc.returncode == 0, proc.stderr
@@ -192,7 +195,7 @@ def test_fold_cli_plans_around_the_collision(lazy_case, tmp_path):
 
 
 def test_linear_planner_fails_cleanly_when_the_straight_line_collides(lazy_case, tmp_path):
-    _, _, net, _ = lazy_case
+    _, _, _, net, _ = lazy_case
     out = tmp_path / "out.fold"
     proc = run_cli("fold", net, "-o", out, "--planner", "linear", "--time-limit", 30)
     assert proc.returncode == 1, proc.stderr
@@ -202,7 +205,7 @@ def test_linear_planner_fails_cleanly_when_the_straight_line_collides(lazy_case,
 
 
 def test_same_seed_same_path(lazy_case, tmp_path):
-    _, _, net, _ = lazy_case
+    _, _, _, net, _ = lazy_case
     paths = []
     for k in range(2):
         out = tmp_path / f"out{k}.fold"
@@ -255,7 +258,7 @@ def test_independent_folding_preserves_edge_lengths(nets, which, values):
     # faces stay proper (no reflection): folded normals agree with the rigid motion of each face
     n = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
     area = 0.5 * np.linalg.norm(n, axis=1)
-    flat_area = 0.5 * np.cross(flat[:, 1, :2] - flat[:, 0, :2], flat[:, 2, :2] - flat[:, 0, :2])
+    flat_area = 0.5 * np.cross(flat[:, 1] - flat[:, 0], flat[:, 2] - flat[:, 0])[:, 2]
     assert np.allclose(area, flat_area, rtol=1e-9, atol=1e-12 * net.scale ** 2)
 
 

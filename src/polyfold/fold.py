@@ -22,6 +22,7 @@ from numba import njit
 from .kinematics import FoldTree, config_collides, config_collides_moving
 
 COARSE_SAMPLES = 7  # bisection levels 1-3 of a segment: the cheap first look of the Lazy PRM
+MAX_BATCH = 1600  # new roadmap samples per round at most (the batch doubles from n0 up to this)
 
 
 @dataclass(frozen=True, eq=False)
@@ -289,17 +290,28 @@ class _Roadmap:
         self.bits.extend(new)
         B = np.array(self.bits)
         W = B * self.weight_scale
-        rows = np.arange(first, len(self.bits))
-        if len(rows):
-            ham = (B[rows, None, :] != B[None, :, :]).sum(axis=2)  # (new, all) Hamming distances
+        all_rows = np.arange(first, len(self.bits))
+        Bf = B.astype(np.float32)
+        kk = min(k, len(self.bits) - 1)
+        found = []
+        # Hamming distances by matrix products, a block of new nodes at a time (memory stays
+        # ~block x nodes floats however large the roadmap grows).
+        block = max(1, 4_000_000 // max(len(self.bits), 1))
+        for start in range(0, len(all_rows), block):
+            rows = all_rows[start:start + block]
+            ham = Bf[rows] @ (1.0 - Bf).T + (1.0 - Bf[rows]) @ Bf.T  # (block, all)
+            ham = np.rint(ham).astype(np.int64)
             ham[np.arange(len(rows)), rows] = self.n_bits + 1
-            kk = min(k, len(self.bits) - 1)
-            nearest = np.argsort(ham, axis=1, kind="stable")[:, :kk]
+            nearest = np.argpartition(ham, kk - 1, axis=1)[:, :kk] if kk > 0 else np.empty((len(rows), 0), np.int64)
             r_near, c_near = np.repeat(np.arange(len(rows)), kk), nearest.ravel()
             r_one, c_one = np.nonzero(ham == 1)  # every neighbour at Hamming distance 1
             r = np.concatenate([r_near, r_one])
             c = np.concatenate([c_near, c_one])
-            i, j = rows[r], c
+            keep = ham[r, c] <= self.n_bits
+            found.append(np.stack([rows[r[keep]], c[keep]], axis=1))
+        if found:
+            ij = np.concatenate(found)
+            i, j = ij[:, 0], ij[:, 1]
             keys = np.unique(np.stack([np.minimum(i, j), np.maximum(i, j)], axis=1), axis=0)
             keys = keys[keys[:, 0] != keys[:, 1]]
             weights = np.linalg.norm(W[keys[:, 0]] - W[keys[:, 1]], axis=1)  # Euclidean distance of the q's
@@ -432,7 +444,7 @@ def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.G
             for e in edges:
                 if not check.segment(config(rm.bits[rm.eu[e]]), config(rm.bits[rm.ev[e]]), check.step / 2):
                     rm.state[e] = rm.BLOCKED
-        batch *= 2
+        batch = min(2 * batch, MAX_BATCH)
     return None
 
 
