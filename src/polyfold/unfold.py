@@ -290,6 +290,38 @@ def _fitness(G: np.ndarray, L: np.ndarray) -> np.ndarray:
     return -(G + 100 * L).astype(np.float64)
 
 
+def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _Budget, population: int,
+                     finished: Callable[[np.ndarray], bool]) -> tuple[np.ndarray, np.ndarray, list[str], int, int]:
+    """The GA's initial population: each individual from a creator drawn from GA_CREATORS.
+
+    Evaluated in small batches so a valid heuristic net (one `finished` accepts) stops the search
+    at once; valid but unaccepted ones get fitness -0.5 (good parents, not answers). Returns
+    (pop, fit, origin, evaluations, index of the accepted individual or -1); pop is cut short
+    when the budget runs out.
+    """
+    mesh = problem.mesh
+    pop = np.empty((population, mesh.topology.n_edges))
+    creators = rng.integers(0, len(GA_CREATORS), size=population)
+    origin = [GA_CREATORS[c] for c in creators]
+    fit = np.full(population, -np.inf)
+    evaluations = filled = 0
+    for start in range(0, population, 25):
+        stop = min(start + 25, population)
+        for i in range(start, stop):
+            pop[i] = HEURISTICS[origin[i]](mesh, rng)
+        G, L = problem.evaluate(pop[start:stop])
+        fit[start:stop] = _fitness(G, L)
+        evaluations += stop - start
+        filled = stop
+        for i in start + np.flatnonzero(fit[start:stop] == 0):
+            if finished(pop[i]):
+                return pop, fit, origin, evaluations, int(i)
+            fit[i] = -0.5
+        if time.perf_counter() >= budget.deadline:
+            break
+    return pop[:filled], fit[:filled], origin[:filled], evaluations, -1
+
+
 def run_ga(
     problem: UnfoldProblem,
     rng: np.random.Generator,
@@ -309,28 +341,11 @@ def run_ga(
     """
     mesh = problem.mesh
     n_e = mesh.topology.n_edges
-    pop = np.empty((population, n_e))
-    creators = rng.integers(0, len(GA_CREATORS), size=population)
-    fit = np.empty(population)
-    evaluations = 0
-    # Evaluate the seeds in small batches so a valid heuristic net stops the search at once.
-    batch = 25
-    for start in range(0, population, batch):
-        stop = min(start + batch, population)
-        for i in range(start, stop):
-            pop[i] = HEURISTICS[GA_CREATORS[creators[i]]](mesh, rng)
-        G, L = problem.evaluate(pop[start:stop])
-        fit[start:stop] = _fitness(G, L)
-        evaluations += stop - start
-        hit = np.flatnonzero(fit[start:stop] == 0)
-        if len(hit):
-            i = start + int(hit[0])
-            return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
-        if time.perf_counter() >= budget.deadline:
-            fit[stop:] = -np.inf
-            pop[stop:] = pop[:1]
-            break
-    origin = np.array([GA_CREATORS[c] for c in creators], dtype=object)
+    pop, fit, origin_list, evaluations, hit = _seed_population(problem, rng, budget, population, lambda g: True)
+    if hit >= 0:
+        return pop[hit].copy(), 0.0, 0, evaluations, origin_list[hit]
+    population = len(pop)
+    origin = np.array(origin_list, dtype=object)
     best = float(fit.max())
     stall = 0
     generation = 0
@@ -414,27 +429,10 @@ def run_memetic(
     mesh = problem.mesh
     topo = mesh.topology
     n_e = topo.n_edges
-    pop = np.empty((population, n_e))
-    creators = rng.integers(0, len(GA_CREATORS), size=population)
-    fit = np.full(population, -np.inf)
-    evaluations = 0
-    filled = 0
-    for start in range(0, population, 25):
-        stop = min(start + 25, population)
-        for i in range(start, stop):
-            pop[i] = HEURISTICS[GA_CREATORS[creators[i]]](mesh, rng)
-        G, L = problem.evaluate(pop[start:stop])
-        fit[start:stop] = _fitness(G, L)
-        evaluations += stop - start
-        filled = stop
-        for i in start + np.flatnonzero(fit[start:stop] == 0):
-            if finished(pop[i]):
-                return pop[i].copy(), 0.0, 0, evaluations, GA_CREATORS[creators[i]]
-            fit[i] = -0.5  # valid but not accepted: a good parent, not an answer
-        if time.perf_counter() >= budget.deadline:
-            break
-    pop, fit = pop[:filled], fit[:filled]
-    n_pop = filled
+    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, budget, population, finished)
+    if hit >= 0:
+        return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
+    n_pop = len(pop)
     # Local-search effort per generation: enough to finish most nets, small enough to restart
     # from a fresh child when the search is stuck in a local minimum.
     chunk_iters = max(1000, 4 * mesh.n_faces)
