@@ -89,7 +89,7 @@ import numpy as np
 from numba import njit
 
 from .errors import PolyfoldError
-from .kinematics import triangles_collide
+from .kinematics import _boxes, triangles_collide
 from .mesh import HYPERBOLIC_EPS, Mesh
 
 TWO_PI = 2.0 * math.pi
@@ -355,15 +355,11 @@ def _intersections(X, F, tol, skip_keys, max_pairs, pairs):
     (the first max_pairs written to pairs)."""
     m = F.shape[0]
     tris = np.empty((m, 3, 3))
-    lo = np.empty((m, 3))
-    hi = np.empty((m, 3))
     for f in range(m):
         for k in range(3):
             for i in range(3):
                 tris[f, k, i] = X[F[f, k], i]
-        for i in range(3):
-            lo[f, i] = min(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
-            hi[f, i] = max(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
+    lo, hi = _boxes(tris)
     xs = np.argsort(lo[:, 0])
     count = 0
     for ii in range(m):
