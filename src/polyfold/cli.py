@@ -320,6 +320,38 @@ def inflate(
          f"HV {res.hyperbolic_start} -> {res.hyperbolic}, IF {res.inflation_rate:.4f}")
 
 
+@app.command()
+@_guard
+def segment(
+    mesh: Path = typer.Argument(..., help="Mesh file (OBJ, OFF, STL, PLY, GLB)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for part-K.obj, labels.json, segments.ply/.glb/.png."),
+    tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Concavity bound per part, fraction of the bounding-box diagonal (default 0.05)."),
+    parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Pick tau so that there are this many parts (instead of --tau)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the surface samples of the concavity measure."),
+    png: bool = typer.Option(True, "--png/--no-png", help="Also draw segments.png."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or table, only errors."),
+) -> None:
+    """Split a mesh into few connected, nearly convex parts (concavity <= tau each), ready to unfold."""
+    if tau is not None and parts is not None:
+        _fail("give --tau or --parts, not both", 2)
+    from .segment import DEFAULT_TAU, segment as segment_mesh, write_segmentation
+
+    t0 = time.perf_counter()
+    loaded = _load(mesh, quiet)
+    seg = segment_mesh(loaded.mesh, tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=seed)
+    seconds = time.perf_counter() - t0
+    if parts is not None and seg.n_parts != parts and not quiet:
+        why = ("even tau 0 gives fewer: the parts are already convex" if seg.n_parts < parts
+               else "the mesh has that many separate components")
+        _say(f"warning: {mesh.name}: {seg.n_parts} parts instead of {parts} ({why})")
+    write_segmentation(seg, loaded.mesh, output, n_input_faces=loaded.n_input_faces, source_name=mesh.name, png=png)
+    if not quiet:
+        print(f"{'part':>4} {'faces':>6} {'concavity':>10}")
+        for k, (p, c) in enumerate(zip(seg.parts, seg.concavity)):
+            print(f"{k:>4} {p.n_faces:>6} {c:>10.4f}")
+        _say(f"{mesh.name}: {seg.n_parts} parts, tau {seg.tau:.4g}, {seconds:.2f} s -> {output}")
+
+
 def main() -> None:
     app()
 

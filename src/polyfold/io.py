@@ -34,7 +34,8 @@ class LoadedMesh:
 
     mesh: the whole mesh (all components), faces CCW seen from outside; components: its
     edge-connected components, each its own Mesh (vertices renumbered); face_source everywhere is
-    the face's index in the input file's face order. warnings: one line per repair / notable fact.
+    the face's index in the input file's face order (n_input_faces of them; faces dropped as
+    degenerate or duplicate have no triangle). warnings: one line per repair / notable fact.
     manifold / oriented: facts about the INPUT (False when a non-manifold vertex had to be split /
     when faces had to be flipped), for `describe`.
     """
@@ -45,6 +46,7 @@ class LoadedMesh:
     warnings: tuple[str, ...]
     manifold: bool = True
     oriented: bool = True
+    n_input_faces: int = -1  # faces in the file (before triangulation and repairs); -1 if unknown
 
 
 @dataclass
@@ -691,6 +693,7 @@ def load_mesh(path: str | os.PathLike) -> LoadedMesh:
         warnings=tuple(w.notes[k] for k in _NOTE_ORDER if k in w.notes),
         manifold=n_split == 0,
         oriented=n_flipped == 0,
+        n_input_faces=int(parsed.source.max()) + 1 if len(parsed.source) else 0,
     )
 
 

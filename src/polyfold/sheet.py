@@ -20,8 +20,6 @@ import colorsys
 import logging
 import math
 import os
-import struct
-import zlib
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +28,7 @@ import numpy as np
 
 from .errors import PolyfoldError
 from .io import atomic_write
+from .raster import png_bytes
 
 log = logging.getLogger(__name__)
 
@@ -570,19 +569,6 @@ def _draw_segments(img: np.ndarray, seg: np.ndarray, color, thick: int) -> None:
             img[iy[ok], ix[ok]] = color
 
 
-def _png_bytes(img: np.ndarray) -> bytes:
-    h, w = img.shape[:2]
-    raw = np.zeros((h, 1 + 3 * w), dtype=np.uint8)  # filter byte 0 per row
-    raw[:, 1:] = img.reshape(h, 3 * w)
-
-    def chunk(tag: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
-
-    ihdr = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
-            + chunk(b"IEND", b""))
-
-
 def write_png(fold: dict, path, *, width_px: int = 1200) -> None:
     """Write a PNG preview: faces filled (one light hue per piece), cuts black, mountains red, valleys blue."""
     net = _parse(fold)
@@ -595,4 +581,4 @@ def write_png(fold: dict, path, *, width_px: int = 1200) -> None:
         sel = [e for e, kk in enumerate(net.kind) if kk == k]
         if sel:
             _draw_segments(img, xy[net.edges[sel]], _PNG_COLORS[k], thick)
-    atomic_write(path, _png_bytes(img))
+    atomic_write(path, png_bytes(img))

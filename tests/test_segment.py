@@ -1,0 +1,268 @@
+"""Segmentation (issue 5): the guarantees on every closed benchmark mesh, part-awareness against
+the paper's own decompositions, the part maps, and the `polyfold segment` command.
+
+Connectivity and concavity are re-measured here with code of the test's own (numpy/scipy, no
+polyfold geometry), so a bug in the segmenter's bookkeeping cannot hide behind itself."""
+
+from __future__ import annotations
+
+import json
+from collections import defaultdict, deque
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial import ConvexHull, QhullError, cKDTree
+
+from conftest import closed_meshes
+from fold_checker import check_fold
+from path_checker import check_path
+from test_cli import one_line, run_cli
+
+from polyfold.io import load_mesh
+from polyfold.mesh import Mesh
+from polyfold.segment import DEFAULT_TAU, rand_index, segment, surface_samples
+
+# ----------------------------------------------------------------------------------------------
+# Independent measures
+
+
+def edge_connected(faces: np.ndarray) -> bool:
+    """True when the triangles form one piece through shared edges (BFS over a dict of edges)."""
+    by_edge = defaultdict(list)
+    for f, (a, b, c) in enumerate(faces.tolist()):
+        for u, v in ((a, b), (b, c), (c, a)):
+            by_edge[(min(u, v), max(u, v))].append(f)
+    nbrs = defaultdict(set)
+    for fs in by_edge.values():
+        for f in fs:
+            nbrs[f].update(fs)
+    seen, todo = {0}, deque([0])
+    while todo:
+        for g in nbrs[todo.popleft()]:
+            if g not in seen:
+                seen.add(g)
+                todo.append(g)
+    return len(seen) == len(faces)
+
+
+def depth_below_hull(points: np.ndarray, hull_points: np.ndarray) -> float:
+    """max over points of the distance to the boundary of conv(hull_points) (0 for flat sets)."""
+    try:
+        eq = ConvexHull(hull_points).equations
+    except (QhullError, ValueError):
+        return 0.0
+    d = -(points @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, distance to each facet plane
+    return float(np.clip(d.min(axis=1), 0.0, None).max())
+
+
+def measured_concavity(mesh: Mesh, faces: np.ndarray, samples: np.ndarray) -> float:
+    verts = mesh.vertices[np.unique(mesh.faces[faces])]
+    pts = np.concatenate([verts, samples[faces].reshape(-1, 3)])
+    return depth_below_hull(pts, verts) / np.linalg.norm(np.ptp(mesh.vertices, axis=0))
+
+
+def check_segmentation(mesh: Mesh, seg, tau: float) -> None:
+    assert seg.labels.shape == (mesh.n_faces,)
+    assert seg.labels.min() == 0 and seg.labels.max() == seg.n_parts - 1
+    # every face in exactly one part: the part face lists partition the faces
+    all_faces = np.concatenate(seg.face_ids)
+    assert np.array_equal(np.sort(all_faces), np.arange(mesh.n_faces))
+    samples = surface_samples(mesh, seed=0)
+    for k, (part, fids, vids) in enumerate(zip(seg.parts, seg.face_ids, seg.vertex_ids)):
+        assert np.all(seg.labels[fids] == k)
+        # maps: part vertex i is mesh vertex vids[i]; part face j is mesh face fids[j]
+        assert np.array_equal(part.vertices, mesh.vertices[vids])
+        assert np.array_equal(vids[part.faces], mesh.faces[fids])
+        assert np.array_equal(part.face_source, mesh.face_source[fids])
+        assert edge_connected(part.faces), f"part {k} is not edge-connected"
+        conc = measured_concavity(mesh, fids, samples)
+        assert conc == pytest.approx(seg.concavity[k], rel=1e-6, abs=1e-9)
+        # (1e-12: rounding of the hull planes; the segmenter treats such depths as 0)
+        assert conc <= tau * (1 + 1e-6) + 1e-12, f"part {k}: concavity {conc} > tau {tau}"
+
+
+def paper_labels(mesh: Mesh, part_files: list[Path]) -> np.ndarray:
+    """Face labels of the paper's decomposition: its part files are in the whole mesh's frame."""
+    centroids = mesh.vertices[mesh.faces].mean(axis=1)
+    tree = cKDTree(centroids)
+    labels = np.full(mesh.n_faces, -1)
+    for k, path in enumerate(part_files):
+        part = trimesh.load(path, process=False, force="mesh")
+        dist, idx = tree.query(np.asarray(part.triangles_center))
+        assert dist.max() < 1e-4 * mesh.bbox_diagonal
+        labels[idx] = k
+    assert (labels >= 0).all()
+    return labels
+
+
+# ----------------------------------------------------------------------------------------------
+# Guarantees
+
+
+@pytest.mark.parametrize("path", closed_meshes(), ids=lambda p: p.stem)
+def test_guarantees_on_every_closed_mesh(path):
+    mesh = load_mesh(path).mesh
+    seg = segment(mesh)
+    assert seg.tau == DEFAULT_TAU
+    check_segmentation(mesh, seg, DEFAULT_TAU)
+
+
+@pytest.mark.parametrize("tau", [0.0, 0.01, 0.1, 1.0])
+def test_guarantees_across_tau(models_dir, tau):
+    for name in ("horse-302", "bunny-128", "u-prism-28"):
+        mesh = load_mesh(models_dir / f"{name}.obj").mesh
+        seg = segment(mesh, tau=tau)
+        check_segmentation(mesh, seg, tau)
+    # a convex mesh is one part at any tau; tau 0 still allows flat or convex pieces
+    cube = load_mesh(models_dir / "icosphere-l2-320.obj").mesh
+    assert segment(cube, tau=tau).n_parts == 1
+
+
+def test_fewer_parts_for_larger_tau(models_dir):
+    mesh = load_mesh(models_dir / "horse-302.obj").mesh
+    counts = [segment(mesh, tau=t).n_parts for t in (0.01, 0.03, 0.05, 0.1, 0.3)]
+    assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1]
+
+
+@pytest.mark.parametrize("name,k", [("periscope-28", 2), ("periscope2-44", 3), ("bunny-128", 3),
+                                    ("fish-472", 5), ("horse-302", 7)])
+def test_parts_option_reaches_the_paper_counts(models_dir, name, k):
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    seg = segment(mesh, parts=k)
+    assert seg.n_parts == k
+    check_segmentation(mesh, seg, seg.tau)
+
+
+def test_parts_bounded_by_tau_zero_and_components(models_dir):
+    mesh = load_mesh(models_dir / "tetrahedron-4.obj").mesh
+    assert segment(mesh, parts=1).n_parts == 1
+    # a convex mesh is one part even at tau 0: more parts would not be nearly convex "parts"
+    assert segment(mesh, parts=9).n_parts == 1
+    # two disjoint copies: never fewer parts than edge-connected components
+    two = Mesh(np.concatenate([mesh.vertices, mesh.vertices + 5.0]), np.concatenate([mesh.faces, mesh.faces + 4]))
+    seg = segment(two, parts=1)
+    assert seg.n_parts == 2
+    check_segmentation(two, seg, seg.tau)
+    with pytest.raises(ValueError):
+        segment(mesh, tau=-1.0)
+
+
+def test_polygons_of_the_input_stay_whole(tmp_path):
+    # an L-shaped prism written with quads and two hexagon caps: any split must follow polygon edges
+    pts2 = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    v = [(x, y, 0.0) for x, y in pts2] + [(x, y, 1.0) for x, y in pts2]
+    faces = ["f 6 5 4 3 2 1", "f 7 8 9 10 11 12"]
+    faces += [f"f {i + 1} {(i + 1) % 6 + 1} {(i + 1) % 6 + 7} {i + 7}" for i in range(6)]
+    path = tmp_path / "l.obj"
+    path.write_text("\n".join(f"v {x} {y} {z}" for x, y, z in v) + "\n" + "\n".join(faces) + "\n")
+    loaded = load_mesh(path)
+    seg = segment(loaded.mesh, tau=0.0)
+    assert seg.n_parts >= 2  # the L is not convex
+    for src in np.unique(loaded.mesh.face_source):
+        assert len(set(seg.labels[loaded.mesh.face_source == src].tolist())) == 1
+    check_segmentation(loaded.mesh, seg, 0.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# Part-awareness
+
+
+def test_rand_index():
+    a = np.array([0, 0, 1, 1, 2])
+    assert rand_index(a, a) == 1.0
+    assert rand_index(a, np.array([5, 5, 3, 3, 9])) == 1.0  # names of parts do not matter
+    # pairs: 10; a and b = all-in-one agree only on the 2 pairs a keeps together
+    assert rand_index(a, np.zeros(5)) == pytest.approx(2 / 10)
+    rng = np.random.default_rng(0)
+    x, y = rng.integers(0, 4, 60), rng.integers(0, 3, 60)
+    brute = np.mean([(x[i] == x[j]) == (y[i] == y[j]) for i in range(60) for j in range(i + 1, 60)])
+    assert rand_index(x, y) == pytest.approx(brute)
+
+
+@pytest.mark.parametrize("name,group,k,target", [("horse-302", "horse", 7, 0.85), ("fish-472", "fish", 5, 0.95)])
+def test_rand_index_against_the_paper(models_dir, name, group, k, target):
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    files = sorted((models_dir / "paper-parts" / group).glob("part-*.obj"))
+    assert len(files) == k
+    theirs = paper_labels(mesh, files)
+    ours = segment(mesh, parts=k)
+    assert ours.n_parts == k
+    assert rand_index(ours.labels, theirs) >= target
+
+
+# ----------------------------------------------------------------------------------------------
+# Parts go straight into the unfolder and the planner
+
+
+def test_horse_parts_unfold_and_fold(models_dir, tmp_path):
+    out = tmp_path / "seg"
+    proc = run_cli("segment", models_dir / "horse-302.obj", "-o", out, "--parts", 7, "--no-png")
+    assert proc.returncode == 0, proc.stderr
+    parts = sorted(out.glob("part-*.obj"))
+    assert len(parts) == 7
+    for part in parts:
+        fold = tmp_path / f"{part.stem}.fold"
+        proc = run_cli("unfold", part, "-o", fold, "--fold", "--max-pieces", 1, "--seed", 1, "--time-limit", 60)
+        assert proc.returncode == 0, f"{part.name}: {proc.stderr}"
+        report = check_fold(str(fold), str(part))
+        assert report.ok and report.pieces == 1, f"{part.name}:\n{report}"
+        path_report = check_path(fold)
+        assert path_report.ok, f"{part.name}:\n{path_report}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Command line
+
+
+def test_segment_cli_writes_every_output(models_dir, tmp_path):
+    src = models_dir / "bunny-128.obj"
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "part-99.obj").write_text("stale\n")
+    proc = run_cli("segment", src, "-o", out, "--tau", 0.05)
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((out / "labels.json").read_text())
+    assert set(doc) >= {"labels", "tau", "concavity"}
+    labels = np.array(doc["labels"])
+    n_parts = len(doc["concavity"])
+    assert doc["tau"] == 0.05 and max(doc["concavity"]) <= 0.05
+    assert len(labels) == 128 and labels.min() == 0 and labels.max() == n_parts - 1
+    assert not (out / "part-99.obj").exists()
+    assert sorted(p.name for p in out.glob("part-*.obj")) == sorted(f"part-{k}.obj" for k in range(n_parts))
+    assert not list(out.glob(".polyfold-*"))
+    # the parts, in the whole mesh's frame, are exactly the labelled faces of the input
+    whole = load_mesh(src).mesh
+    centroids = whole.vertices[whole.faces].mean(axis=1)
+    for k in range(n_parts):
+        part = load_mesh(out / f"part-{k}.obj").mesh
+        dist, idx = cKDTree(centroids).query(part.vertices[part.faces].mean(axis=1))
+        assert dist.max() < 1e-12
+        assert sorted(idx.tolist()) == np.flatnonzero(labels == k).tolist()
+    # coloured whole mesh: one colour per part, faces in input order
+    ply = trimesh.load(out / "segments.ply", process=False)
+    assert len(ply.faces) == 128
+    colors = np.asarray(ply.visual.face_colors)[:, :3]
+    by_part = {tuple(c) for c in colors[labels == 0]}
+    assert len(by_part) == 1 and len({tuple(c) for c in colors}) == n_parts
+    glb = trimesh.load(out / "segments.glb", force="mesh", process=False)
+    assert len(glb.faces) == 128
+    png = (out / "segments.png").read_bytes()
+    assert png.startswith(b"\x89PNG") and len(png) > 5000
+    assert "parts" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_segment_cli_parts_and_errors(models_dir, tmp_path):
+    proc = run_cli("segment", models_dir / "fish-472.obj", "-o", tmp_path / "f", "--parts", 5, "--no-png")
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((tmp_path / "f" / "labels.json").read_text())
+    assert len(doc["concavity"]) == 5 and not (tmp_path / "f" / "segments.png").exists()
+    proc = run_cli("segment", models_dir / "fish-472.obj", "-o", tmp_path / "g", "--parts", 5, "--tau", 0.1)
+    assert proc.returncode == 2 and "--tau or --parts" in one_line(proc.stderr)
+    assert not (tmp_path / "g").exists()
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 3\n")
+    proc = run_cli("segment", bad, "-o", tmp_path / "h")
+    assert proc.returncode == 2 and "bad.obj" in one_line(proc.stderr)
+    assert not (tmp_path / "h").exists()
