@@ -15,10 +15,9 @@ $(STAMP): pyproject.toml
 setup: $(STAMP)
 
 demo: $(STAMP)
-	mkdir -p out
 	$(BIN)/polyfold info examples/bunny-128.obj
-	$(BIN)/polyfold unfold examples/bunny-128.obj -o out/bunny-128.fold --svg out/bunny-128.svg --png out/bunny-128.png --seed 1 --size 80
-	@echo "wrote out/bunny-128.fold, out/bunny-128.svg, out/bunny-128.png"
+	$(BIN)/polyfold make examples/bunny-128.obj -o out/bunny-128
+	@echo "open out/bunny-128/instructions.html; print out/bunny-128/sheets.pdf at 100 %"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

@@ -352,6 +352,75 @@ def segment(
         _say(f"{mesh.name}: {seg.n_parts} parts, tau {seg.tau:.4g}, {seconds:.2f} s -> {output}")
 
 
+@app.command()
+@_guard
+def make(
+    mesh: Path = typer.Argument(..., help="Mesh file (OBJ, OFF, STL, PLY, GLB)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for sheets, FOLD files, instructions and report."),
+    inflate_mode: str = typer.Option("none", "--inflate", help="none | constrained | uniform: inflate the mesh first (paper Sec. 3)."),
+    segment_mode: str = typer.Option("auto", "--segment", help="auto (one part per component unless no single net is found) | none."),
+    tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Segment into parts of concavity <= tau (fraction of the bbox diagonal)."),
+    parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Segment into this many parts."),
+    paper: str = typer.Option("a4", "--paper", help="a4 | letter | a3 | 12x12in | WxHmm."),
+    size: float = typer.Option(150.0, "--size", min=1e-6, help="Longest dimension of the built model, mm."),
+    margin: float = typer.Option(10.0, "--margin", min=0.0, help="Page margin, mm."),
+    tabs: str = typer.Option("auto", "--tabs", help="auto (glue tabs where they fit) | none."),
+    seed: int = typer.Option(1, "--seed", help="Random seed (same seed, same sheets)."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the searches (unfold, fold)."),
+    fold: bool = typer.Option(True, "--fold/--no-fold", help="Plan and verify a folding path for every piece."),
+    contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
+) -> None:
+    """Mesh in, printable sheets out: inflate, segment, unfold, fold, lay out with tabs and labels, export."""
+    if tau is not None and parts is not None:
+        _fail("give --tau or --parts, not both", 2)
+    if tabs not in ("auto", "none"):
+        _fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
+    from .make import MakeOptions, make as run_make
+
+    opts = MakeOptions(inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts, paper=paper, size=size,
+                       margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
+                       contact_tol=contact_tol)
+    t0 = time.perf_counter()
+    if quiet:
+        result = run_make(mesh, output, opts)
+    else:
+        from rich.console import Console
+
+        console = Console(stderr=True)
+        if console.is_terminal:
+            with console.status("polyfold make") as status:
+                result = run_make(mesh, output, opts,
+                                  lambda stage, msg: status.update(f"[bold]{stage}[/bold]: {msg}"))
+        else:
+            last = [None]
+
+            def progress(stage: str, msg: str) -> None:
+                if stage != last[0]:
+                    _say(f"{stage}: {msg}")
+                    last[0] = stage
+
+            result = run_make(mesh, output, opts, progress)
+    rep = result.report
+    if not quiet:
+        for w in rep["input"]["warnings"]:
+            _say(f"warning: {mesh.name}: {w}")
+        for row in rep["pieces"]:
+            if not row["path_verified"] and fold:
+                _say(f"warning: piece {row['piece']}: no verified folding path ({row['note']})")
+        lay = rep["stages"]["layout"]
+        if lay["untabbed_edges"]:
+            _say(f"warning: {len(lay['untabbed_edges'])} glue edge(s) without a tab (no room on either side): "
+                 f"{', '.join(lay['untabbed_edges'][:10])}{' ...' if len(lay['untabbed_edges']) > 10 else ''}")
+        if lay["splits_for_page"]:
+            _say(f"split {lay['splits_for_page']} crease(s) so every piece fits a {paper} page at {size:g} mm")
+    seg = rep["stages"]["segment"]
+    if not quiet:
+        _say(f"{mesh.name}: {seg['parts']} part(s), {len(rep['pieces'])} piece(s), {rep['stages']['layout']['pages']} "
+             f"page(s), {rep['checks']['paths_verified']}/{len(rep['pieces'])} folding paths verified, "
+             f"{time.perf_counter() - t0:.2f} s -> {output}")
+
+
 def main() -> None:
     app()
 

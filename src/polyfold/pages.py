@@ -42,6 +42,7 @@ STYLES = {
     "valley": {"rgb": (0, 0, 255), "dash": (1.5, 1.0)},
 }
 PREVIEW_RGB = (225, 232, 245)  # light fill under the lines, for on-screen / printed previews
+TAB_RGB = (236, 236, 236)  # glue tabs, lighter than the faces
 TEXT_RGB = (0, 0, 0)
 
 
@@ -71,8 +72,9 @@ class Page:
 
     cut: closed polylines (k, 2), k >= 3, piece outlines incl. tabs, not repeating the first point
     (a repeated closing point is dropped); mountain / valley / tab_folds: (n, 2, 2) segments;
-    texts: labels; faces: optional (n, 3, 2) triangles per piece, filled light in previews only.
-    Arrays are coerced to float64 and validated on construction.
+    texts: labels; faces: optional (n, 3, 2) triangles per piece, filled light in previews only;
+    slits: (n, 2, 2) cut segments inside an outline (two faces of one piece that touch along a cut
+    edge: the outline alone would not separate them). Arrays are coerced to float64 and validated on construction.
     """
 
     width: float
@@ -83,6 +85,8 @@ class Page:
     tab_folds: np.ndarray
     texts: tuple[TextItem, ...]
     faces: tuple[np.ndarray, ...] = ()
+    slits: np.ndarray = ()  # type: ignore[assignment]
+    tabs: tuple[np.ndarray, ...] = ()  # optional (4, 2) glue-tab polygons, shaded in previews only
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.width) and math.isfinite(self.height) and self.width > 0 and self.height > 0):
@@ -96,10 +100,11 @@ class Page:
                 raise ValueError(f"cut[{i}] needs at least 3 distinct points, got {len(p)}")
             cut.append(p)
         object.__setattr__(self, "cut", tuple(cut))
-        for name in ("mountain", "valley", "tab_folds"):
+        for name in ("mountain", "valley", "tab_folds", "slits"):
             object.__setattr__(self, name, _finite(getattr(self, name), name, (-1, 2, 2)))
         faces = tuple(_finite(f, f"faces[{i}]", (-1, 3, 2)) for i, f in enumerate(self.faces))
         object.__setattr__(self, "faces", faces)
+        object.__setattr__(self, "tabs", tuple(_finite(t, f"tabs[{i}]", (-1, 2)) for i, t in enumerate(self.tabs)))
         object.__setattr__(self, "texts", tuple(self.texts))
 
 
@@ -167,7 +172,7 @@ def svg_page_string(page: Page) -> str:
         "viewBox": f"0 0 {_num(page.width)} {_num(page.height)}",
     })
 
-    if page.faces:
+    if page.faces or page.tabs:
         g = _layer(root, "preview", **{"class": "no-cut", "fill": _hex(PREVIEW_RGB), "stroke": "none"})
         ET.SubElement(g, "desc").text = "preview fill: print only, do not cut"
         for i, tris in enumerate(page.faces):
@@ -175,6 +180,9 @@ def svg_page_string(page: Page) -> str:
                          for (a, b), (c, e), (f, h) in tris)
             if d:
                 ET.SubElement(g, "path", {"id": f"preview-{i}", "d": d})
+        for i, t in enumerate(page.tabs):
+            d = f"M{_num(t[0, 0])},{_num(t[0, 1])} " + " ".join(f"L{_num(x)},{_num(y)}" for x, y in t[1:]) + " Z"
+            ET.SubElement(g, "path", {"id": f"tab-{i}", "class": "tab", "fill": _hex(TAB_RGB), "d": d})
 
     g = _layer(root, "labels", **{
         "class": "no-cut",
@@ -209,6 +217,8 @@ def svg_page_string(page: Page) -> str:
     for i, poly in enumerate(page.cut):
         d = f"M{_num(poly[0, 0])},{_num(poly[0, 1])} L" + " ".join(f"{_num(x)},{_num(y)}" for x, y in poly[1:]) + " Z"
         ET.SubElement(g, "path", {"id": f"cut-{i}", "class": "cut", "d": d})
+    for i, ((x0, y0), (x1, y1)) in enumerate(page.slits):
+        ET.SubElement(g, "path", {"id": f"slit-{i}", "class": "cut slit", "d": f"M{_num(x0)},{_num(y0)} L{_num(x1)},{_num(y1)}"})
 
     ET.indent(root, space=" ")
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
@@ -242,6 +252,16 @@ def _pdf_stroke(c, style: str) -> None:
 
 def _draw_pdf_page(c, page: Page) -> None:
     """Draw `page` on the current page of reportlab canvas `c` (page size already set)."""
+    if page.tabs:
+        c.setFillColorRGB(*(v / 255 for v in TAB_RGB))
+        for t in page.tabs:
+            q = _pt(page, t)
+            p = c.beginPath()
+            p.moveTo(*q[0])
+            for x, y in q[1:]:
+                p.lineTo(x, y)
+            p.close()
+            c.drawPath(p, stroke=0, fill=1)
     if page.faces:
         c.setFillColorRGB(*(v / 255 for v in PREVIEW_RGB))
         for tris in page.faces:
@@ -270,6 +290,8 @@ def _draw_pdf_page(c, page: Page) -> None:
             p.lineTo(x, y)
         p.close()
         c.drawPath(p, stroke=1, fill=0)
+    for (x0, y0), (x1, y1) in _pt(page, page.slits):
+        c.line(x0, y0, x1, y1)
 
     c.setFillColorRGB(*(v / 255 for v in TEXT_RGB))
     for t in page.texts:
@@ -340,6 +362,9 @@ def dxf_document(page: Page):
     msp = doc.modelspace()
     for poly in page.cut:
         msp.add_lwpolyline(flip(poly), close=True, dxfattribs={"layer": "CUT"})
+    for seg in page.slits:
+        a, b = flip(seg)
+        msp.add_line(a, b, dxfattribs={"layer": "CUT"})
     for style, _cls, segs in _crease_layers(page):
         for seg in segs:
             a, b = flip(seg)

@@ -613,3 +613,53 @@ def unfold(
         pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs), accepted=accepted,
     )
     return net, stats
+
+
+def cut_creases(net: Net, faces: np.ndarray) -> Net:
+    """The net with the creases between `faces` and their parents cut: each such face becomes the
+    root of a new piece. The layout is unchanged, so every new piece is as overlap-free as before."""
+    faces = np.asarray(faces, dtype=np.int64)
+    parent = net.parent.copy()
+    parent_edge = net.parent_edge.copy()
+    parent[faces] = -1
+    parent_edge[faces] = -1
+    piece = np.full(len(parent), -1, dtype=np.int64)
+    n_pieces = 0
+    for f in net.order:  # parents come first, so a child's piece is known when it is reached
+        if parent[f] < 0:
+            piece[f] = n_pieces
+            n_pieces += 1
+        else:
+            piece[f] = piece[parent[f]]
+    return Net(mesh=net.mesh, parent=parent, parent_edge=parent_edge, order=net.order.copy(),
+               coords=net.coords.copy(), piece=piece)
+
+
+def piece_net(net: Net, piece: int) -> tuple[Net, np.ndarray]:
+    """One piece of a net as a single-piece Net of its own faces: (net, face ids in net.mesh).
+
+    The piece's mesh is `net.mesh.submesh(face_ids)`; crease ids are renumbered into its edges."""
+    fids = np.flatnonzero(net.piece == piece)
+    sub = net.mesh.submesh(fids)
+    new_id = np.full(len(net.piece), -1, dtype=np.int64)
+    new_id[fids] = np.arange(len(fids))
+    used = np.unique(net.mesh.faces[fids])
+    old_edges = net.mesh.topology.edges
+    sub_edges = sub.topology.edges
+    # crease (old mesh edge) -> the same vertex pair in the sub-mesh's vertex numbering
+    se = np.sort(sub_edges, axis=1)
+    key = se[:, 0] * (len(used) + 1) + se[:, 1]
+    order = np.argsort(key)
+    parent = new_id[np.where(net.parent[fids] >= 0, net.parent[fids], 0)]
+    parent[net.parent[fids] < 0] = -1
+    parent_edge = np.full(len(fids), -1, dtype=np.int64)
+    has = np.flatnonzero(net.parent_edge[fids] >= 0)
+    if len(has):
+        ends = np.searchsorted(used, old_edges[net.parent_edge[fids[has]]])
+        ends.sort(axis=1)
+        k = ends[:, 0] * (len(used) + 1) + ends[:, 1]
+        parent_edge[has] = order[np.searchsorted(key, k, sorter=order)]
+    net_order = new_id[net.order[np.isin(net.order, fids)]]
+    out = Net(mesh=sub, parent=parent, parent_edge=parent_edge, order=net_order, coords=net.coords[fids].copy(),
+              piece=np.zeros(len(fids), dtype=np.int64))
+    return out, fids
