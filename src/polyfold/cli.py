@@ -421,6 +421,13 @@ def make(
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 
 
+# Commands that live in their own modules (each registers itself on `app`).
+from . import cli_batch, cli_view  # noqa: E402
+
+cli_view.register(app, _guard, _say, _fail)
+cli_batch.register(app, _guard, _say, _fail)
+
+
 def main() -> None:
     app()
 

@@ -128,6 +128,9 @@ def _dfs_intervals(parent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return tin, tout
 
 
+MAX_PEEL_TRIES = 64
+
+
 def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> float:
     """Largest scale at which the convex hull of the points, grown by `pad` mm, fits the page."""
     import shapely
@@ -142,7 +145,8 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
                  pad: float = TAB_MAX_MM + 1.0) -> tuple[Net, int]:
     """Cut creases of `net` until every piece, grown by `pad` mm (room for tabs), fits the page.
 
-    Greedy: peel off the largest subtree (by area) that fits, until the rest fits. Returns the new
+    Greedy: peel off a subtree that fits (the largest whose rest also fits, else the largest),
+    until the rest fits. Returns the new
     net and the number of creases cut. Raises PolyfoldError when a single face is too large,
     naming the largest model size that would fit."""
     xy = net.coords * scale
@@ -170,12 +174,24 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
                 sub_area[net.parent[f]] += sub_area[f]
         cand = todo[net.parent[todo] >= 0]
         cand = cand[np.argsort(-sub_area[cand], kind="stable")]
-        chosen = None
+        # Peel a subtree that fits; best one whose rest fits too (two pieces instead of three),
+        # else the largest that fits. Only the MAX_PEEL_TRIES largest fitting subtrees are weighed.
+        chosen, fitting = None, []
+        in_piece = np.zeros(len(net.piece), dtype=bool)
+        in_piece[todo] = True
         for c in cand:
             members = by_tin[tin[c]:tout[c]]
             if _hull_scale(xy[members].reshape(-1, 2), page_size, margin, pad) >= 1.0:
-                chosen = int(c)
-                break
+                fitting.append(int(c))
+                rest = in_piece.copy()
+                rest[members] = False
+                if _hull_scale(xy[rest].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+                    chosen = int(c)
+                    break
+                if len(fitting) >= MAX_PEEL_TRIES:
+                    break
+        if chosen is None and fitting:
+            chosen = fitting[0]
         if chosen is None:  # not even one face fits on its own below the root: cut the root off
             chosen = int(cand[-1])
         net = cut_creases(net, np.array([chosen]))

@@ -27,6 +27,8 @@ PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), 
 FOOTER_MM = 6.0  # strip at the bottom of the printable area for the page footer
 GAP_MM = 3.0  # minimum distance between pieces on a page (room for scissors)
 REPORT_VERSION = 1
+FOLD_BUDGET_S = 3.0  # planning time per piece before it is split: this + per face
+FOLD_BUDGET_PER_FACE_S = 0.03
 
 
 def paper_size(spec: str) -> tuple[float, float]:
@@ -209,7 +211,10 @@ def _fold_pieces(parts: list, opts: MakeOptions, clock: _Clock, say) -> tuple[li
                 if collides(tree, tree.goal):
                     info["note"] = "the folded shape itself intersects (input geometry); no path can exist"
                 else:
-                    share = max(0.5, clock.left() / max(1, total - len(results)))
+                    # a short budget, then split: two halves usually fold at once, while a hard
+                    # piece can eat the whole time limit
+                    share = max(0.5, min(clock.left() / max(1, total - len(results)),
+                                         FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
                     try:
                         path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
                     except PolyfoldError as exc:
