@@ -32,6 +32,7 @@ class Planner(str, Enum):
 class Strategy(str, Enum):
     discrete = "discrete"
     continuous = "continuous"
+    continuous_full = "continuous-full"
 
 
 class Method(str, Enum):
@@ -419,6 +420,36 @@ def make(
         _say(f"{mesh.name}: {seg['parts']} part(s), {len(rep['pieces'])} piece(s), {rep['stages']['layout']['pages']} "
              f"page(s), {rep['checks']['paths_verified']}/{len(rep['pieces'])} folding paths verified, "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
+
+
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks against the paper.")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("paper")
+@_guard
+def bench_paper(
+    output: Path = typer.Option(Path("out/bench-paper"), "-o", "--output", help="Folder for report.md, report.json, fig3.png, fig5.png."),
+    runs: int = typer.Option(20, "--runs", min=1, help="Runs (seeds) per row; the paper used 20."),
+    quick: bool = typer.Option(False, "--quick", help="3 runs, 5 s limits, 200 samples: a smoke test (under 3 minutes)."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.1, help="Seconds per search (one unfold or one path)."),
+    samples: int = typer.Option(1000, "--samples", min=1, help="Fig. 5 samples per net and strategy."),
+    models: Optional[Path] = typer.Option(None, "--models", help="Benchmark models folder (default: $POLYFOLD_MODELS or ../shared/models)."),
+) -> None:
+    """Regenerate the paper's Tables 1-2 and Figs. 3 and 5 next to the paper's numbers."""
+    import os
+
+    from .benchpaper import BenchSettings, quick_settings, run
+
+    st = quick_settings() if quick else BenchSettings(runs=runs, time_limit=time_limit, samples=samples)
+    if models is None:
+        env = os.environ.get("POLYFOLD_MODELS")
+        models = Path(env) if env else Path.cwd().parent / "shared" / "models"
+    t0 = time.perf_counter()
+    data = run(models, output, st, progress=lambda line: _say(line))
+    if not data["figures"]:
+        _say("warning: matplotlib is not installed (pip install polyfold[bench]): no figures, tables only")
+    _say(f"bench paper: {time.perf_counter() - t0:.0f} s -> {output / 'report.md'}")
 
 
 # Commands that live in their own modules (each registers itself on `app`).

@@ -240,19 +240,23 @@ class _Merger:
         hit = self.cache.get(key)
         if hit is not None and (hit[1] or hit[0] > limit):
             return hit
+        floor = max(a.conc, b.conc)  # a u b is at least as concave as either part
+        if floor > limit:  # decided without a hull (most candidate pairs once clusters grow)
+            self.cache[key] = res = (floor, False, None)
+            return res
+        if len(a.faces) + len(b.faces) == 2:
+            # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
+            self.cache[key] = res = (0.0, True, np.concatenate([a.hull, b.hull]))
+            return res
         hull_pts, eq = _hull(np.concatenate([a.hull, b.hull]))
         if eq is None:
             res = (0.0, True, hull_pts)
         else:
-            floor = max(a.conc, b.conc)  # a u b is at least as concave as either part
-            if floor > limit:
-                res = (floor, False, hull_pts)
-            else:
-                # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding
-                # noise must not count as exceeding it
-                stop = max(limit, NOISE * self.diag)
-                d = float(_max_depth(np.concatenate([a.pts, b.pts]), eq, stop))
-                res = (_denoise(d, self.diag), d <= stop, hull_pts)
+            # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding
+            # noise must not count as exceeding it
+            stop = max(limit, NOISE * self.diag)
+            d = float(_max_depth(np.concatenate([a.pts, b.pts]), eq, stop))
+            res = (_denoise(d, self.diag), d <= stop, hull_pts)
         self.cache[key] = res
         return res
 
@@ -434,26 +438,36 @@ def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed
 
 
 def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[list[np.ndarray], float]:
+    """Parts and tau for `parts=k`: the default tau when it already gives k parts (so `segment()`
+    and `segment(parts=k)` agree), else a bisection on tau from the default towards k."""
     mesh = m.mesh
-    n_comp = int(face_components(mesh.n_faces, mesh.topology).max()) + 1
+    comp = face_components(mesh.n_faces, mesh.topology)
+    n_comp = int(comp.max()) + 1
     k = int(min(max(k, n_comp), mesh.n_faces))
-    lo, hi = 0.0, max(part_concavity(mesh, np.arange(mesh.n_faces), m.samples), 1e-12) * 1.001
-    # Every component as one part is always admissible at hi (its concavity <= that of the whole).
-    hi = max(hi, max(part_concavity(mesh, np.flatnonzero(face_components(mesh.n_faces, mesh.topology) == c), m.samples)
-                     for c in range(n_comp)) * 1.001)
-    best_above = (_run(m, lo, None, seeds), lo)  # more parts than k
-    if len(best_above[0]) <= k:
-        return best_above
-    groups_hi = _run(m, hi, None, seeds)
-    if len(groups_hi) == k:
-        return groups_hi, hi
+    g = _run(m, DEFAULT_TAU, None, seeds)
+    if len(g) == k:
+        return g, DEFAULT_TAU
+    if len(g) > k:
+        lo, hi = DEFAULT_TAU, None
+    else:
+        lo, hi = 0.0, DEFAULT_TAU
+        g0 = _run(m, 0.0, None, seeds)
+        if len(g0) <= k:  # even tau 0 gives no more parts: already-convex pieces stay whole
+            return g0, 0.0
+    if hi is None:
+        # every component as one part is admissible at its own concavity
+        hi = max(part_concavity(mesh, np.flatnonzero(comp == c), m.samples) for c in range(n_comp)) * 1.001
+        hi = max(hi, lo * 1.001)
+        g = _run(m, hi, None, seeds)
+        if len(g) == k:
+            return g, hi
     for _ in range(40):
         mid = 0.5 * (lo + hi)
         g = _run(m, mid, None, seeds)
         if len(g) == k:
             return g, mid
         if len(g) > k:
-            lo, best_above = mid, (g, mid)
+            lo = mid
         else:
             hi = mid
         if hi - lo < 1e-6:

@@ -1,0 +1,417 @@
+"""`polyfold bench paper`: the paper's Tables 1-2 and Figs. 3 and 5, regenerated next to the
+paper's own numbers (ALGORITHMS.md 8).
+
+In: the benchmark models folder (../shared/models), a number of runs, time limits. Out (into a
+folder): report.md (tables: ours as mean ± standard deviation over the runs, the paper's value,
+paper / ours), report.json (every run), fig3.png and fig5.png. Needs matplotlib for the figures
+(the `bench` extra); the tables do not.
+
+Every time is wall-clock seconds in this process with the numba kernels already compiled. A
+"path" is a collision-free folding path found by `fold.plan_fold` (straight line first = LC,
+then Lazy PRM) and re-validated by it; a run without a path within the time limit counts the
+time limit as its path time and is marked.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+# ALGORITHMS.md 8.1: (DOF, LC, finding net s, path planning s) per horse patch
+PAPER_TABLE1 = [(17, True, 0.00, 0.01), (17, True, 0.00, 0.02), (21, False, 0.00, 2.69), (42, False, 0.56, 1.39),
+                (37, False, 0.02, 0.73), (86, True, 4.84, 0.31), (75, False, 0.58, 1.60)]
+# ALGORITHMS.md 8.2 (+ the horse of 8.1): model -> whole (net, path, total), parts (k, seg, net, path, total)
+PAPER_TABLE2 = {
+    "periscope-28": {"whole": (0.08, 7.05, 7.13), "parts": (2, 0.00, 0.00, 0.12, 0.12)},
+    "periscope2-44": {"whole": (0.21, 12.40, 12.61), "parts": (3, 0.00, 0.09, 0.17, 0.26)},
+    "bunny-128": {"whole": (8.09, 482.57, 490.66), "parts": (3, 0.02, 2.90, 23.15, 26.07)},
+    "fish-472": {"whole": (69.66, 1848.86, 1918.52), "parts": (5, 0.92, 13.19, 105.82, 119.01)},
+    "fish-472 inflated": {"whole": None, "parts": (5, 0.92, 0.88, 9.93, 11.73)},
+    "horse-302": {"whole": (219.87, math.inf, math.inf), "parts": (7, None, 6.00, 6.75, 12.75)},
+}
+# fish-472 folds into a shape that intersects itself by ~2.4e-4 of its size (MODELS.md): at the
+# default contact tolerance no path can exist, so the fish rows use the paper's thickness scale.
+CONTACT = {"fish-472": 1e-3, "fish-472 inflated": 1e-3}
+STRATEGIES = ("discrete", "continuous", "continuous-full")
+STRATEGY_STYLE = {"discrete": ("o", "tab:red"), "continuous": ("^", "tab:blue"), "continuous-full": ("s", "tab:green")}
+FIG3_PAPER = {
+    "uniform": [(0.0, 44), (0.0918, 48), (0.1726, 36), (0.2371, 20), (0.2681, 14), (0.3182, 0)],
+    "constrained": [(0.0, 44), (0.0539, 38), (0.0705, 28), (0.0807, 20), (0.0830, 6), (0.0839, 0)],
+}
+
+
+@dataclass(frozen=True)
+class BenchSettings:
+    runs: int = 20
+    time_limit: float = 60.0  # per search (one unfold, one path), whole meshes and parts alike
+    samples: int = 1000  # Fig. 5 samples per net and strategy (ALGORITHMS.md 6.6)
+    quick: bool = False
+
+
+def quick_settings() -> BenchSettings:
+    return BenchSettings(runs=3, time_limit=5.0, samples=200, quick=True)
+
+
+# ----------------------------------------------------------------------------------------------
+# Measurements
+
+
+def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float) -> dict:
+    """Unfold `mesh` (one component) and plan a folding path for the net; seconds and facts."""
+    from .errors import PolyfoldError
+    from .fold import plan_fold
+    from .foldfile import net_to_fold
+    from .kinematics import collides, fold_tree
+    from .unfold import unfold
+
+    t0 = time.perf_counter()
+    net, st = unfold(mesh, seed=seed, time_limit=time_limit)
+    t1 = time.perf_counter()
+    fold = net_to_fold([net])
+    tree = fold_tree(fold, contact_tol)
+    row = {"dof": int(len(tree.creases)), "pieces": int(net.n_pieces), "net_s": t1 - t0, "path": False,
+           "lc": None, "path_s": float(time_limit), "note": "", "tree": tree}
+    if net.n_pieces > 1:
+        row["note"] = "no single net in time"
+        return row
+    if collides(tree, tree.goal):
+        row["note"] = "goal self-intersects"
+        return row
+    try:
+        path = plan_fold(tree, time_limit=time_limit, seed=seed)
+    except PolyfoldError as exc:
+        row["note"] = str(exc)
+        return row
+    t2 = time.perf_counter()
+    if path is None:
+        row["note"] = "no path in time"
+        row["path_s"] = max(t2 - t1, float(time_limit))
+    else:
+        row.update(path=True, lc=bool(path.linear), path_s=t2 - t1)
+    return row
+
+
+def _mean_sd(xs: list[float]) -> tuple[float, float]:
+    a = np.asarray(xs, dtype=float)
+    return float(a.mean()), float(a.std(ddof=1)) if len(a) > 1 else 0.0
+
+
+def _fmt(m: float, s: float, digits: int = 3) -> str:
+    return f"{m:.{digits}f} ± {s:.{digits}f}"
+
+
+def _ratio(paper: float | None, ours: float) -> str:
+    if paper is None or not math.isfinite(paper):
+        return "–" if paper is None else "∞"
+    if ours <= 0:
+        return "–"
+    return f"{paper / ours:.0f}×" if paper / ours >= 10 else f"{paper / ours:.1f}×"
+
+
+def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: list[float] | None = None) -> dict:
+    """Runs over a list of part meshes: per run the sums of net and path seconds."""
+    per_run, dofs, lcs, ok = [], [], [], True
+    trees = []
+    for seed in range(1, runs + 1):
+        rows = [net_and_path(p, seed, time_limit, tol) for p in parts]
+        net_s = sum(r["net_s"] for r in rows)
+        path_s = sum(r["path_s"] for r in rows)
+        ok &= all(r["path"] for r in rows)
+        per_run.append({"net_s": net_s, "path_s": path_s, "paths": [r["path"] for r in rows],
+                        "lc": [r["lc"] for r in rows], "notes": [r["note"] for r in rows],
+                        "part_net_s": [r["net_s"] for r in rows], "part_path_s": [r["path_s"] for r in rows]})
+        if seed == 1:
+            dofs = [r["dof"] for r in rows]
+            trees = [r["tree"] for r in rows]
+        lcs.append([r["lc"] for r in rows])
+    seg = seg_s or [0.0] * runs
+    totals = [s + r["net_s"] + r["path_s"] for s, r in zip(seg, per_run)]
+    return {"dofs": dofs, "runs": per_run, "seg_s": seg, "totals": totals, "all_paths": ok, "trees": trees}
+
+
+# ----------------------------------------------------------------------------------------------
+# Tables
+
+
+def table1(models: Path, st: BenchSettings, say) -> dict:
+    """Horse: the paper's 7 patches and our own 7-part segmentation of horse-302."""
+    from .io import load_mesh
+    from .segment import segment
+
+    say("table 1: the paper's horse patches")
+    paper_parts = [load_mesh(p).components[0] for p in sorted((models / "paper-parts" / "horse").glob("part-*.obj"))]
+    per_part = []
+    for k, part in enumerate(paper_parts):
+        rows = [net_and_path(part, seed, st.time_limit, 1e-7) for seed in range(1, st.runs + 1)]
+        per_part.append({"dof": rows[0]["dof"], "lc": sum(bool(r["lc"]) for r in rows), "paths": sum(r["path"] for r in rows),
+                         "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows]})
+    say("table 1: our segmentation of horse-302")
+    whole = load_mesh(models / "horse-302.obj").mesh
+    seg_s, seg = [], None
+    for _ in range(st.runs):
+        t0 = time.perf_counter()
+        seg = segment(whole, parts=7)
+        seg_s.append(time.perf_counter() - t0)
+    ours = []
+    for k, part in enumerate(seg.parts):
+        rows = [net_and_path(part, seed, st.time_limit, 1e-7) for seed in range(1, st.runs + 1)]
+        ours.append({"dof": rows[0]["dof"], "lc": sum(bool(r["lc"]) for r in rows), "paths": sum(r["path"] for r in rows),
+                     "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows]})
+    return {"paper_patches": per_part, "our_parts": ours, "our_seg_s": seg_s}
+
+
+def table2(models: Path, st: BenchSettings, say) -> tuple[dict, list]:
+    """Whole mesh vs segmented, per model; also the nets for Fig. 5 (DOF, tree, whole/part)."""
+    from .inflate import inflate
+    from .io import load_mesh
+    from .segment import segment
+
+    out, fig5_trees = {}, []
+    fish_labels = None
+    for name, paper in PAPER_TABLE2.items():
+        tol = CONTACT.get(name, 1e-7)
+        k = paper["parts"][0]
+        if name == "fish-472 inflated":
+            say(f"table 2: {name} (constrained inflation, the fish's own parts)")
+            fish = load_mesh(models / "fish-472.obj").mesh
+            t0 = time.perf_counter()
+            res = inflate(fish, mode="constrained")
+            inflate_s = time.perf_counter() - t0
+            mesh = res.mesh
+            parts = [mesh.submesh(np.flatnonzero(fish_labels == p)) for p in range(k)]
+            seg_s = None
+            extra = {"inflate_s": inflate_s, "inflate_stop": res.stop_reason,
+                     "hv": [int(res.hyperbolic_start), int(res.hyperbolic)]}
+        else:
+            say(f"table 2: {name}")
+            mesh = load_mesh(models / f"{name}.obj").mesh
+            seg_s = []
+            for _ in range(st.runs):
+                t0 = time.perf_counter()
+                seg = segment(mesh, parts=k)
+                seg_s.append(time.perf_counter() - t0)
+            parts = list(seg.parts)
+            if name == "fish-472":
+                fish_labels = seg.labels
+            extra = {"tau": seg.tau}
+        whole = None
+        if paper["whole"] is not None:
+            rows = [net_and_path(mesh, seed, st.time_limit, tol) for seed in range(1, st.runs + 1)]
+            whole = {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
+                     "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
+                     "notes": sorted({r["note"] for r in rows if r["note"]})}
+            fig5_trees.append((name, "whole", rows[0]["tree"]))
+        pr = _parts_row(parts, st.runs, st.time_limit, tol, seg_s)
+        fig5_trees += [(name, "parts", t) for t in pr.pop("trees")]
+        out[name] = {"whole": whole, "parts": pr, "contact_tol": tol, **extra}
+    return out, fig5_trees
+
+
+# ----------------------------------------------------------------------------------------------
+# Figures
+
+
+def fig5(trees: list, st: BenchSettings, say) -> list[dict]:
+    from .fold import sample_ratio
+
+    say(f"fig. 5: valid configuration ratios ({st.samples} samples per net and strategy)")
+    rows = []
+    for name, kind, tree in trees:
+        dof = int(len(tree.creases))
+        m = st.samples * (10 if dof < 20 and not st.quick else 1)
+        r = {"model": name, "kind": kind, "dof": dof, "samples": m}
+        for strategy in STRATEGIES:
+            valid, n = sample_ratio(tree, samples=m, strategy=strategy, seed=0)
+            r[strategy] = valid / n
+        rows.append(r)
+    return rows
+
+
+def fig3(models: Path, say) -> dict:
+    from .inflate import inflate
+    from .io import load_mesh
+
+    say("fig. 3: inflation of sphere-deformed-320, both modes")
+    mesh = load_mesh(models / "sphere-deformed-320.obj").mesh
+    out = {}
+    for mode in ("uniform", "constrained"):
+        t0 = time.perf_counter()
+        res = inflate(mesh, mode=mode, log_every=10)
+        hist = res.history
+        hit = np.flatnonzero(hist[:, 2] <= 0)
+        out[mode] = {"seconds": time.perf_counter() - t0, "steps": res.steps, "stop": res.stop_reason,
+                     "if_at_hv0": float(hist[hit[0], 1]) if len(hit) else None,
+                     "history": hist[:, :3].tolist()}
+    return out
+
+
+def _plots(out_dir: Path, f3: dict, f5: list[dict]) -> list[str]:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return []
+    written = []
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for mode, color in (("uniform", "tab:blue"), ("constrained", "tab:orange")):
+        h = np.asarray(f3[mode]["history"])
+        ax.plot(h[:, 1], h[:, 2], color=color, label=f"{mode} (polyfold)")
+        p = np.asarray(FIG3_PAPER[mode])
+        ax.plot(p[:, 0], p[:, 1], "o", color=color, mfc="none", label=f"{mode} (paper)")
+    ax.set_xlabel("inflation rate IF")
+    ax.set_ylabel("hyperbolic vertices HV")
+    ax.set_title("Fig. 3: sphere-deformed-320")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "fig3.png", dpi=120)
+    plt.close(fig)
+    written.append("fig3.png")
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    floor = 0.5 / max(r["samples"] for r in f5)  # zero ratios drawn at half a sample
+    for strategy, (marker, color) in STRATEGY_STYLE.items():
+        for kind, fill in (("whole", "full"), ("parts", "none")):
+            sel = [r for r in f5 if r["kind"] == kind]
+            if not sel:
+                continue
+            x, y = [r["dof"] for r in sel], [max(r[strategy], floor) for r in sel]
+            label = f"{strategy} – {'original' if kind == 'whole' else 'NCD parts'}"
+            if fill == "full":
+                ax.scatter(x, y, marker=marker, color=color, label=label)
+            else:
+                ax.scatter(x, y, marker=marker, facecolors="none", edgecolors=color, label=label)
+    ax.set_yscale("log")
+    ax.set_xlabel("DOF (creases)")
+    ax.set_ylabel("|C_valid| / |C_sampled|")
+    ax.set_title("Fig. 5: valid configuration ratio")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out_dir / "fig5.png", dpi=120)
+    plt.close(fig)
+    written.append("fig5.png")
+    return written
+
+
+# ----------------------------------------------------------------------------------------------
+# Report
+
+
+def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, seconds: float, figs: list[str]) -> str:
+    L = [f"# polyfold vs the paper (Xi & Lien 2017)", "",
+         f"{st.runs} runs (seeds 1–{st.runs}) per row{' (--quick)' if st.quick else ''}; time limit "
+         f"{st.time_limit:g} s per search (one unfold, one path); mean ± standard deviation of wall-clock "
+         f"seconds; a run without a path counts the time limit as its path time. The paper: C++ on a "
+         f"2012 MacBook Pro, mean of 20 runs. Bench time {seconds:.0f} s.", ""]
+    L += ["## Table 1 — horse, 7 patches", "", "The paper's own patches (../shared/models/paper-parts/horse):", "",
+          "| patch | DOF | LC (runs) | paths | net s | path s | paper DOF | paper LC | paper net s | paper path s |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
+    tot_net = np.sum([p["net_s"] for p in t1["paper_patches"]], axis=0)
+    tot_path = np.sum([p["path_s"] for p in t1["paper_patches"]], axis=0)
+    for k, (p, ref) in enumerate(zip(t1["paper_patches"], PAPER_TABLE1)):
+        L.append(f"| {k} | {p['dof']} | {p['lc']}/{st.runs} | {p['paths']}/{st.runs} | {_fmt(*_mean_sd(p['net_s']))} | "
+                 f"{_fmt(*_mean_sd(p['path_s']))} | {ref[0]} | {'yes' if ref[1] else 'no'} | {ref[2]:.2f} | {ref[3]:.2f} |")
+    L.append(f"| subtotal | | | | {_fmt(*_mean_sd(tot_net))} | {_fmt(*_mean_sd(tot_path))} | | | 6.00 | 6.75 |")
+    total = tot_net + tot_path
+    L += ["", f"Total {_fmt(*_mean_sd(total))} s (paper 12.75 s, ratio {_ratio(12.75, float(np.mean(total)))}).", "",
+          "Our own 7-part segmentation of horse-302 (`segment(parts=7)`):", "",
+          "| part | DOF | LC (runs) | paths | net s | path s |", "|---|---|---|---|---|---|"]
+    for k, p in enumerate(t1["our_parts"]):
+        L.append(f"| {k} | {p['dof']} | {p['lc']}/{st.runs} | {p['paths']}/{st.runs} | {_fmt(*_mean_sd(p['net_s']))} | "
+                 f"{_fmt(*_mean_sd(p['path_s']))} |")
+    o_total = np.sum([p["net_s"] for p in t1["our_parts"]], axis=0) + np.sum([p["path_s"] for p in t1["our_parts"]], axis=0) \
+        + np.asarray(t1["our_seg_s"])
+    L += ["", f"Total with segmentation {_fmt(*_mean_sd(o_total))} s.", ""]
+
+    L += ["## Table 2 — whole mesh vs nearly convex parts", "",
+          "| model | route | parts | DOF per part | seg s | net s | path s | total s | paths | paper total | paper / ours |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, r in t2.items():
+        paper = PAPER_TABLE2[name]
+        w = r["whole"]
+        if w is not None:
+            tot = np.asarray(w["net_s"]) + np.asarray(w["path_s"])
+            pw = paper["whole"][2]
+            note = f" ({'; '.join(w['notes'])})" if w["notes"] else ""
+            L.append(f"| {name} | whole | 1 | {w['dof']} | – | {_fmt(*_mean_sd(w['net_s']))} | "
+                     f"{_fmt(*_mean_sd(w['path_s']))} | {_fmt(*_mean_sd(tot))} | {w['paths']}/{st.runs}{note} | "
+                     f"{'> 3600 (no path)' if not math.isfinite(pw) else f'{pw:.2f}'} | {_ratio(pw, float(tot.mean())) if w['paths'] == st.runs else '–'} |")
+        p = r["parts"]
+        n_paths = sum(all(run["paths"]) for run in p["runs"])
+        pp = paper["parts"]
+        L.append(f"| {name} | parts | {len(p['dofs'])} | {' / '.join(map(str, p['dofs']))} | {_fmt(*_mean_sd(p['seg_s']))} | "
+                 f"{_fmt(*_mean_sd([x['net_s'] for x in p['runs']]))} | {_fmt(*_mean_sd([x['path_s'] for x in p['runs']]))} | "
+                 f"{_fmt(*_mean_sd(p['totals']))} | {n_paths}/{st.runs} | {pp[4]:.2f} | "
+                 f"{_ratio(pp[4], float(np.mean(p['totals']))) if n_paths == st.runs else '–'} |")
+    L += ["", "Contact tolerance 1e-3 of the model size for the fish rows (its folded shape self-intersects "
+          "by 2.4e-4 of its size; see MODELS.md), 1e-7 elsewhere. 'fish-472 inflated': constrained inflation, "
+          "then the same parts as 'fish-472'.", ""]
+    if "fish-472 inflated" in t2:
+        fi = t2["fish-472 inflated"]
+        L += [f"Inflation of the fish: {fi['inflate_s']:.2f} s, HV {fi['hv'][0]} → {fi['hv'][1]}, stop: {fi['inflate_stop']}.", ""]
+
+    L += ["## Fig. 3 — inflation rate vs hyperbolic vertices (sphere-deformed-320)", "",
+          "| mode | steps | seconds | IF at HV = 0 | paper |", "|---|---|---|---|---|"]
+    for mode in ("uniform", "constrained"):
+        f = f3[mode]
+        v = "not reached" if f["if_at_hv0"] is None else f"{f['if_at_hv0']:.4f}"
+        L.append(f"| {mode} | {f['steps']} | {f['seconds']:.2f} | {v} | {FIG3_PAPER[mode][-1][0]:.4f} |")
+    u, c = f3["uniform"]["if_at_hv0"], f3["constrained"]["if_at_hv0"]
+    if u and c:
+        L += ["", f"Constrained / uniform IF: {c / u:.2f} (paper 0.26): "
+              f"{'reproduced' if c / u < 1 / 3 else 'not reproduced'} (constrained needs far less deformation)."]
+    L += [""]
+    if "fig3.png" in figs:
+        L += ["![Fig. 3](fig3.png)", ""]
+
+    L += ["## Fig. 5 — valid configuration ratio", "",
+          "Continuous: each crease uniform between 0 and its goal angle; continuous-full: uniform in (−π, π), "
+          "the whole configuration space (ALGORITHMS.md 6.4 names both; the paper does not say which it used).", "",
+          "| model | net | DOF | samples | discrete | continuous | continuous-full |", "|---|---|---|---|---|---|---|"]
+    for r in sorted(f5, key=lambda r: r["dof"]):
+        L.append(f"| {r['model']} | {r['kind']} | {r['dof']} | {r['samples']} | {r['discrete']:.4f} | "
+                 f"{r['continuous']:.4f} | {r['continuous-full']:.4f} |")
+    for other in ("continuous", "continuous-full"):
+        ge = sum(r["discrete"] >= r[other] for r in f5)
+        L.append(f"Discrete ≥ {other} on {ge} of {len(f5)} nets.")
+    L += ["", "Paper: discrete ≫ continuous, the gap growing roughly exponentially with DOF."]
+    parts = [r for r in f5 if r["kind"] == "parts"]
+    whole = [r for r in f5 if r["kind"] == "whole"]
+    if parts and whole:
+        L.append(f"Mean discrete ratio: parts {np.mean([r['discrete'] for r in parts]):.3f}, whole meshes "
+                 f"{np.mean([r['discrete'] for r in whole]):.3f} (paper: parts higher).")
+    if "fig5.png" in figs:
+        L += ["", "![Fig. 5](fig5.png)"]
+    return "\n".join(L) + "\n"
+
+
+def run(models: Path, out_dir: Path, st: BenchSettings, progress: Callable[[str], None] | None = None) -> dict:
+    """Run everything, write out_dir/report.md, report.json, fig3.png, fig5.png; return the data."""
+    from .io import atomic_write, load_mesh
+
+    say = progress or (lambda s: None)
+    if not (models / "horse-302.obj").exists():
+        from .errors import PolyfoldError
+
+        raise PolyfoldError(f"benchmark models not found in {models} (set POLYFOLD_MODELS)")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    net_and_path(load_mesh(models / "tetrahedron-4.obj").components[0], 0, 10, 1e-7)  # compile / load caches
+    t1 = table1(models, st, say)
+    t2, trees = table2(models, st, say)
+    f5 = fig5(trees, st, say)
+    f3 = fig3(models, say)
+    figs = _plots(out_dir, f3, f5)
+    seconds = time.perf_counter() - t0
+    data = {"settings": st.__dict__, "seconds": seconds, "table1": t1, "table2": t2, "fig3": f3, "fig5": f5,
+            "figures": figs}
+    atomic_write(out_dir / "report.json", json.dumps(data, indent=1, default=float) + "\n")
+    atomic_write(out_dir / "report.md", _markdown(t1, t2, f3, f5, st, seconds, figs))
+    return data
