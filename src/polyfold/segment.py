@@ -345,11 +345,20 @@ def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
     heap: list = []
 
     def push(i: int, j: int) -> None:
+        # Lazy: the key is a lower bound (a u b is at least as concave as a or b); the exact union
+        # concavity (a convex hull) is computed only when the pair reaches the top of the heap.
+        a, b = clusters[i], clusters[j]
+        floor = max(a.conc, b.conc)
+        if floor > limit:
+            return
+        heapq.heappush(heap, (cost(a, b, a.nbrs[j], floor), 0, i, j))
+
+    def push_exact(i: int, j: int) -> None:
         a, b = clusters[i], clusters[j]
         conc, exact, _ = m.union_conc(a, b, limit)
         if not exact or conc > limit:  # (the memo may hold exact values from runs with a larger tau)
             return
-        heapq.heappush(heap, (cost(a, b, a.nbrs[j], conc), i, j, a.version, b.version))
+        heapq.heappush(heap, (cost(a, b, a.nbrs[j], conc), 1, i, j))
 
     for i, c in clusters.items():
         for j in c.nbrs:
@@ -384,8 +393,11 @@ def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
 
     stop = 1 if target is None else target
     while heap and len(clusters) > stop:
-        _, i, j, vi, vj = heapq.heappop(heap)
-        if i not in clusters or j not in clusters or clusters[i].version != vi or clusters[j].version != vj:
+        _, exact, i, j = heapq.heappop(heap)
+        if i not in clusters or j not in clusters:  # a merged cluster: its ids are never reused
+            continue
+        if not exact:
+            push_exact(i, j)
             continue
         k = merge(i, j)
         for n in list(clusters[k].nbrs):
