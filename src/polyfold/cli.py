@@ -414,7 +414,7 @@ def make(
             _say(f"warning: {len(lay['untabbed_edges'])} glue edge(s) without a tab (no room on either side): "
                  f"{', '.join(lay['untabbed_edges'][:10])}{' ...' if len(lay['untabbed_edges']) > 10 else ''}")
         if lay["splits_for_page"]:
-            _say(f"split {lay['splits_for_page']} crease(s) so every piece fits a {paper} page at {size:g} mm")
+            _say(f"split {lay['splits_for_page']} crease(s) so every piece fits on {paper} paper at {size:g} mm")
     seg = rep["stages"]["segment"]
     if not quiet:
         _say(f"{mesh.name}: {seg['parts']} part(s), {len(rep['pieces'])} piece(s), {rep['stages']['layout']['pages']} "
