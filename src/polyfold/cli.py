@@ -15,6 +15,8 @@ from typing import Optional
 
 import typer
 
+from . import cli_options
+
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
@@ -292,7 +294,7 @@ def inflate(
     if mode not in ("constrained", "uniform"):
         _fail(f"--mode must be 'constrained' or 'uniform', not {mode!r}", 2)
     from .inflate import inflate as inflate_mesh
-    from .io import atomic_write
+    from .io import atomic_write, obj_text
 
     t0 = time.perf_counter()
     loaded = _load(mesh)
@@ -308,10 +310,8 @@ def inflate(
         print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
     for note in res.notes:
         _say(f"warning: {mesh.name}: {note}")
-    lines = [f"# {mesh.name} inflated by polyfold ({mode}): {res.steps} steps, {res.stop_reason}"]
-    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in res.mesh.vertices.tolist()]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in res.mesh.faces.tolist()]
-    atomic_write(output, "\n".join(lines) + "\n")
+    atomic_write(output, obj_text(res.mesh.vertices, res.mesh.faces,
+                                  f"{mesh.name} inflated by polyfold ({mode}): {res.steps} steps, {res.stop_reason}"))
     if log is not None:
         rows = ["step,IF,HV,volume_change"]
         rows += [f"{int(s)},{r!r},{int(h)},{v!r}" for s, r, h, v in res.history.tolist()]
@@ -358,30 +358,26 @@ def segment(
 def make(
     mesh: Path = typer.Argument(..., help="Mesh file (OBJ, OFF, STL, PLY, GLB)."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for sheets, FOLD files, instructions and report."),
-    inflate_mode: str = typer.Option("none", "--inflate", help="none | constrained | uniform: inflate the mesh first (paper Sec. 3)."),
-    segment_mode: str = typer.Option("auto", "--segment", help="auto (one part per component unless no single net is found) | none."),
-    tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Segment into parts of concavity <= tau (fraction of the bbox diagonal)."),
-    parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Segment into this many parts."),
-    paper: str = typer.Option("a4", "--paper", help="a4 | letter | a3 | 12x12in | WxHmm."),
-    size: float = typer.Option(150.0, "--size", min=1e-6, help="Longest dimension of the built model, mm."),
-    margin: float = typer.Option(10.0, "--margin", min=0.0, help="Page margin, mm."),
-    tabs: str = typer.Option("auto", "--tabs", help="auto (glue tabs where they fit) | none."),
+    inflate_mode: str = cli_options.INFLATE,
+    segment_mode: str = cli_options.SEGMENT,
+    tau: Optional[float] = cli_options.TAU,
+    parts: Optional[int] = cli_options.PARTS,
+    paper: str = cli_options.PAPER,
+    size: float = cli_options.SIZE,
+    margin: float = cli_options.MARGIN,
+    tabs: str = cli_options.TABS,
     seed: int = typer.Option(1, "--seed", help="Random seed (same seed, same sheets)."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the searches (unfold, fold)."),
-    fold: bool = typer.Option(True, "--fold/--no-fold", help="Plan and verify a folding path for every piece."),
-    contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
+    fold: bool = cli_options.FOLD,
+    contact_tol: float = cli_options.CONTACT_TOL,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
     """Mesh in, printable sheets out: inflate, segment, unfold, fold, lay out with tabs and labels, export."""
-    if tau is not None and parts is not None:
-        _fail("give --tau or --parts, not both", 2)
-    if tabs not in ("auto", "none"):
-        _fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
-    from .make import MakeOptions, make as run_make
+    opts = cli_options.make_options(_fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
+                                    paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
+                                    time_limit=time_limit, fold=fold, contact_tol=contact_tol)
+    from .make import make as run_make
 
-    opts = MakeOptions(inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts, paper=paper, size=size,
-                       margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
-                       contact_tol=contact_tol)
     t0 = time.perf_counter()
     if quiet:
         result = run_make(mesh, output, opts)

@@ -10,6 +10,8 @@ from typing import List, Optional
 
 import typer
 
+from . import cli_options
+
 
 def register(app, guard, say, fail) -> None:
     """Add the command to the typer `app`. guard: wraps a command body (one-line errors, exit
@@ -28,17 +30,17 @@ def register(app, guard, say, fail) -> None:
         study: Optional[str] = typer.Option(None, "--study", help="cspace | unfold: run a study over the meshes instead of make (CSV + SVG plot)."),
         runs: int = typer.Option(5, "--runs", min=1, help="--study unfold: seeds 1..N per component."),
         samples: int = typer.Option(1000, "--samples", min=1, help="--study cspace: configurations per strategy."),
-        inflate_mode: str = typer.Option("none", "--inflate", help="none | constrained | uniform: inflate the mesh first (paper Sec. 3)."),
-        segment_mode: str = typer.Option("auto", "--segment", help="auto (one part per component unless no single net is found) | none."),
-        tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Segment into parts of concavity <= tau (fraction of the bbox diagonal)."),
-        parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Segment into this many parts."),
-        paper: str = typer.Option("a4", "--paper", help="a4 | letter | a3 | 12x12in | WxHmm."),
-        size: float = typer.Option(150.0, "--size", min=1e-6, help="Longest dimension of the built model, mm."),
-        margin: float = typer.Option(10.0, "--margin", min=0.0, help="Page margin, mm."),
-        tabs: str = typer.Option("auto", "--tabs", help="auto (glue tabs where they fit) | none."),
+        inflate_mode: str = cli_options.INFLATE,
+        segment_mode: str = cli_options.SEGMENT,
+        tau: Optional[float] = cli_options.TAU,
+        parts: Optional[int] = cli_options.PARTS,
+        paper: str = cli_options.PAPER,
+        size: float = cli_options.SIZE,
+        margin: float = cli_options.MARGIN,
+        tabs: str = cli_options.TABS,
         seed: int = typer.Option(1, "--seed", help="Random seed (same seed, same sheets; --study cspace: the net and samples)."),
-        fold: bool = typer.Option(True, "--fold/--no-fold", help="Plan and verify a folding path for every piece."),
-        contact_tol: float = typer.Option(1e-7, "--contact-tol", min=0.0, help="Faces closer than this (fraction of the model size) touch rather than cross."),
+        fold: bool = cli_options.FOLD,
+        contact_tol: float = cli_options.CONTACT_TOL,
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress and no table: only the summary line and errors."),
     ) -> None:
         """Make (or study) every mesh matching GLOB, each in its own process, locally or on Dask.
@@ -47,22 +49,17 @@ def register(app, guard, say, fail) -> None:
         mesh failed (error, timeout, crashed)."""
         import time
 
-        if tau is not None and parts is not None:
-            fail("give --tau or --parts, not both", 2)
-        if tabs not in ("auto", "none"):
-            fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
+        opts = cli_options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
+                                        paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
+                                        time_limit=time_limit, fold=fold, contact_tol=contact_tol)
         if study is not None and study not in ("cspace", "unfold"):
             fail(f"--study must be 'cspace' or 'unfold', not {study!r}", 2)
         from .batch import run_batch, run_study
-        from .make import MakeOptions
 
         t0 = time.perf_counter()
         progress, close = _progress(quiet, say)
         try:
             if study is None:
-                opts = MakeOptions(inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts, paper=paper,
-                                   size=size, margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit,
-                                   fold=fold, contact_tol=contact_tol)
                 result = run_batch(patterns, output, opts, workers=workers, scheduler=scheduler,
                                    hard_limit=hard_limit, force=force, progress=progress)
             else:

@@ -747,6 +747,16 @@ def _default_mode() -> int:
 _FILE_MODE = _default_mode()  # read once: os.umask is process-wide, so never toggle it later
 
 
+def obj_text(vertices: np.ndarray, faces: np.ndarray, header: list[str] | str = ()) -> str:
+    """Wavefront OBJ text of a triangle mesh: header comment lines, then v and f (1-based) lines.
+    Coordinates are written with repr so reading the file back gives the same floats."""
+    header = [header] if isinstance(header, str) else list(header)
+    lines = [f"# {h}" for h in header]
+    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, dtype=np.float64).tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.asarray(faces).tolist()]
+    return "\n".join(lines) + "\n"
+
+
 def atomic_write(path: str | os.PathLike, data: str | bytes) -> None:
     """Write `data` to `path` via a temp file in the same directory and os.replace.
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import PolyfoldError
+from .foldfile import FLAT_EPS  # flat creases are not scored, as in the FOLD files
 from .pages import Page, TextItem
 from .unfold import Net, cut_creases
 
@@ -26,7 +27,6 @@ TAB_MIN_MM = 1.0  # smaller tabs are useless: no tab instead
 LABEL_MAX_MM = 3.0
 LABEL_MIN_MM = 0.8  # a label smaller than this is reported (it is still placed inside its face)
 CHAR_EM = 0.62  # mean advance width of a Helvetica digit/capital, in em
-FLAT_EPS = 1e-10  # |fold angle| below this: flat crease, not scored
 
 
 class PieceTooLarge(PolyfoldError):
@@ -131,6 +131,29 @@ def _dfs_intervals(parent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 MAX_PEEL_TRIES = 64
 
 
+def subtree_areas(net: Net) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sub_area, tin, tout) per face: the flat area of the face's subtree in the net (net units^2)
+    and its Euler-tour interval (see `_dfs_intervals`)."""
+    xy = net.coords
+    e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+    sub_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    tin, tout = _dfs_intervals(net.parent)
+    for f in np.argsort(tin)[::-1]:  # children come after their parent in tin order
+        if net.parent[f] >= 0:
+            sub_area[net.parent[f]] += sub_area[f]
+    return sub_area, tin, tout
+
+
+def balanced_cut(net: Net, piece: int) -> int:
+    """The face of `piece` (two faces or more) whose crease to its parent splits the piece's area
+    most evenly."""
+    faces = np.flatnonzero(net.piece == piece)
+    cand = faces[net.parent[faces] >= 0]
+    sub_area, _, _ = subtree_areas(net)
+    root = faces[net.parent[faces] < 0][0]
+    return int(cand[np.argmin(np.abs(sub_area[cand] - sub_area[root] / 2))])
+
+
 def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> float:
     """Largest scale at which the convex hull of the points, grown by `pad` mm, fits the page."""
     import shapely
@@ -150,11 +173,9 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
     net and the number of creases cut. Raises PolyfoldError when a single face is too large,
     naming the largest model size that would fit."""
     xy = net.coords * scale
-    e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
-    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
     cuts = 0
     for _ in range(len(net.piece)):
-        tin, tout = _dfs_intervals(net.parent)
+        sub_area, tin, tout = subtree_areas(net)
         by_tin = np.argsort(tin)
         todo = None
         for p in range(net.n_pieces):
@@ -167,11 +188,6 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
         if len(todo) == 1:
             f = int(todo[0])
             raise PieceTooLarge(int(net.mesh.face_source[f]), _hull_scale(xy[f], page_size, margin, pad))
-        # subtree area of every face of the piece (reverse tin order accumulates children first)
-        sub_area = area.copy()
-        for f in by_tin[::-1]:
-            if net.parent[f] >= 0:
-                sub_area[net.parent[f]] += sub_area[f]
         cand = todo[net.parent[todo] >= 0]
         cand = cand[np.argsort(-sub_area[cand], kind="stable")]
         # Peel a subtree that fits; best one whose rest fits too (two pieces instead of three),

@@ -107,7 +107,6 @@ def _unfold_parts(mesh, opts: MakeOptions, clock: _Clock, say) -> tuple[list, di
     from .segment import DEFAULT_TAU, segment
     from .unfold import unfold
 
-    t0 = time.perf_counter()
     comp = face_components(mesh.n_faces, mesh.topology)
     components = [np.flatnonzero(comp == c) for c in range(int(comp.max()) + 1)]
     explicit = opts.tau is not None or opts.parts is not None
@@ -157,30 +156,9 @@ def _unfold_parts(mesh, opts: MakeOptions, clock: _Clock, say) -> tuple[list, di
                                       "method": st.method, "timed_out": bool(st.timed_out)})
         out.append((faces, net))
     seg_report["parts"] = len(out)
-    seg_report["seconds"] = seg_report["seconds"] or 0.0
     if not explicit:
         seg_report["tau"] = DEFAULT_TAU if seg_report["segmented_components"] else None
     return out, seg_report, unfold_report
-
-
-def _balanced_cut(net, piece: int) -> int | None:
-    """The face of `piece` whose crease to its parent splits the piece's area most evenly."""
-    from .layout import _dfs_intervals
-
-    faces = np.flatnonzero(net.piece == piece)
-    cand = faces[net.parent[faces] >= 0]
-    if len(cand) == 0:
-        return None
-    xy = net.coords
-    e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
-    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    tin, _ = _dfs_intervals(net.parent)
-    sub = area.copy()
-    for f in np.argsort(tin)[::-1]:
-        if net.parent[f] >= 0:
-            sub[net.parent[f]] += sub[f]
-    total = area[faces].sum()
-    return int(cand[np.argmin(np.abs(sub[cand] - total / 2))])
 
 
 def _fold_pieces(parts: list, opts: MakeOptions, clock: _Clock, say) -> tuple[list, dict]:
@@ -191,57 +169,57 @@ def _fold_pieces(parts: list, opts: MakeOptions, clock: _Clock, say) -> tuple[li
     from .fold import plan_fold, with_path
     from .foldfile import net_to_fold
     from .kinematics import collides, fold_tree
+    from .layout import balanced_cut
     from .unfold import cut_creases, piece_net
 
     t0 = time.perf_counter()
     results = []
-    total = sum(net.n_pieces for _, net in parts)
+    pending = sum(net.n_pieces for _, net in parts)  # pieces not planned yet (for the time shares)
     splits = 0
-    for pi, (faces, net) in enumerate(parts):
-        queue = [(net, k, 0) for k in range(net.n_pieces)]
-        while queue:
-            cur, k, depth = queue.pop(0)
-            pnet, fids = piece_net(cur, k)
-            fold = net_to_fold([pnet], title=f"part {pi} piece")
-            info = {"path": False, "linear": None, "planner": None, "seconds": 0.0, "frames": 0, "note": ""}
-            if opts.fold and pnet.mesh.n_faces > 1:
-                say("fold", f"part {pi + 1}/{len(parts)}: planning a path for {pnet.mesh.n_faces} faces")
-                tf = time.perf_counter()
-                tree = fold_tree(fold, opts.contact_tol)
-                if collides(tree, tree.goal):
-                    info["note"] = "the folded shape itself intersects (input geometry); no path can exist"
-                else:
-                    # a short budget, then split: two halves usually fold at once, while a hard
-                    # piece can eat the whole time limit
-                    share = max(0.5, min(clock.left() / max(1, total - len(results)),
-                                         FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
-                    try:
-                        path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
-                    except PolyfoldError as exc:
-                        path, info["note"] = None, str(exc)
-                    if path is None and depth < 3 and clock.left() > 0:
-                        cut = _balanced_cut(cur, k)
-                        if cut is not None:
-                            splits += 1
-                            new = cut_creases(cur, np.array([cut]))
-                            # cutting renumbers the pieces: follow each piece by its root face
-                            def renumber(kk: int) -> int:
-                                root = np.flatnonzero((cur.piece == kk) & (cur.parent < 0))[0]
-                                return int(new.piece[root])
 
-                            halves = sorted({int(new.piece[cut]), renumber(k)})
-                            queue = [(new, x, depth + 1) for x in halves] + [(new, renumber(kk), d) for _, kk, d in queue]
-                            say("fold", f"no path in {share:.1f} s: split the piece in two")
-                            continue
-                    if path is not None:
-                        fold = with_path(fold, path, opts.resolution_deg, opts.contact_tol)
-                        info.update(path=True, linear=bool(path.linear), planner=path.planner, frames=len(path.frames))
-                    elif not info["note"]:
-                        info["note"] = "no path within the time limit"
-                info["seconds"] = time.perf_counter() - tf
-            elif pnet.mesh.n_faces == 1:
-                info.update(path=True, linear=True, planner="trivial", note="single face")
-            results.append((pi, faces, pnet, fids, fold, info))
+    def plan(pi: int, faces: np.ndarray, pnet, fids: np.ndarray, depth: int) -> None:
+        """Plan one single-piece net (fids: its faces in the part); split and recurse on failure."""
+        nonlocal pending, splits
+        fold = net_to_fold([pnet], title=f"part {pi} piece")
+        info = {"path": False, "linear": None, "planner": None, "seconds": 0.0, "frames": 0, "note": ""}
+        if pnet.mesh.n_faces == 1:
+            info.update(path=True, linear=True, planner="trivial", note="single face")
+        elif opts.fold:
+            say("fold", f"part {pi + 1}/{len(parts)}: planning a path for {pnet.mesh.n_faces} faces")
+            tf = time.perf_counter()
+            tree = fold_tree(fold, opts.contact_tol)
+            if collides(tree, tree.goal):
+                info["note"] = "the folded shape itself intersects (input geometry); no path can exist"
+            else:
+                # a short budget, then split: two halves usually fold at once, while a hard
+                # piece can eat the whole time limit
+                share = max(0.5, min(clock.left() / max(1, pending),
+                                     FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
+                try:
+                    path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
+                except PolyfoldError as exc:
+                    path, info["note"] = None, str(exc)
+                if path is None and depth < 3 and clock.left() > 0:
+                    say("fold", f"no path in {share:.1f} s: split the piece in two")
+                    halves = cut_creases(pnet, np.array([balanced_cut(pnet, 0)]))
+                    splits += 1
+                    pending += 1
+                    for h in range(2):
+                        sub, sub_fids = piece_net(halves, h)
+                        plan(pi, faces, sub, fids[sub_fids], depth + 1)
+                    return
+                if path is not None:
+                    fold = with_path(fold, path, opts.resolution_deg, opts.contact_tol)
+                    info.update(path=True, linear=bool(path.linear), planner=path.planner, frames=len(path.frames))
+                elif not info["note"]:
+                    info["note"] = "no path within the time limit"
+            info["seconds"] = time.perf_counter() - tf
+        pending -= 1
+        results.append((pi, faces, pnet, fids, fold, info))
+
+    for pi, (faces, net) in enumerate(parts):
+        for k in range(net.n_pieces):
+            plan(pi, faces, *piece_net(net, k), 0)
     report = {"enabled": opts.fold, "seconds": time.perf_counter() - t0, "splits_for_folding": splits,
               "verified": sum(r[5]["path"] for r in results), "pieces": len(results)}
     return results, report
@@ -301,13 +279,6 @@ def _check_pages(placed: list, page_index: list[int], n_pages: int, width: float
 # Outputs
 
 
-def _obj_text(vertices: np.ndarray, faces: np.ndarray, header: str) -> str:
-    lines = [f"# {header}"]
-    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices.tolist()]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces.tolist()]
-    return "\n".join(lines) + "\n"
-
-
 def _png_b64(mesh, part_faces: list[np.ndarray], highlight: int | None) -> str:
     import base64
 
@@ -345,7 +316,6 @@ def _instructions_html(name: str, mesh, part_faces, pieces, glue, page_of_piece,
          "<h2>Sheets</h2>"]
     for f in sheet_files:
         h.append(f"<img class='sheet' src='{escape(f)}' alt='{escape(f)}'>")
-    by_label = {g.label: g for g in glue}
     for part, idx in sorted(part_pieces.items()):
         h.append(f"<div class='step'><h2>Part {part + 1}</h2>"
                  f"<img src='data:image/png;base64,{_png_b64(mesh, part_faces, part)}' alt='part {part + 1}'>")
@@ -370,7 +340,6 @@ def _instructions_html(name: str, mesh, part_faces, pieces, glue, page_of_piece,
         h.append("</table>")
     h.append("<p>Every piece's folding path is in its <code>piece-*.fold</code> file "
              "(FOLD 1.1, <code>polyfold:path</code>).</p></body></html>")
-    _ = by_label
     return "\n".join(h) + "\n"
 
 
@@ -387,7 +356,7 @@ def make(mesh_path: str | os.PathLike, out_dir: str | os.PathLike, opts: MakeOpt
     instructions.html (pictures, what glues to what) and report.json. Raises PolyfoldError (nothing
     written) on bad input, a piece too large for the paper, or a failed sheet check."""
     from .foldfile import dumps
-    from .io import load_mesh
+    from .io import load_mesh, obj_text
     from .layout import PieceInput, PieceTooLarge, build_sheet_pieces, page_of, place, split_to_fit
     from .pack import pack_outlines
     from .pages import pdf_bytes, svg_page_string, dxf_document
@@ -501,7 +470,7 @@ def make(mesh_path: str | os.PathLike, out_dir: str | os.PathLike, opts: MakeOpt
         part_faces = [faces for faces, _ in parts]
         for k, faces in enumerate(part_faces):
             sub = mesh.submesh(faces)
-            (tmp / f"part-{k}.obj").write_text(_obj_text(sub.vertices, sub.faces, f"part {k} of {name} (polyfold make)"))
+            (tmp / f"part-{k}.obj").write_text(obj_text(sub.vertices, sub.faces, f"part {k} of {name} (polyfold make)"))
             files.append(f"part-{k}.obj")
         piece_rows = []
         for i, (pi, faces, pnet, fids, fold, info) in enumerate(folded):

@@ -250,28 +250,25 @@ def _pdf_stroke(c, style: str) -> None:
     c.setDash([v * MM_TO_PT for v in st["dash"]] if st["dash"] else [], 0)
 
 
+def _pdf_polygon(c, pts_pt: np.ndarray, stroke: int, fill: int) -> None:
+    """One closed polygon (points already in PDF points) on reportlab canvas `c`."""
+    p = c.beginPath()
+    p.moveTo(*pts_pt[0])
+    for x, y in pts_pt[1:]:
+        p.lineTo(x, y)
+    p.close()
+    c.drawPath(p, stroke=stroke, fill=fill)
+
+
 def _draw_pdf_page(c, page: Page) -> None:
     """Draw `page` on the current page of reportlab canvas `c` (page size already set)."""
-    if page.tabs:
-        c.setFillColorRGB(*(v / 255 for v in TAB_RGB))
-        for t in page.tabs:
-            q = _pt(page, t)
-            p = c.beginPath()
-            p.moveTo(*q[0])
-            for x, y in q[1:]:
-                p.lineTo(x, y)
-            p.close()
-            c.drawPath(p, stroke=0, fill=1)
-    if page.faces:
-        c.setFillColorRGB(*(v / 255 for v in PREVIEW_RGB))
-        for tris in page.faces:
-            for tri in _pt(page, tris):
-                p = c.beginPath()
-                p.moveTo(*tri[0])
-                p.lineTo(*tri[1])
-                p.lineTo(*tri[2])
-                p.close()
-                c.drawPath(p, stroke=0, fill=1)
+    c.setFillColorRGB(*(v / 255 for v in TAB_RGB))
+    for t in page.tabs:
+        _pdf_polygon(c, _pt(page, t), stroke=0, fill=1)
+    c.setFillColorRGB(*(v / 255 for v in PREVIEW_RGB))
+    for tris in page.faces:
+        for tri in _pt(page, tris):
+            _pdf_polygon(c, tri, stroke=0, fill=1)
 
     for style, _cls, segs in _crease_layers(page):
         if not len(segs):
@@ -283,13 +280,7 @@ def _draw_pdf_page(c, page: Page) -> None:
     _pdf_stroke(c, "cut")
     c.setLineJoin(1)  # round, as in the SVG
     for poly in page.cut:
-        q = _pt(page, poly)
-        p = c.beginPath()
-        p.moveTo(*q[0])
-        for x, y in q[1:]:
-            p.lineTo(x, y)
-        p.close()
-        c.drawPath(p, stroke=1, fill=0)
+        _pdf_polygon(c, _pt(page, poly), stroke=1, fill=0)
     for (x0, y0), (x1, y1) in _pt(page, page.slits):
         c.line(x0, y0, x1, y1)
 

@@ -73,6 +73,14 @@ def _zfill(img, zbuf, tri, depth, colors):
                     img[py, px, 2] = colors[t, 2]
 
 
+def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> None:
+    """Paint 2D pixel-space triangles (n, 3, 2) with flat colours (n, 3) into img (H, W, 3), in
+    place; where triangles overlap, the first one drawn stays (a net has no overlaps to resolve)."""
+    tris = np.ascontiguousarray(tris, dtype=np.float64)
+    zbuf = np.full(img.shape[:2], np.inf)
+    _zfill(img, zbuf, tris, np.zeros(tris.shape[:2]), np.ascontiguousarray(colors, dtype=np.uint8))
+
+
 def view_rotation(elevation_deg: float, azimuth_deg: float, up_axis: int) -> np.ndarray:
     """3x3 rotation taking model coordinates to view coordinates (x right, y up, z towards the viewer).
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .io import obj_text
 from .mesh import Mesh, face_areas, face_components
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
@@ -188,18 +189,16 @@ def rand_index(a: np.ndarray, b: np.ndarray) -> float:
 
 
 class _Cluster:
-    __slots__ = ("faces", "verts", "pts", "hull", "conc", "area", "perim", "nbrs", "version", "key")
+    __slots__ = ("faces", "pts", "hull", "conc", "area", "perim", "nbrs", "key")
 
-    def __init__(self, faces, verts, pts, hull, conc, area, perim, key):
+    def __init__(self, faces, pts, hull, conc, area, perim, key):
         self.faces = faces  # int64 array of mesh faces
-        self.verts = verts  # unique mesh vertex ids
         self.pts = pts  # (n, 3) vertices + surface samples
         self.hull = hull  # (h, 3) hull vertex coordinates (all points when flat)
         self.conc = conc  # absolute concavity (not divided by the diagonal)
         self.area = area
         self.perim = perim
         self.nbrs: dict[int, list[float]] = {}  # neighbour -> [shared length, concave-weighted length]
-        self.version = 0
         self.key = key
 
 
@@ -231,7 +230,7 @@ class _Merger:
         pts = np.concatenate([vpts, self.samples[faces].reshape(-1, 3)])
         hull, eq = _hull(vpts)
         conc = 0.0 if eq is None else _denoise(float(_max_depth(pts, eq, np.inf)), self.diag)
-        return _Cluster(faces, verts, pts, hull, conc, float(self.areas[faces].sum()),
+        return _Cluster(faces, pts, hull, conc, float(self.areas[faces].sum()),
                         float(self.face_perim[faces].sum()), hash(faces.tobytes()))
 
     def union_conc(self, a: _Cluster, b: _Cluster, limit: float) -> tuple[float, bool, np.ndarray]:
@@ -371,7 +370,7 @@ def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
         conc, exact, hull_pts = m.union_conc(a, b, limit)
         shared = a.nbrs[j]
         faces = np.sort(np.concatenate([a.faces, b.faces]))
-        c = _Cluster(faces, None, np.concatenate([a.pts, b.pts]), hull_pts, conc, a.area + b.area,
+        c = _Cluster(faces, np.concatenate([a.pts, b.pts]), hull_pts, conc, a.area + b.area,
                      a.perim + b.perim - 2 * shared[0], hash(faces.tobytes()))
         for src in (a, b):
             for k, rec in src.nbrs.items():
@@ -515,13 +514,6 @@ def input_face_labels(seg: Segmentation, face_source: np.ndarray, n_input_faces:
     return out
 
 
-def _obj_text(part: Mesh, header: list[str]) -> str:
-    lines = [f"# {h}" for h in header]
-    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in part.vertices.tolist()]  # exact: parts match the whole mesh
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in part.faces.tolist()]
-    return "\n".join(lines) + "\n"
-
-
 def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces: int | None = None,
                        source_name: str = "mesh", png: bool = True) -> list[str]:
     """Write the parts into `out_dir` and return the file names written.
@@ -549,7 +541,7 @@ def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces:
         names = []
         for k, part in enumerate(seg.parts):
             name = f"part-{k}.obj"
-            (tmp / name).write_text(_obj_text(part, [
+            (tmp / name).write_text(obj_text(part.vertices, part.faces, [
                 f"part {k} of {seg.n_parts} of {source_name}, segmented by polyfold (tau {seg.tau:.6g})",
                 f"{part.n_faces} faces, concavity {seg.concavity[k]:.6g} of the whole mesh's bbox diagonal"]))
             names.append(name)

@@ -28,7 +28,7 @@ import numpy as np
 
 from .errors import PolyfoldError
 from .io import atomic_write
-from .raster import png_bytes
+from .raster import fill_triangles, png_bytes
 
 log = logging.getLogger(__name__)
 
@@ -526,29 +526,6 @@ def _piece_color(piece: int) -> tuple[int, int, int]:
     return int(round(r * 255)), int(round(g * 255)), int(round(b * 255))
 
 
-def _fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> None:
-    H, W = img.shape[:2]
-    for t, col in zip(tris, colors):
-        a, b, c = t
-        area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-        if abs(area2) < 1e-12:
-            continue
-        x0 = max(0, int(math.floor(t[:, 0].min())))
-        x1 = min(W - 1, int(math.ceil(t[:, 0].max())))
-        y0 = max(0, int(math.floor(t[:, 1].min())))
-        y1 = min(H - 1, int(math.ceil(t[:, 1].max())))
-        if x1 < x0 or y1 < y0:
-            continue
-        px = np.arange(x0, x1 + 1) + 0.5
-        py = (np.arange(y0, y1 + 1) + 0.5)[:, None]
-        sgn = 1.0 if area2 > 0 else -1.0
-        eps = -1e-9 * abs(area2)
-        inside = np.ones((y1 - y0 + 1, x1 - x0 + 1), dtype=bool)
-        for p, q in ((a, b), (b, c), (c, a)):
-            inside &= sgn * ((q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0])) >= eps
-        img[y0:y1 + 1, x0:x1 + 1][inside] = col
-
-
 def _draw_segments(img: np.ndarray, seg: np.ndarray, color, thick: int) -> None:
     if len(seg) == 0:
         return
@@ -576,7 +553,7 @@ def write_png(fold: dict, path, *, width_px: int = 1200) -> None:
     img = np.full((r.height, r.width, 3), 255, dtype=np.uint8)
     xy = r.to_px(net.coords)
     cols = np.array([_piece_color(p) for p in range(int(net.pieces.max()) + 1)], dtype=np.uint8)
-    _fill_triangles(img, xy[net.faces], cols[net.pieces])
+    fill_triangles(img, xy[net.faces], cols[net.pieces])
     for k, thick in (("crease", 1), ("valley", 1), ("mountain", 1), ("cut", 2)):
         sel = [e for e, kk in enumerate(net.kind) if kk == k]
         if sel:

@@ -32,6 +32,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import PolyfoldError
+from .io import obj_text
 from .kinematics import FoldTree, fold_positions, fold_tree
 from .mesh import Mesh
 
@@ -200,13 +201,6 @@ def _read_obj(path: Path) -> Mesh:
     if len(f) == 0 or f.min() < 0 or f.max() >= len(v):
         raise PolyfoldError(f"{path.name}: not a usable part mesh (no faces or bad vertex indices)")
     return Mesh(v, f)
-
-
-def _obj_text(vertices: np.ndarray, faces: np.ndarray, header: str) -> str:
-    lines = [f"# {header}"]
-    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices.tolist()]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces.tolist()]
-    return "\n".join(lines) + "\n"
 
 
 def _inside(root: Path, name: str) -> Path:
@@ -698,7 +692,7 @@ class Viewer:
         mesh, kind = self._mesh_for_make()
         out.mkdir(parents=True, exist_ok=True)
         name = f"{self._stem()}-{kind}.obj" if kind == "original" else f"{self._stem()}-inflated-{self.mode_dropdown.value}.obj"
-        atomic_write(out / name, _obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind}) exported by polyfold view"))
+        atomic_write(out / name, obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind}) exported by polyfold view"))
         self.make_status.content = f"exported {name} to {out}"
 
     def _run_make(self) -> None:
@@ -714,7 +708,7 @@ class Viewer:
                 # make reads a file: the mesh as an OBJ named after the model (the report names it)
                 suffix = "" if kind == "original" else "-inflated"
                 src = tmp / f"{self._stem()}{suffix}.obj"
-                src.write_text(_obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind})"))
+                src.write_text(obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind})"))
             opts = make_options(self.folder.options, inflate="none")
 
             def progress(stage: str, msg: str) -> None:
