@@ -32,7 +32,15 @@ def test_bench_paper_quick(models_dir, tmp_path):
         assert r["parts"]["all_paths"], name
         assert all(t > 0 for t in r["parts"]["totals"])
         if r["whole"] is not None:
-            assert r["whole"]["dof"] == sum(d + 1 for d in r["parts"]["dofs"]) - 1
+            w = r["whole"]
+            assert w["dof"] == sum(d + 1 for d in r["parts"]["dofs"]) - 1
+            # whole meshes fold (the paper: the horse had no path after an hour), and every path
+            # found is credited to the planner that found it, also on the paper's planner's row
+            assert w["runs"] == 3 and w["paths"] >= 1, name
+            for row in (w, w["paper_planner"]):
+                assert sum(row["planners"].values()) == row["paths"] <= row["runs"], name
+                assert set(row["planners"]) <= {"linear", "sequential", "lazy-prm"}
+            assert set(w["paper_planner"]["planners"]) <= {"linear", "lazy-prm"}
     # Fig. 3: constrained inflation needs far less deformation than uniform (paper: about 1/4)
     f3 = data["fig3"]
     assert f3["constrained"]["if_at_hv0"] < f3["uniform"]["if_at_hv0"] / 3

@@ -80,7 +80,7 @@ def test_unfold_fold_gives_a_checked_path(folded_parts, name):
     fold = json.loads(net.read_text())
     assert fold["polyfold:path_resolutionDeg"] == 1.0
     assert fold.get("polyfold:path_contactTol", 1e-7) == 1e-7
-    assert fold["polyfold:path_planner"] in ("linear", "lazy-prm")
+    assert fold["polyfold:path_planner"] in ("linear", "sequential", "lazy-prm")
     assert fold["polyfold:path_linear"] == (len(fold["polyfold:path"]) == 2)
     report = check_path(net)
     assert report.ok, str(report)
@@ -89,17 +89,18 @@ def test_unfold_fold_gives_a_checked_path(folded_parts, name):
     assert report.fold_error < 1e-9
 
 
-def test_horse_parts_need_the_lazy_prm(folded_parts):
-    """The horse parts' nets do not fold along the straight line; the checker sees why."""
-    lazy = []
+def test_horse_parts_need_more_than_the_straight_line(folded_parts):
+    """Some horse parts' nets do not fold along the straight line; the checker sees why."""
+    bent = []
     for name in PARTS[:7]:
         _, net, proc = folded_parts[name]
         assert proc.returncode == 0, proc.stderr
         fold = json.loads(net.read_text())
-        if fold["polyfold:path_planner"] == "lazy-prm" and len(fold["polyfold:path"]) > 2:
-            lazy.append(name)
+        if fold["polyfold:path_planner"] != "linear":
+            assert len(fold["polyfold:path"]) > 2
+            bent.append(name)
             assert check_path(straight(fold), step_deg=0.5).first_collision is not None, name
-    assert lazy, "no horse part needed the Lazy PRM"
+    assert bent, "every horse part folded along the straight line"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -145,8 +146,8 @@ def lazy_case(tmp_path_factory):
             tree = fold_tree(fold)
             if plan_fold(tree, planner="linear") is not None:
                 continue
-            path = plan_fold(tree, planner="auto", time_limit=20, seed=1)
-            if path is not None and path.planner == "lazy-prm" and len(path.frames) > 2:
+            path = plan_fold(tree, planner="lazy-prm", time_limit=20, seed=1)
+            if path is not None and len(path.frames) > 2:
                 net = root / f"{mesh.stem}-{method}-{seed}.fold"
                 net.write_text(dumps(fold))
                 return f"{mesh.name} --method {method} --seed {seed}", mesh, fold, net, path
@@ -175,7 +176,7 @@ def test_lazy_prm_path_where_the_straight_line_collides(lazy_case):
 def test_fold_cli_plans_around_the_collision(lazy_case, tmp_path):
     name, _, _, net, _ = lazy_case
     out = tmp_path / "out.fold"
-    proc = run_cli("fold", net, "-o", out, "--seed", 1, "--time-limit", 30)
+    proc = run_cli("fold", net, "-o", out, "--planner", "lazy-prm", "--seed", 1, "--time-limit", 30)
     assert proc.returncode == 0, proc.stderr
     line = one_line(proc.stderr)
     assert "not linearly foldable" in line and "lazy-prm" in line
@@ -214,6 +215,72 @@ def test_same_seed_same_path(lazy_case, tmp_path):
         paths.append(json.loads(out.read_text())["polyfold:path"])
     assert paths[0] == paths[1]
     assert check_path(tmp_path / "out0.fold").ok
+
+
+# ----------------------------------------------------------------------------------------------
+# Whole meshes: the sequential planner (crease-by-crease unfolding of the folded shape)
+
+
+def _whole_net(models_dir: Path, name: str, seed: int, n_faces: int) -> dict:
+    fold = api_net(models_dir / f"{name}.obj", "auto", seed)
+    assert len(fold["faces_vertices"]) == n_faces
+    return fold
+
+
+def _assert_monotone_discrete(tree, path) -> None:
+    """Every frame is a discrete state of the paper's sampling domain (each crease flat or at its
+    goal), and the frames only fold creases, from all flat to all folded."""
+    goal = tree.goal[tree.creases]
+    cr = path.frames[:, tree.creases]
+    assert np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal))
+    folded = np.isclose(cr, goal).sum(axis=1)
+    assert folded[0] == 0 and folded[-1] == len(goal) and np.all(np.diff(folded) > 0)
+
+
+def test_sequential_planner_folds_the_whole_horse(models_dir):
+    """The paper found no path for the whole horse (301 DOF) in an hour, and the Lazy PRM alone
+    finds none here in seconds; crease-by-crease unfolding of the folded shape does. (The
+    independent checker re-checks a whole-mesh path below, on the smaller bunny: on the horse
+    it takes minutes.)"""
+    tree = fold_tree(_whole_net(models_dir, "horse-302", 3, 302))
+    assert plan_fold(tree, planner="linear") is None
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=1)
+    assert path is not None, "no sequential path for the whole horse"
+    assert path.planner == "sequential" and not path.linear
+    _assert_monotone_discrete(tree, path)
+    assert plan_fold(tree, planner="lazy-prm", time_limit=3, seed=1) is None
+
+
+@pytest.fixture(scope="module")
+def whole_bunny(models_dir, tmp_path_factory) -> tuple[dict, Path]:
+    """A one-piece net of the whole bunny (127 DOF) as a FOLD dict and file."""
+    fold = _whole_net(models_dir, "bunny-128", 1, 128)
+    net = tmp_path_factory.mktemp("whole") / "bunny.fold"
+    net.write_text(dumps(fold))
+    return fold, net
+
+
+def test_sequential_path_of_a_whole_mesh_passes_the_independent_checker(whole_bunny):
+    fold, _ = whole_bunny
+    tree = fold_tree(fold)
+    assert plan_fold(tree, planner="linear") is None
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=1)
+    assert path is not None and path.planner == "sequential"
+    _assert_monotone_discrete(tree, path)
+    report = check_path(with_path(fold, path, 1.0, 1e-7), step_deg=0.5)
+    assert report.ok, str(report)
+    assert report.frames == len(path.frames) > 2
+
+
+def test_fold_cli_uses_the_sequential_planner_when_the_line_collides(whole_bunny, tmp_path):
+    _, net = whole_bunny
+    out = tmp_path / "bunny-path.fold"
+    proc = run_cli("fold", net, "-o", out, "--seed", 1, "--time-limit", 60)
+    assert proc.returncode == 0, proc.stderr
+    assert "sequential" in one_line(proc.stderr)
+    fold = json.loads(out.read_text())
+    assert fold["polyfold:path_planner"] == "sequential" and fold["polyfold:path_linear"] is False
+    assert check_path(out).ok
 
 
 # ----------------------------------------------------------------------------------------------

@@ -7,9 +7,10 @@ paper / ours), report.json (every run), fig3.png and fig5.png. Needs matplotlib 
 (the `bench` extra); the tables do not.
 
 Every time is wall-clock seconds in this process with the numba kernels already compiled. A
-"path" is a collision-free folding path found by `fold.plan_fold` (straight line first = LC,
-then Lazy PRM) and re-validated by it; a run without a path within the time limit counts the
-time limit as its path time and is marked.
+"path" is a collision-free folding path found by `fold.plan_fold` ("auto": straight line first =
+LC, then the sequential planner, then Lazy PRM); whole meshes are also run with the paper's own
+planner (straight line, then Lazy PRM) on a few seeds. A run without a path within the time limit
+counts the time limit as its path time and is marked.
 """
 
 from __future__ import annotations
@@ -62,8 +63,14 @@ def quick_settings() -> BenchSettings:
 # Measurements
 
 
-def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float) -> dict:
-    """Unfold `mesh` (one component) and plan a folding path for the net; seconds and facts."""
+PAPER_PLANNER_RUNS = 5  # whole meshes with the paper's planner: it mostly runs into the time limit
+
+
+def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner: str = "auto") -> dict:
+    """Unfold `mesh` (one component) and plan a folding path for the net; seconds and facts.
+
+    planner: a `plan_fold` planner, or "paper": the straight line, then Lazy PRM for the time left.
+    """
     from .errors import PolyfoldError
     from .fold import plan_fold
     from .foldfile import net_to_fold
@@ -76,7 +83,7 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float) -> dict
     fold = net_to_fold([net])
     tree = fold_tree(fold, contact_tol)
     row = {"dof": int(len(tree.creases)), "pieces": int(net.n_pieces), "net_s": t1 - t0, "path": False,
-           "lc": None, "path_s": float(time_limit), "note": "", "tree": tree}
+           "lc": None, "path_s": float(time_limit), "note": "", "tree": tree, "planner": None}
     if net.n_pieces > 1:
         row["note"] = "no single net in time"
         return row
@@ -84,7 +91,13 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float) -> dict
         row["note"] = "goal self-intersects"
         return row
     try:
-        path = plan_fold(tree, time_limit=time_limit, seed=seed)
+        if planner == "paper":
+            path = plan_fold(tree, planner="linear", time_limit=time_limit, seed=seed)
+            if path is None:
+                left = max(0.0, time_limit - (time.perf_counter() - t1))
+                path = plan_fold(tree, planner="lazy-prm", time_limit=left, seed=seed)
+        else:
+            path = plan_fold(tree, planner=planner, time_limit=time_limit, seed=seed)
     except PolyfoldError as exc:
         row["note"] = str(exc)
         return row
@@ -93,8 +106,20 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float) -> dict
         row["note"] = "no path in time"
         row["path_s"] = max(t2 - t1, float(time_limit))
     else:
-        row.update(path=True, lc=bool(path.linear), path_s=t2 - t1)
+        row.update(path=True, lc=bool(path.linear), path_s=t2 - t1, planner=path.planner)
     return row
+
+
+def _whole_row(mesh, seeds, time_limit: float, tol: float, planner: str) -> dict:
+    """Runs of one whole mesh: seconds per run, paths found, LC count, planners that found them."""
+    rows = [net_and_path(mesh, seed, time_limit, tol, planner) for seed in seeds]
+    planners: dict[str, int] = {}
+    for r in rows:
+        if r["planner"]:
+            planners[r["planner"]] = planners.get(r["planner"], 0) + 1
+    return {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
+            "runs": len(rows), "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
+            "planners": planners, "notes": sorted({r["note"] for r in rows if r["note"]}), "rows": rows}
 
 
 def _mean_sd(xs: list[float]) -> tuple[float, float]:
@@ -202,10 +227,12 @@ def table2(models: Path, st: BenchSettings, say) -> tuple[dict, list]:
             extra = {"tau": seg.tau}
         whole = None
         if paper["whole"] is not None:
-            rows = [net_and_path(mesh, seed, st.time_limit, tol) for seed in range(1, st.runs + 1)]
-            whole = {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
-                     "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
-                     "notes": sorted({r["note"] for r in rows if r["note"]})}
+            whole = _whole_row(mesh, range(1, st.runs + 1), st.time_limit, tol, "auto")
+            say(f"table 2: {name} whole, the paper's planner")
+            whole["paper_planner"] = _whole_row(mesh, range(1, min(st.runs, PAPER_PLANNER_RUNS) + 1),
+                                                st.time_limit, tol, "paper")
+            rows = whole.pop("rows")
+            whole["paper_planner"].pop("rows")
             fig5_trees.append((name, "whole", rows[0]["tree"]))
         pr = _parts_row(parts, st.runs, st.time_limit, tol, seg_s)
         fig5_trees += [(name, "parts", t) for t in pr.pop("trees")]
@@ -337,12 +364,19 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
         paper = PAPER_TABLE2[name]
         w = r["whole"]
         if w is not None:
-            tot = np.asarray(w["net_s"]) + np.asarray(w["path_s"])
             pw = paper["whole"][2]
-            note = f" ({'; '.join(w['notes'])})" if w["notes"] else ""
-            L.append(f"| {name} | whole | 1 | {w['dof']} | – | {_fmt(*_mean_sd(w['net_s']))} | "
-                     f"{_fmt(*_mean_sd(w['path_s']))} | {_fmt(*_mean_sd(tot))} | {w['paths']}/{st.runs}{note} | "
-                     f"{'> 3600 (no path)' if not math.isfinite(pw) else f'{pw:.2f}'} | {_ratio(pw, float(tot.mean())) if w['paths'] == st.runs else '–'} |")
+            for route, row in (("whole", w), ("whole, paper's planner", w.get("paper_planner"))):
+                if row is None:
+                    continue
+                tot = np.asarray(row["net_s"]) + np.asarray(row["path_s"])
+                found = ", ".join(f"{k} {v}" for k, v in sorted(row["planners"].items()))
+                facts = [found] if found else []
+                facts += row["notes"]
+                note = f" ({'; '.join(facts)})" if facts else ""
+                L.append(f"| {name} | {route} | 1 | {row['dof']} | – | {_fmt(*_mean_sd(row['net_s']))} | "
+                         f"{_fmt(*_mean_sd(row['path_s']))} | {_fmt(*_mean_sd(tot))} | {row['paths']}/{row['runs']}{note} | "
+                         f"{'> 3600 (no path)' if not math.isfinite(pw) else f'{pw:.2f}'} | "
+                         f"{_ratio(pw, float(tot.mean())) if row['paths'] == row['runs'] else '–'} |")
         p = r["parts"]
         n_paths = sum(all(run["paths"]) for run in p["runs"])
         pp = paper["parts"]
@@ -350,7 +384,12 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
                  f"{_fmt(*_mean_sd([x['net_s'] for x in p['runs']]))} | {_fmt(*_mean_sd([x['path_s'] for x in p['runs']]))} | "
                  f"{_fmt(*_mean_sd(p['totals']))} | {n_paths}/{st.runs} | {pp[4]:.2f} | "
                  f"{_ratio(pp[4], float(np.mean(p['totals']))) if n_paths == st.runs else '–'} |")
-    L += ["", "Contact tolerance 1e-3 of the model size for the fish rows (its folded shape self-intersects "
+    L += ["", "Planners: 'whole' and 'parts' rows use `plan_fold`'s default: the straight line (the paper's LC "
+          "test), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
+          "the first free crease in a fixed priority order, stuck creases promoted on a restart), then Lazy PRM. "
+          f"'whole, paper's planner' rows: the straight line, then Lazy PRM only (ALGORITHMS.md 6.5), on the first "
+          f"{PAPER_PLANNER_RUNS} seeds. The planner that found each path is named beside the path count.", "",
+          "Contact tolerance 1e-3 of the model size for the fish rows (its folded shape self-intersects "
           "by 2.4e-4 of its size; see MODELS.md), 1e-7 elsewhere. 'fish-472 inflated': constrained inflation, "
           "then the same parts as 'fish-472'.", ""]
     if "fish-472 inflated" in t2:

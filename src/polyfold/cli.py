@@ -28,6 +28,7 @@ app = typer.Typer(
 class Planner(str, Enum):
     auto = "auto"
     linear = "linear"
+    sequential = "sequential"
     lazy_prm = "lazy-prm"
 
 
@@ -233,7 +234,7 @@ def unfold(
 def fold_cmd(
     net: Path = typer.Argument(..., help="Net as a FOLD file (from `polyfold unfold`)."),
     output: Path = typer.Option(..., "-o", "--output", help="FOLD file with the path added as polyfold:path."),
-    planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then Lazy PRM."),
+    planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then crease-by-crease unfolding, then Lazy PRM."),
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="Collision-check step along path segments, degrees."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
     seed: int = typer.Option(1, "--seed", help="Random seed of the sampling planner."),

@@ -4,10 +4,13 @@ In: a `FoldTree` (kinematics.py) built from a FOLD net. Out: a `FoldPath` — co
 (radians per FOLD edge, + = mountain) whose consecutive straight segments are collision-free when
 sampled at `resolution` (ALGORITHMS.md 6.3-6.5).
 
-Planner: the straight line C_s -> C_g first (bisection order, early exit); otherwise Lazy PRM over
-discrete configurations (each crease either flat or at its goal angle) with Hamming-distance
-neighbours, lazily checked edges, A* search, and greedy shortcutting. Every returned path is
-re-validated at half the resolution before it is reported.
+Planners ("auto" runs them in this order):
+1. linear: the straight line C_s -> C_g (bisection order, early exit) — the paper's LC test;
+2. sequential: unfold the folded shape one crease at a time (not in the paper, see `_sequential`);
+3. lazy-prm: Lazy PRM over discrete configurations (each crease either flat or at its goal angle)
+   with Hamming-distance neighbours, lazily checked edges, A* search, and greedy shortcutting —
+   the paper's planner (ALGORITHMS.md 6.5).
+Every returned path is re-validated at half the resolution before it is reported.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from numba import njit
 
 from .kinematics import FoldTree, config_collides, config_collides_moving
 
+PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
 COARSE_SAMPLES = 7  # bisection levels 1-3 of a segment: the cheap first look of the Lazy PRM
 MAX_BATCH = 1600  # new roadmap samples per round at most (the batch doubles from n0 up to this)
 
@@ -142,7 +146,7 @@ def is_linearly_foldable(tree: FoldTree, resolution_deg: float = 1.0) -> bool:
     zero = np.zeros(len(tree.goal))
     if not check.valid(zero) or not check.valid(tree.goal):
         return False
-    return check.segment(zero, tree.goal) and check.segment(zero, tree.goal, check.step / 2)
+    return check.segment(zero, tree.goal, check.step / 2)  # half the resolution covers the full one
 
 
 def plan_fold(
@@ -156,13 +160,14 @@ def plan_fold(
 ) -> FoldPath | None:
     """Plan a collision-free folding path; None when none is found within `time_limit`.
 
-    planner: "linear" (straight line only), "lazy-prm" (skip the straight-line shortcut), "auto"
-    (straight line first, then Lazy PRM). Raises PolyfoldError when the flat net or the goal
-    itself self-intersects (then no path can exist).
+    planner: "linear" (straight line only), "sequential" (crease-by-crease unfolding of the goal
+    only), "lazy-prm" (Lazy PRM only, as the paper after its LC test), "auto" (straight line,
+    then sequential, then Lazy PRM for the time left). Raises PolyfoldError when the flat net or
+    the goal itself self-intersects (then no path can exist).
     """
     from .errors import PolyfoldError
 
-    if planner not in ("auto", "linear", "lazy-prm"):
+    if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}")
     t0 = time.perf_counter()
     deadline = t0 + time_limit
@@ -187,9 +192,17 @@ def plan_fold(
 
     if planner in ("auto", "linear"):
         straight = np.stack([zero, goal])
-        if _path_free(check, straight, check.step) < 0 and _path_free(check, straight, check.step / 2) < 0:
+        # at half the resolution at once (its samples include the full-resolution ones; a blocked
+        # line fails as early, at its first bisection samples)
+        if _path_free(check, straight, check.step / 2) < 0:
             return done(straight, True, "linear", 2)
         if planner == "linear":
+            return None
+    if planner in ("auto", "sequential"):
+        frames = _sequential(tree, check, deadline, np.random.default_rng(seed))
+        if frames is not None:
+            return done(frames, False, "sequential", len(frames))
+        if planner == "sequential":
             return None
     result = _lazy_prm(tree, check, deadline, np.random.default_rng(seed), n0, k_neighbours)
     if result is None:
@@ -340,9 +353,8 @@ class _Roadmap:
         return _astar(self.indptr, self.nbr, self.eid, self.weight, self.state == self.BLOCKED, self.h, 0, 1)
 
 
-def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
-    """Discrete states (bits per crease of tree.creases) folding the outer part of the tree first
-    or last: thresholds on the depth and on the subtree size of each crease's child face."""
+def _crease_depth_size(tree: FoldTree) -> tuple[np.ndarray, np.ndarray]:
+    """Per crease of tree.creases: depth of its child face in the tree, faces in the child's subtree."""
     n_f = len(tree.order)
     depth = np.zeros(n_f, dtype=np.int64)
     size = np.ones(n_f, dtype=np.int64)
@@ -356,12 +368,89 @@ def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
     has = tree.crease >= 0
     child[tree.crease[has]] = np.flatnonzero(has)
     kids = child[tree.creases]
+    return depth[kids], size[kids]
+
+
+def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
+    """Discrete states (bits per crease of tree.creases) folding the outer part of the tree first
+    or last: thresholds on the depth and on the subtree size of each crease's child face."""
+    depth, size = _crease_depth_size(tree)
     states = []
-    for key in (depth[kids], -size[kids]):
+    for key in (depth, -size):
         for thr in np.unique(np.quantile(key, np.linspace(0, 1, levels + 2)[1:-1], method="nearest")):
             outer = key >= thr
             states.extend([outer, ~outer])
     return states
+
+
+def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator) -> np.ndarray | None:
+    """Reverse sequential unfolding: frames flat -> goal, or None (stuck or out of time).
+
+    Start at the folded goal and open one crease at a time (its angle to 0), always the first
+    crease in priority order whose motion is collision-free; the path is that sequence reversed.
+    Every frame stays in the paper's discrete domain (each crease flat or at its goal), so this is
+    a path the Lazy PRM could also find, but found directly instead of by sampling 2^n states.
+    Priority: creases splitting the net most evenly first (the largest smaller side), so a closed
+    shape first opens into big halves that swing apart, and small flaps open last, when little is
+    left in their way. When no remaining crease can open, start again from the goal with the
+    stuck creases promoted to the front: opened early, while the shape around them is still
+    folded, they usually swing out freely (a curled strip of faces, say, that would sweep through
+    a flattened neighbour). Stops when a restart is stuck with the same creases as before.
+    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
+    """
+    creases, goal = tree.creases, tree.goal
+    n = len(creases)
+    depth, size = _crease_depth_size(tree)
+    smaller_side = np.minimum(size, len(tree.order) - size)
+    prio = list(np.lexsort((depth, -smaller_side)))  # ties: shallower first
+    fine = check.step / 2
+    tried: set[frozenset] = set()
+    while time.perf_counter() < deadline:
+        q = goal.copy()
+        frames = [q.copy()]
+        is_open = np.zeros(n, dtype=bool)
+        fails = np.zeros(n, dtype=np.int64)
+        retry_at = np.zeros(n, dtype=np.int64)
+        group, step = 1, 0
+        while not is_open.all() and time.perf_counter() < deadline:
+            step += 1
+            todo = [i for i in prio if not is_open[i]]
+            # Open the next `group` creases in one motion when that is free (one check instead of
+            # `group`: a segment costs its largest angle change, not its crease count); the group
+            # doubles after each success, else one crease at a time: the first free one. A crease
+            # that was blocked waits 2, 4, 8, ... steps before it is tried again (it is usually
+            # still blocked); only when nothing else moves are the waiting ones tried at once.
+            ready = [i for i in todo if retry_at[i] <= step]
+            waiting = [i for i in todo if retry_at[i] > step]
+            moves = [ready[:group]] if group > 1 and len(ready) > 1 else []
+            moves += ([i] for i in ready + waiting)
+            for move in moves:
+                nxt = q.copy()
+                nxt[creases[move]] = 0.0
+                # the new state itself first (segments assume valid endpoints), then the motion,
+                # at half the resolution straight away: the path needs no re-validation
+                if check.valid(nxt) and check.segment(q, nxt, fine):
+                    is_open[move] = True
+                    q = nxt
+                    frames.append(q.copy())
+                    group = min(2 * len(move), len(todo))
+                    break
+                if len(move) == 1:
+                    fails[move[0]] += 1
+                    retry_at[move[0]] = step + (1 << min(int(fails[move[0]]), 6))
+            else:
+                break
+        if is_open.all():
+            frames.reverse()
+            return np.stack(frames)
+        stuck = [i for i in prio if not is_open[i]]
+        if time.perf_counter() >= deadline:
+            return None
+        if frozenset(stuck) in tried:
+            rng.shuffle(stuck)
+        tried.add(frozenset(stuck))
+        prio = stuck + [i for i in prio if is_open[i]]
+    return None
 
 
 def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator, n0: int, k: int):

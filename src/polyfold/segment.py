@@ -220,18 +220,25 @@ class _Merger:
         self.inner = inner
         self.ef = topo.edge_faces[inner]
         self.cache: dict[tuple, tuple[float, bool, np.ndarray | None]] = {}
+        self.made: dict[int, tuple] = {}
         self.polygon = _polygon_groups(mesh)
 
     # -- clusters --------------------------------------------------------------------------------
     def make(self, faces: np.ndarray) -> _Cluster:
         faces = np.sort(np.asarray(faces, dtype=np.int64))
-        verts = np.unique(self.mesh.faces[faces])
-        vpts = self.mesh.vertices[verts]
-        pts = np.concatenate([vpts, self.samples[faces].reshape(-1, 3)])
-        hull, eq = _hull(vpts)
-        conc = 0.0 if eq is None else _denoise(float(_max_depth(pts, eq, np.inf)), self.diag)
-        return _Cluster(faces, pts, hull, conc, float(self.areas[faces].sum()),
-                        float(self.face_perim[faces].sum()), hash(faces.tobytes()))
+        key = hash(faces.tobytes())
+        # Every run (one per tau tried by `parts=K`) starts from the same seed clusters: their
+        # hulls are computed once. A fresh _Cluster each time: its neighbour dict is per run.
+        known = self.made.get(key)
+        if known is None:
+            verts = np.unique(self.mesh.faces[faces])
+            vpts = self.mesh.vertices[verts]
+            pts = np.concatenate([vpts, self.samples[faces].reshape(-1, 3)])
+            hull, eq = _hull(vpts)
+            conc = 0.0 if eq is None else _denoise(float(_max_depth(pts, eq, np.inf)), self.diag)
+            known = self.made[key] = (faces, pts, hull, conc, float(self.areas[faces].sum()),
+                                      float(self.face_perim[faces].sum()), key)
+        return _Cluster(*known)
 
     def union_conc(self, a: _Cluster, b: _Cluster, limit: float) -> tuple[float, bool, np.ndarray]:
         """(absolute concavity of a u b, exact?, hull points of a u b); inexact values exceed limit."""

@@ -269,6 +269,8 @@ HEURISTICS: dict[str, Callable[[Mesh, np.random.Generator], np.ndarray]] = {
     "random-edge": random_edge_weights,
 }
 
+FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
+
 # The GA's initial population draws from these creators (ALGORITHMS.md 5.5).
 GA_CREATORS = ("steepest-edge", "flat-tree", "unflat-tree", "random-edge")
 
@@ -305,8 +307,11 @@ def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _
     origin = [GA_CREATORS[c] for c in creators]
     fit = np.full(population, -np.inf)
     evaluations = filled = 0
-    for start in range(0, population, 25):
-        stop = min(start + 25, population)
+    start, size = 0, 2
+    while start < population:
+        # batches of 2, 4, 8, 16, then 25: small meshes are often done by the first heuristic
+        stop = min(start + size, population)
+        size = min(2 * size, 25)
         for i in range(start, stop):
             pop[i] = HEURISTICS[origin[i]](mesh, rng)
         G, L = problem.evaluate(pop[start:stop])
@@ -317,6 +322,7 @@ def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _
             if finished(pop[i]):
                 return pop, fit, origin, evaluations, int(i)
             fit[i] = -0.5
+        start = stop
         if time.perf_counter() >= budget.deadline:
             break
     return pop[:filled], fit[:filled], origin[:filled], evaluations, -1
@@ -429,30 +435,26 @@ def run_memetic(
     mesh = problem.mesh
     topo = mesh.topology
     n_e = topo.n_edges
-    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, budget, population, finished)
+    # The first batch of the population only, then one local search from its best: most nets
+    # are finished by that search, and building the whole population (hundreds of heuristic
+    # trees) first would cost ten times more. The rest of the population is built only if not.
+    first = min(FIRST_BATCH, population)
+    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, budget, first, finished)
     if hit >= 0:
         return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
-    n_pop = len(pop)
     # Local-search effort per generation: enough to finish most nets, small enough to restart
     # from a fresh child when the search is stuck in a local minimum.
     chunk_iters = max(1000, 4 * mesh.n_faces)
     step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
     cap = 4 * mesh.n_faces
-    generation = 0
     crease = np.zeros(n_e, dtype=np.bool_)
-    while not budget.exhausted(generation):
-        generation += 1
-        if generation == 1:
-            child = pop[int(np.argmax(fit))].copy()
-        else:
-            draws = rng.integers(0, n_pop, size=(2, tournament))
-            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
-            swap = rng.random(n_e) < p_cross
-            child = np.where(swap, pop[winners[1]], pop[winners[0]])
+
+    def improve(child: np.ndarray) -> tuple[np.ndarray, int, int]:
+        """Local search from a child genome: (improved genome, overlap score, iterations)."""
         parent, parent_edge, _, _ = problem.decode(child)
         crease[:] = False
         crease[parent_edge[parent_edge >= 0]] = True
-        done_iters, score = 0, None
+        done_iters, score = 0, 0
         while done_iters < chunk_iters:
             score, it = K.local_search(
                 crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
@@ -462,8 +464,28 @@ def run_memetic(
             done_iters += max(it, 1)
             if score == 0 or time.perf_counter() >= budget.deadline:
                 break
+        return _genome_of_tree(crease, rng), int(score), done_iters
+
+    generation = 0
+    while not budget.exhausted(generation):
+        generation += 1
+        if generation == 1:
+            child = pop[int(np.argmax(fit))].copy()
+        else:
+            if generation == 2 and len(pop) < population:
+                more, more_fit, more_origin, more_ev, hit = _seed_population(
+                    problem, rng, budget, population - len(pop), finished)
+                evaluations += more_ev
+                if hit >= 0:
+                    return more[hit].copy(), 0.0, generation, evaluations, more_origin[hit]
+                pop, fit = np.concatenate([pop, more]), np.concatenate([fit, more_fit])
+            n_pop = len(pop)
+            draws = rng.integers(0, n_pop, size=(2, tournament))
+            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
+            swap = rng.random(n_e) < p_cross
+            child = np.where(swap, pop[winners[1]], pop[winners[0]])
+        genome, score, done_iters = improve(child)
         evaluations += done_iters
-        genome = _genome_of_tree(crease, rng)
         worst = int(np.argmin(fit))
         pop[worst] = genome
         fit[worst] = -float(score)
