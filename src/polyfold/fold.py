@@ -25,6 +25,7 @@ from numba import njit
 from .kinematics import FoldTree, config_collides, config_collides_moving
 
 PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
+SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
 COARSE_SAMPLES = 7  # bisection levels 1-3 of a segment: the cheap first look of the Lazy PRM
 MAX_BATCH = 1600  # new roadmap samples per round at most (the batch doubles from n0 up to this)
 
@@ -199,7 +200,10 @@ def plan_fold(
         if planner == "linear":
             return None
     if planner in ("auto", "sequential"):
-        frames = _sequential(tree, check, deadline, np.random.default_rng(seed))
+        # auto: the Lazy PRM keeps a third of the time for the rare net the sequential planner
+        # cannot unlock (it finds nothing on large nets, but may on a small one)
+        seq_deadline = deadline if planner == "sequential" else t0 + time_limit * SEQUENTIAL_SHARE
+        frames = _sequential(tree, check, seq_deadline, np.random.default_rng(seed))
         if frames is not None:
             return done(frames, False, "sequential", len(frames))
         if planner == "sequential":
@@ -395,8 +399,10 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
     left in their way. When no remaining crease can open, start again from the goal with the
     stuck creases promoted to the front: opened early, while the shape around them is still
     folded, they usually swing out freely (a curled strip of faces, say, that would sweep through
-    a flattened neighbour). Stops when a restart is stuck with the same creases as before.
-    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
+    a flattened neighbour). A restart stuck on the same creases again shuffles them (rng, so the
+    seed decides) before the next one; restarts go on until the deadline.
+    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none;
+    it still fails when some creases can open neither alone, nor first, nor together.
     """
     creases, goal = tree.creases, tree.goal
     n = len(creases)
@@ -425,6 +431,8 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
             moves = [ready[:group]] if group > 1 and len(ready) > 1 else []
             moves += ([i] for i in ready + waiting)
             for move in moves:
+                if time.perf_counter() >= deadline:  # a scan of a large net can take a while
+                    return None
                 nxt = q.copy()
                 nxt[creases[move]] = 0.0
                 # the new state itself first (segments assume valid endpoints), then the motion,
