@@ -399,8 +399,9 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
     left in their way. When no remaining crease can open, start again from the goal with the
     stuck creases promoted to the front: opened early, while the shape around them is still
     folded, they usually swing out freely (a curled strip of faces, say, that would sweep through
-    a flattened neighbour). A restart stuck on the same creases again shuffles them (rng, so the
-    seed decides) before the next one; restarts go on until the deadline.
+    a flattened neighbour). Restarts alternate between two base orders (see `tracks`), each with
+    its own promotions; a track stuck on the same creases again shuffles them (rng, so the seed
+    decides). Restarts go on until the deadline.
     Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none;
     it still fails when some creases can open neither alone, nor first, nor together.
     """
@@ -408,10 +409,17 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
     n = len(creases)
     depth, size = _crease_depth_size(tree)
     smaller_side = np.minimum(size, len(tree.order) - size)
-    prio = list(np.lexsort((depth, -smaller_side)))  # ties: shallower first
+    # Two tracks of restarts, taken in turn, each with its own base order and promotions: creases
+    # splitting the net most evenly first (ties: shallower first), and the shallowest first (ties:
+    # larger smaller side first), which unlocks some nets the first order cannot.
+    tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
+    tried: list[set[frozenset]] = [set(), set()]
     fine = check.step / 2
-    tried: set[frozenset] = set()
+    restart = 0
     while time.perf_counter() < deadline:
+        track = restart % 2
+        prio = tracks[track]
+        restart += 1
         q = goal.copy()
         frames = [q.copy()]
         is_open = np.zeros(n, dtype=bool)
@@ -454,10 +462,10 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
         stuck = [i for i in prio if not is_open[i]]
         if time.perf_counter() >= deadline:
             return None
-        if frozenset(stuck) in tried:
+        if frozenset(stuck) in tried[track]:
             rng.shuffle(stuck)
-        tried.add(frozenset(stuck))
-        prio = stuck + [i for i in prio if is_open[i]]
+        tried[track].add(frozenset(stuck))
+        tracks[track] = stuck + [i for i in prio if is_open[i]]
     return None
 
 
