@@ -251,6 +251,17 @@ def test_sequential_planner_folds_the_whole_horse(models_dir):
     assert plan_fold(tree, planner="lazy-prm", time_limit=3, seed=1) is None
 
 
+@pytest.mark.parametrize("planner", ["auto", "linear", "sequential", "lazy-prm"])
+def test_every_planner_handles_a_net_without_creases(models_dir, planner):
+    mesh = load_mesh(models_dir / "tetrahedron-4.obj").mesh.submesh(np.array([0]))
+    net, _ = unfold(mesh)
+    tree = fold_tree(net_to_fold([net]))
+    assert len(tree.creases) == 0
+    path = plan_fold(tree, planner=planner)
+    assert path is not None and path.linear and path.frames.shape == (2, tree.n_edges)
+    assert np.allclose(path.frames, 0.0)
+
+
 @pytest.fixture(scope="module")
 def whole_bunny(models_dir, tmp_path_factory) -> tuple[dict, Path]:
     """A one-piece net of the whole bunny (127 DOF) as a FOLD dict and file."""

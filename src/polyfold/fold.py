@@ -191,6 +191,8 @@ def plan_fold(
         return FoldPath(frames=frames, linear=linear, planner=name, seconds=time.perf_counter() - t0,
                         edges_checked=check.edges, configs_checked=check.configs, nodes=nodes)
 
+    if len(tree.creases) == 0:  # single faces (no DOF): the flat net is the goal, whatever the planner
+        return done(np.stack([zero, goal]), True, "linear", 2)
     if planner in ("auto", "linear"):
         straight = np.stack([zero, goal])
         # at half the resolution at once (its samples include the full-resolution ones; a blocked
@@ -458,6 +460,8 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
                 break
         if is_open.all():
             frames.reverse()
+            if len(frames) == 1:  # no creases: still a path from the flat net to the goal
+                frames.append(frames[0].copy())
             return np.stack(frames)
         stuck = [i for i in prio if not is_open[i]]
         if time.perf_counter() >= deadline:
