@@ -388,10 +388,11 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
     # original fish's whole mesh, as in the paper).
     L += ["", "Speedup of the segmented route over the whole mesh (whole total / parts total; the paper's in brackets):"]
     for name, r in t2.items():
-        w = r["whole"] if r["whole"] is not None else t2.get(name.replace(" inflated", ""), {}).get("whole")
+        base = name.replace(" inflated", "")  # the model whose whole mesh this row is compared with
+        w = t2.get(base, {}).get("whole")
         if w is None:
             continue
-        paper_whole = PAPER_TABLE2[name.replace(" inflated", "")]["whole"][2]
+        paper_whole = PAPER_TABLE2[base]["whole"][2]
         paper_parts = PAPER_TABLE2[name]["parts"][4]
         ours_whole = float(np.mean(np.asarray(w["net_s"]) + np.asarray(w["path_s"])))
         ours_parts = float(np.mean(r["parts"]["totals"]))

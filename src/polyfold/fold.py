@@ -10,7 +10,8 @@ Planners ("auto" runs them in this order):
 3. lazy-prm: Lazy PRM over discrete configurations (each crease either flat or at its goal angle)
    with Hamming-distance neighbours, lazily checked edges, A* search, and greedy shortcutting —
    the paper's planner (ALGORITHMS.md 6.5).
-Every returned path is re-validated at half the resolution before it is reported.
+Every returned path is checked at half the resolution before it is reported (the sequential
+planner checks each move at that resolution as it goes; the others re-validate the final path).
 """
 
 from __future__ import annotations
@@ -423,7 +424,7 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
         prio = tracks[track]
         restart += 1
         q = goal.copy()
-        frames = [q.copy()]
+        frames = [q]  # q is replaced, never changed in place
         is_open = np.zeros(n, dtype=bool)
         fails = np.zeros(n, dtype=np.int64)
         retry_at = np.zeros(n, dtype=np.int64)
@@ -449,8 +450,8 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
                 # at half the resolution straight away: the path needs no re-validation
                 if check.valid(nxt) and check.segment(q, nxt, fine):
                     is_open[move] = True
-                    q = nxt
-                    frames.append(q.copy())
+                    q = nxt  # a fresh array: frames may keep it
+                    frames.append(q)
                     group = min(2 * len(move), len(todo))
                     break
                 if len(move) == 1:
@@ -459,9 +460,7 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
             else:
                 break
         if is_open.all():
-            frames.reverse()
-            if len(frames) == 1:  # no creases: still a path from the flat net to the goal
-                frames.append(frames[0].copy())
+            frames.reverse()  # (plan_fold answers nets without creases before this runs)
             return np.stack(frames)
         stuck = [i for i in prio if not is_open[i]]
         if time.perf_counter() >= deadline:
