@@ -19,9 +19,9 @@ Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 3. Clean up: parts smaller than MIN_FACES faces join the neighbour with the cheapest admissible
    merge (concavity still <= tau).
 
-The union concavity uses cached hulls (the hull of A u B is the hull of the two hulls' vertices)
-and a numba kernel with early exit; evaluations are memoized, so `parts=K` (a bisection on tau)
-re-uses most of them. Merging adjacent connected clusters keeps every part edge-connected.
+The union concavity uses cached hulls (the hull of A u B is the hull of the two hulls' vertices,
+by a numba kernel for small sets, qhull beyond) and a numba depth kernel with early exit;
+evaluations are memoized, so `parts=K` (a bisection on tau) re-uses most of them. Merging adjacent connected clusters keeps every part edge-connected.
 
 Concavity (`part_concavity`): max over the part's vertices plus SAMPLES_PER_FACE seeded surface
 samples per face of the depth below the part's own convex hull (hull of its vertices), divided by
@@ -123,12 +123,157 @@ def _denoise(depth: float, diag: float) -> float:
     return 0.0 if depth <= NOISE * diag else depth
 
 
+@njit(cache=True)
+def _plane(p, a, b, c):
+    """Unit normal (right-hand rule a->b->c), offset d (n.x + d = 0 on the plane), and the cross
+    product's length (0: degenerate triangle, the normal is then not normalized)."""
+    ux, uy, uz = p[b, 0] - p[a, 0], p[b, 1] - p[a, 1], p[b, 2] - p[a, 2]
+    vx, vy, vz = p[c, 0] - p[a, 0], p[c, 1] - p[a, 1], p[c, 2] - p[a, 2]
+    nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+    ln = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if ln > 0:
+        nx, ny, nz = nx / ln, ny / ln, nz / ln
+    return nx, ny, nz, -(nx * p[a, 0] + ny * p[a, 1] + nz * p[a, 2]), ln
+
+
+@njit(cache=True)
+def convex_hull(p, rel_eps):
+    """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)).
+
+    Facet planes are unit outward normals with offsets, n.x + d <= 0 inside (qhull's convention).
+    Empty equations when the points span no volume (thinner than rel_eps * their extent).
+    Incremental: start from a tetrahedron of extreme points; each point above some facets (by more
+    than the tolerance) replaces them by a cone over their boundary edges, the horizon. The
+    horizon is found as the edges whose reverse lies on a kept facet, so the surface stays closed
+    even if rounding makes the visible region odd. O(n * facets^2): for the small sets of the
+    merging, where qhull's per-call set-up (about 45 us) is most of its cost."""
+    n = p.shape[0]
+    empty_v = np.empty(0, dtype=np.int64)
+    empty_e = np.empty((0, 4))
+    if n < 4:
+        return empty_v, empty_e
+    ext = 0.0
+    for k in range(3):
+        ext = max(ext, p[:, k].max() - p[:, k].min())
+    eps = rel_eps * ext
+    if ext <= 0:
+        return empty_v, empty_e
+    # initial tetrahedron: extreme x, farthest from it, farthest from their line, farthest from the plane
+    i0 = np.argmin(p[:, 0])
+    i1, best = -1, -1.0
+    for i in range(n):
+        d = (p[i, 0] - p[i0, 0]) ** 2 + (p[i, 1] - p[i0, 1]) ** 2 + (p[i, 2] - p[i0, 2]) ** 2
+        if d > best:
+            best, i1 = d, i
+    d01 = math.sqrt(best)
+    i2, best = -1, -1.0
+    for i in range(n):
+        nx, ny, nz, d, ln = _plane(p, i0, i1, i)
+        if ln > best:
+            best, i2 = ln, i
+    nx, ny, nz, d0, ln = _plane(p, i0, i1, i2)
+    if ln <= eps * d01:  # all points on the line i0-i1 (ln / d01 is the distance from it)
+        return empty_v, empty_e
+    i3, best = -1, 0.0
+    for i in range(n):
+        d = nx * p[i, 0] + ny * p[i, 1] + nz * p[i, 2] + d0
+        if abs(d) > abs(best):
+            best, i3 = d, i
+    if abs(best) <= eps:
+        return empty_v, empty_e
+    cap = 8 * n + 16
+    F = np.empty((cap, 3), dtype=np.int64)
+    E = np.empty((cap, 4))
+    alive = np.zeros(cap, dtype=np.bool_)
+    nf = 0
+    if best > 0:  # i3 above the plane (i0, i1, i2): orient that face downwards
+        i1, i2 = i2, i1
+    for a, b, c in ((i0, i1, i2), (i0, i3, i1), (i1, i3, i2), (i2, i3, i0)):
+        F[nf, 0], F[nf, 1], F[nf, 2] = a, b, c
+        nx, ny, nz, d, ln = _plane(p, a, b, c)
+        E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
+        alive[nf] = True
+        nf += 1
+    vis = np.zeros(cap, dtype=np.bool_)
+    hor = np.empty((cap, 2), dtype=np.int64)
+    for i in range(n):
+        if i == i0 or i == i1 or i == i2 or i == i3:
+            continue
+        x, y, z = p[i, 0], p[i, 1], p[i, 2]
+        any_vis = False
+        for f in range(nf):
+            vis[f] = False
+            if alive[f] and E[f, 0] * x + E[f, 1] * y + E[f, 2] * z + E[f, 3] > eps:
+                vis[f] = True
+                any_vis = True
+        if not any_vis:
+            continue
+        # horizon: directed edges of visible faces whose reverse lies on an alive invisible face
+        nh = 0
+        for f in range(nf):
+            if not vis[f]:
+                continue
+            for k in range(3):
+                a, b = F[f, k], F[f, (k + 1) % 3]
+                for g in range(nf):
+                    if not alive[g] or vis[g]:
+                        continue
+                    if (F[g, 0] == b and F[g, 1] == a) or (F[g, 1] == b and F[g, 2] == a) or (F[g, 2] == b and F[g, 0] == a):
+                        hor[nh, 0], hor[nh, 1] = a, b
+                        nh += 1
+                        break
+        if nf + nh > cap:  # cannot happen for a consistent hull; be safe
+            return empty_v, empty_e
+        for f in range(nf):
+            if vis[f]:
+                alive[f] = False
+        for h in range(nh):
+            a, b = hor[h, 0], hor[h, 1]
+            F[nf, 0], F[nf, 1], F[nf, 2] = a, b, i
+            nx, ny, nz, d, ln = _plane(p, a, b, i)
+            E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
+            alive[nf] = ln > 0
+            nf += 1
+        # compact when the dead faces dominate, so the loops stay short
+        if nf > 2 * n + 64:
+            m = 0
+            for f in range(nf):
+                if alive[f]:
+                    F[m] = F[f]
+                    E[m] = E[f]
+                    alive[m] = True
+                    m += 1
+            nf = m
+    used = np.zeros(n, dtype=np.bool_)
+    m = 0
+    for f in range(nf):
+        if alive[f]:
+            m += 1
+            used[F[f, 0]] = True
+            used[F[f, 1]] = True
+            used[F[f, 2]] = True
+    eq = np.empty((m, 4))
+    m = 0
+    for f in range(nf):
+        if alive[f]:
+            eq[m] = E[f]
+            m += 1
+    return np.flatnonzero(used), eq
+
+
+SMALL_HULL = 64  # up to this many points our kernel; beyond, qhull (its ~45 us set-up no longer dominates)
+FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
+
+
 def _hull(points: np.ndarray):
     """(hull vertex coordinates, facet equations) or (points, None) when the set has no volume."""
     from scipy.spatial import ConvexHull, QhullError
 
     if len(points) < 4:
         return points, None
+    if len(points) <= SMALL_HULL:
+        verts, eq = convex_hull(np.ascontiguousarray(points, dtype=np.float64), FLAT_EPS)
+        return (points, None) if len(eq) == 0 else (points[verts], eq)
     try:
         h = ConvexHull(points)
     except (QhullError, ValueError):
