@@ -22,7 +22,8 @@ from test_cli import one_line, run_cli
 
 from polyfold.io import load_mesh
 from polyfold.mesh import Mesh
-from polyfold.segment import DEFAULT_TAU, FLAT_EPS, convex_hull, rand_index, segment, surface_samples
+from polyfold._segment_kernels import FLAT_EPS, convex_hull
+from polyfold.segment import DEFAULT_TAU, rand_index, segment, surface_samples
 
 # ----------------------------------------------------------------------------------------------
 # Independent measures

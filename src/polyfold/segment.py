@@ -19,9 +19,10 @@ Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 3. Clean up: parts smaller than MIN_FACES faces join the neighbour with the cheapest admissible
    merge (concavity still <= tau).
 
-The union concavity uses cached hulls (the hull of A u B is the hull of the two hulls' vertices,
-by a numba kernel for small sets, qhull beyond) and a numba depth kernel with early exit;
-evaluations are memoized, so `parts=K` (a bisection on tau) re-uses most of them. Merging adjacent connected clusters keeps every part edge-connected.
+A merging run is one numba kernel (`_segment_kernels.merge_run`). The union concavity uses cached
+hulls (the hull of A u B is the hull of the two hulls' vertices) and a depth kernel with early
+exit; evaluations are memoized across runs, so `parts=K` (a bisection on tau) re-uses most of
+them. Merging adjacent connected clusters keeps every part edge-connected.
 
 Concavity (`part_concavity`): max over the part's vertices plus SAMPLES_PER_FACE seeded surface
 samples per face of the depth below the part's own convex hull (hull of its vertices), divided by
@@ -32,15 +33,14 @@ the merging checked against tau.
 
 from __future__ import annotations
 
-import heapq
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ._segment_kernels import FLAT_EPS, convex_hull, denoise, make_units, max_depth, merge_run, new_memo, union_labels
 from .io import obj_text
-from .mesh import Mesh, face_areas, face_components
+from .mesh import Mesh, face_areas
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
 SAMPLES_PER_FACE = 3
@@ -90,179 +90,7 @@ def surface_samples(mesh: Mesh, samples_per_face: int = SAMPLES_PER_FACE, seed: 
     return tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
 
 
-@njit(cache=True)
-def _max_depth(pts, eq, limit):
-    """max_i min_j -(eq[j, :3] . pts[i] + eq[j, 3]) (>= 0); stops early once it exceeds `limit`."""
-    best = 0.0
-    n_f = eq.shape[0]
-    hint = 0
-    for i in range(pts.shape[0]):
-        x, y, z = pts[i, 0], pts[i, 1], pts[i, 2]
-        # The facet that bounded the previous point first: neighbouring points share facets.
-        m = -(eq[hint, 0] * x + eq[hint, 1] * y + eq[hint, 2] * z + eq[hint, 3])
-        if m <= best:
-            continue
-        for j in range(n_f):
-            d = -(eq[j, 0] * x + eq[j, 1] * y + eq[j, 2] * z + eq[j, 3])
-            if d < m:
-                m = d
-                hint = j
-                if m <= best:
-                    break
-        if m > best:
-            best = m
-            if best > limit:
-                return best
-    return best
-
-
-NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex
-
-
-def _denoise(depth: float, diag: float) -> float:
-    return 0.0 if depth <= NOISE * diag else depth
-
-
-@njit(cache=True)
-def _plane(p, a, b, c):
-    """Unit normal (right-hand rule a->b->c), offset d (n.x + d = 0 on the plane), and the cross
-    product's length (0: degenerate triangle, the normal is then not normalized)."""
-    ux, uy, uz = p[b, 0] - p[a, 0], p[b, 1] - p[a, 1], p[b, 2] - p[a, 2]
-    vx, vy, vz = p[c, 0] - p[a, 0], p[c, 1] - p[a, 1], p[c, 2] - p[a, 2]
-    nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
-    ln = math.sqrt(nx * nx + ny * ny + nz * nz)
-    if ln > 0:
-        nx, ny, nz = nx / ln, ny / ln, nz / ln
-    return nx, ny, nz, -(nx * p[a, 0] + ny * p[a, 1] + nz * p[a, 2]), ln
-
-
-@njit(cache=True)
-def convex_hull(p, rel_eps):
-    """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)).
-
-    Facet planes are unit outward normals with offsets, n.x + d <= 0 inside (qhull's convention).
-    Empty equations when the points span no volume (thinner than rel_eps * their extent).
-    Incremental: start from a tetrahedron of extreme points; each point above some facets (by more
-    than the tolerance) replaces them by a cone over their boundary edges, the horizon. The
-    horizon is found as the edges whose reverse lies on a kept facet, so the surface stays closed
-    even if rounding makes the visible region odd. O(n * facets^2): for the small sets of the
-    merging, where qhull's per-call set-up (about 45 us) is most of its cost."""
-    n = p.shape[0]
-    empty_v = np.empty(0, dtype=np.int64)
-    empty_e = np.empty((0, 4))
-    if n < 4:
-        return empty_v, empty_e
-    ext = 0.0
-    for k in range(3):
-        ext = max(ext, p[:, k].max() - p[:, k].min())
-    eps = rel_eps * ext
-    if ext <= 0:
-        return empty_v, empty_e
-    # initial tetrahedron: extreme x, farthest from it, farthest from their line, farthest from the plane
-    i0 = np.argmin(p[:, 0])
-    i1, best = -1, -1.0
-    for i in range(n):
-        d = (p[i, 0] - p[i0, 0]) ** 2 + (p[i, 1] - p[i0, 1]) ** 2 + (p[i, 2] - p[i0, 2]) ** 2
-        if d > best:
-            best, i1 = d, i
-    d01 = math.sqrt(best)
-    i2, best = -1, -1.0
-    for i in range(n):
-        nx, ny, nz, d, ln = _plane(p, i0, i1, i)
-        if ln > best:
-            best, i2 = ln, i
-    nx, ny, nz, d0, ln = _plane(p, i0, i1, i2)
-    if ln <= eps * d01:  # all points on the line i0-i1 (ln / d01 is the distance from it)
-        return empty_v, empty_e
-    i3, best = -1, 0.0
-    for i in range(n):
-        d = nx * p[i, 0] + ny * p[i, 1] + nz * p[i, 2] + d0
-        if abs(d) > abs(best):
-            best, i3 = d, i
-    if abs(best) <= eps:
-        return empty_v, empty_e
-    cap = 8 * n + 16
-    F = np.empty((cap, 3), dtype=np.int64)
-    E = np.empty((cap, 4))
-    alive = np.zeros(cap, dtype=np.bool_)
-    nf = 0
-    if best > 0:  # i3 above the plane (i0, i1, i2): orient that face downwards
-        i1, i2 = i2, i1
-    for a, b, c in ((i0, i1, i2), (i0, i3, i1), (i1, i3, i2), (i2, i3, i0)):
-        F[nf, 0], F[nf, 1], F[nf, 2] = a, b, c
-        nx, ny, nz, d, ln = _plane(p, a, b, c)
-        E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
-        alive[nf] = True
-        nf += 1
-    vis = np.zeros(cap, dtype=np.bool_)
-    hor = np.empty((cap, 2), dtype=np.int64)
-    for i in range(n):
-        if i == i0 or i == i1 or i == i2 or i == i3:
-            continue
-        x, y, z = p[i, 0], p[i, 1], p[i, 2]
-        any_vis = False
-        for f in range(nf):
-            vis[f] = False
-            if alive[f] and E[f, 0] * x + E[f, 1] * y + E[f, 2] * z + E[f, 3] > eps:
-                vis[f] = True
-                any_vis = True
-        if not any_vis:
-            continue
-        # horizon: directed edges of visible faces whose reverse lies on an alive invisible face
-        nh = 0
-        for f in range(nf):
-            if not vis[f]:
-                continue
-            for k in range(3):
-                a, b = F[f, k], F[f, (k + 1) % 3]
-                for g in range(nf):
-                    if not alive[g] or vis[g]:
-                        continue
-                    if (F[g, 0] == b and F[g, 1] == a) or (F[g, 1] == b and F[g, 2] == a) or (F[g, 2] == b and F[g, 0] == a):
-                        hor[nh, 0], hor[nh, 1] = a, b
-                        nh += 1
-                        break
-        if nf + nh > cap:  # cannot happen for a consistent hull; be safe
-            return empty_v, empty_e
-        for f in range(nf):
-            if vis[f]:
-                alive[f] = False
-        for h in range(nh):
-            a, b = hor[h, 0], hor[h, 1]
-            F[nf, 0], F[nf, 1], F[nf, 2] = a, b, i
-            nx, ny, nz, d, ln = _plane(p, a, b, i)
-            E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
-            alive[nf] = ln > 0
-            nf += 1
-        # compact when the dead faces dominate, so the loops stay short
-        if nf > 2 * n + 64:
-            m = 0
-            for f in range(nf):
-                if alive[f]:
-                    F[m] = F[f]
-                    E[m] = E[f]
-                    alive[m] = True
-                    m += 1
-            nf = m
-    used = np.zeros(n, dtype=np.bool_)
-    m = 0
-    for f in range(nf):
-        if alive[f]:
-            m += 1
-            used[F[f, 0]] = True
-            used[F[f, 1]] = True
-            used[F[f, 2]] = True
-    eq = np.empty((m, 4))
-    m = 0
-    for f in range(nf):
-        if alive[f]:
-            eq[m] = E[f]
-            m += 1
-    return np.flatnonzero(used), eq
-
-
 SMALL_HULL = 64  # up to this many points our kernel; beyond, qhull (its ~45 us set-up no longer dominates)
-FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
 
 
 def _hull(points: np.ndarray):
@@ -296,7 +124,7 @@ def part_concavity(mesh: Mesh, face_ids: np.ndarray, samples: np.ndarray | None 
     if eq is None or diag <= 0:
         return 0.0
     pts = np.concatenate([verts, samples[face_ids].reshape(-1, 3)])
-    return _denoise(float(_max_depth(pts, eq, np.inf)), diag) / diag
+    return denoise(float(max_depth(pts, eq, np.inf)), diag) / diag
 
 
 # ----------------------------------------------------------------------------------------------
@@ -333,92 +161,60 @@ def rand_index(a: np.ndarray, b: np.ndarray) -> float:
 # Merging
 
 
-class _Cluster:
-    __slots__ = ("faces", "pts", "hull", "conc", "area", "perim", "nbrs", "key")
-
-    def __init__(self, faces, pts, hull, conc, area, perim, key):
-        self.faces = faces  # int64 array of mesh faces
-        self.pts = pts  # (n, 3) vertices + surface samples
-        self.hull = hull  # (h, 3) hull vertex coordinates (all points when flat)
-        self.conc = conc  # absolute concavity (not divided by the diagonal)
-        self.area = area
-        self.perim = perim
-        self.nbrs: dict[int, list[float]] = {}  # neighbour -> [shared length, concave-weighted length]
-        self.key = key
-
-
 class _Merger:
-    """Dual-graph state shared by all runs on one mesh (memoizes union concavities)."""
+    """Per-mesh state shared by all merging runs of one `segment` call: the dual graph's arrays,
+    the candidate initial clusters of each seed labelling, and the memo of union concavities."""
 
     def __init__(self, mesh: Mesh, seed: int):
         self.mesh = mesh
         self.diag = mesh.bbox_diagonal
-        self.samples = surface_samples(mesh, seed=seed)
+        self.samples = np.ascontiguousarray(surface_samples(mesh, seed=seed))
         topo = mesh.topology
         self.areas = face_areas(mesh.vertices, mesh.faces)
         e = topo.edges
-        self.edge_len = np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)
-        self.rho = mesh.fold_angles
+        edge_len = np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)
         # Perimeter of each face counted over all its edges; shared edges are subtracted on merges.
-        self.face_perim = self.edge_len[topo.face_edges].sum(axis=1)
+        self.face_perim = edge_len[topo.face_edges].sum(axis=1)
         inner = np.flatnonzero(topo.interior)
-        self.inner = inner
-        self.ef = topo.edge_faces[inner]
-        self.cache: dict[tuple, tuple[float, bool, np.ndarray | None]] = {}
-        self.made: dict[int, tuple] = {}
+        self.ef0 = np.ascontiguousarray(topo.edge_faces[inner, 0])
+        self.ef1 = np.ascontiguousarray(topo.edge_faces[inner, 1])
+        self.inner_len = edge_len[inner]
+        self.inner_conc = self.inner_len * np.clip(-mesh.fold_angles[inner], 0.0, None) / (math.pi / 2)
+        # random 64-bit face keys: a cluster's key is their sum (see _segment_kernels.new_memo)
+        self.face_key = np.random.default_rng(0x5E6).integers(0, 2**64 - 1, mesh.n_faces, dtype=np.uint64, endpoint=True)
+        self.memo = new_memo()
         self.polygon = _polygon_groups(mesh)
+        self._units: dict[bytes, tuple] = {}
 
-    # -- clusters --------------------------------------------------------------------------------
-    def make(self, faces: np.ndarray) -> _Cluster:
-        faces = np.sort(np.asarray(faces, dtype=np.int64))
-        key = hash(faces.tobytes())
-        # Every run (one per tau tried by `parts=K`) starts from the same seed clusters: their
-        # hulls are computed once. A fresh _Cluster each time: its neighbour dict is per run.
-        known = self.made.get(key)
-        if known is None:
-            verts = np.unique(self.mesh.faces[faces])
-            vpts = self.mesh.vertices[verts]
-            pts = np.concatenate([vpts, self.samples[faces].reshape(-1, 3)])
-            hull, eq = _hull(vpts)
-            conc = 0.0 if eq is None else _denoise(float(_max_depth(pts, eq, np.inf)), self.diag)
-            known = self.made[key] = (faces, pts, hull, conc, float(self.areas[faces].sum()),
-                                      float(self.face_perim[faces].sum()), key)
-        return _Cluster(*known)
-
-    def union_conc(self, a: _Cluster, b: _Cluster, limit: float) -> tuple[float, bool, np.ndarray]:
-        """(absolute concavity of a u b, exact?, hull points of a u b); inexact values exceed limit."""
-        key = (a.key, b.key) if a.key < b.key else (b.key, a.key)
-        hit = self.cache.get(key)
-        if hit is not None and (hit[1] or hit[0] > limit):
-            return hit
-        floor = max(a.conc, b.conc)  # a u b is at least as concave as either part
-        if floor > limit:  # decided without a hull (most candidate pairs once clusters grow)
-            self.cache[key] = res = (floor, False, None)
-            return res
-        if len(a.faces) + len(b.faces) == 2:
-            # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
-            self.cache[key] = res = (0.0, True, np.concatenate([a.hull, b.hull]))
-            return res
-        hull_pts, eq = _hull(np.concatenate([a.hull, b.hull]))
-        if eq is None:
-            res = (0.0, True, hull_pts)
-        else:
-            # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding
-            # noise must not count as exceeding it
-            stop = max(limit, NOISE * self.diag)
-            d = float(_max_depth(np.concatenate([a.pts, b.pts]), eq, stop))
-            res = (_denoise(d, self.diag), d <= stop, hull_pts)
-        self.cache[key] = res
-        return res
+    def units(self, seed_labels: np.ndarray) -> tuple:
+        """The candidate initial clusters for these seeds: each seed, then its input polygons
+        (used when the seed is too concave), with points, hulls, concavities, areas, perimeters."""
+        got = self._units.get(seed_labels.tobytes())
+        if got is not None:
+            return got
+        groups = []
+        seed_unit, sub_lo, sub_hi = [], [], []
+        for g in _groups(seed_labels):
+            seed_unit.append(len(groups))
+            groups.append(g)
+            subs = _groups(self.polygon[g], g)
+            sub_lo.append(len(groups))
+            groups += subs
+            sub_hi.append(len(groups))
+        mesh = self.mesh
+        start = np.concatenate([[0], np.cumsum([len(g) for g in groups])]).astype(np.int64)
+        faces = np.concatenate(groups).astype(np.int64)
+        pts, hulls, conc = make_units(faces, start, mesh.faces, mesh.vertices, self.samples, self.diag)
+        area = np.add.reduceat(self.areas[faces], start[:-1])
+        perim = np.add.reduceat(self.face_perim[faces], start[:-1])
+        got = (np.array(seed_unit), np.array(sub_lo), np.array(sub_hi), faces, start, pts, hulls, conc, area, perim)
+        self._units[seed_labels.tobytes()] = got
+        return got
 
 
 def _union_labels(n: int, f0: np.ndarray, f1: np.ndarray) -> np.ndarray:
     """Connected-component label of each of n faces, joined by the face pairs (f0[i], f1[i])."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    _, labels = connected_components(coo_matrix((np.ones(len(f0)), (f0, f1)), shape=(n, n)), directed=False)
-    return labels
+    return union_labels(n, np.ascontiguousarray(f0, dtype=np.int64), np.ascontiguousarray(f1, dtype=np.int64))
 
 
 def _polygon_groups(mesh: Mesh) -> np.ndarray:
@@ -451,129 +247,14 @@ def _groups(labels: np.ndarray, items: np.ndarray | None = None) -> list[np.ndar
 
 def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
          w_compact: float = W_COMPACT, w_seam: float = W_SEAM, min_faces: int = MIN_FACES) -> list[np.ndarray]:
-    """One merging run: the face lists of the parts (tau absolute; stop at `target` clusters)."""
-    mesh = m.mesh
+    """One merging run: the face lists of the parts (tau absolute; stop at `target` clusters).
+    The merging itself is `_segment_kernels.merge_run`."""
     limit = tau * m.diag * (1 - 1e-9)  # margin: the final re-measure may differ by rounding
-    clusters: dict[int, _Cluster] = {}
-    label = np.empty(mesh.n_faces, dtype=np.int64)
-    nid = 0
-    for g in _groups(seed_labels):
-        c = m.make(g)
-        if c.conc > limit:
-            # too concave a seed: restart from its polygons (single triangles unless the file had
-            # polygons, which stay whole: a flat polygon has concavity 0)
-            subs = [m.make(sub) for sub in _groups(m.polygon[g], g)]
-        else:
-            subs = [c]
-        for s in subs:
-            clusters[nid] = s
-            label[s.faces] = nid
-            nid += 1
-    # Adjacency with shared and concave-weighted lengths.
-    la, lb = label[m.ef[:, 0]], label[m.ef[:, 1]]
-    length = m.edge_len[m.inner]
-    conc_w = length * np.clip(-m.rho[m.inner], 0.0, None) / (math.pi / 2)
-    for x, y, ln, cw in zip(la.tolist(), lb.tolist(), length.tolist(), conc_w.tolist()):
-        if x == y:
-            continue
-        for p, q in ((x, y), (y, x)):
-            rec = clusters[p].nbrs.get(q)
-            if rec is None:
-                clusters[p].nbrs[q] = [ln, cw]
-            else:
-                rec[0] += ln
-                rec[1] += cw
-
     scale = limit if limit > 0 and math.isfinite(limit) else m.diag
-
-    def cost(a: _Cluster, b: _Cluster, shared: list[float], conc: float) -> float:
-        area = a.area + b.area
-        perim = a.perim + b.perim - 2 * shared[0]
-        compact = perim * perim / (4 * math.pi * area) - 1.0 if area > 0 else 0.0
-        seam = shared[1] / shared[0] if shared[0] > 0 else 0.0
-        return conc + (w_compact * compact + w_seam * seam) * scale
-
-    heap: list = []
-
-    def push(i: int, j: int) -> None:
-        # Lazy: the key is a lower bound (a u b is at least as concave as a or b); the exact union
-        # concavity (a convex hull) is computed only when the pair reaches the top of the heap.
-        a, b = clusters[i], clusters[j]
-        floor = max(a.conc, b.conc)
-        if floor > limit:
-            return
-        heapq.heappush(heap, (cost(a, b, a.nbrs[j], floor), 0, i, j))
-
-    def push_exact(i: int, j: int) -> None:
-        a, b = clusters[i], clusters[j]
-        conc, exact, _ = m.union_conc(a, b, limit)
-        if not exact or conc > limit:  # (the memo may hold exact values from runs with a larger tau)
-            return
-        heapq.heappush(heap, (cost(a, b, a.nbrs[j], conc), 1, i, j))
-
-    for i, c in clusters.items():
-        for j in c.nbrs:
-            if i < j:
-                push(i, j)
-
-    def merge(i: int, j: int) -> int:
-        nonlocal nid
-        a, b = clusters.pop(i), clusters.pop(j)
-        conc, exact, hull_pts = m.union_conc(a, b, limit)
-        shared = a.nbrs[j]
-        faces = np.sort(np.concatenate([a.faces, b.faces]))
-        c = _Cluster(faces, np.concatenate([a.pts, b.pts]), hull_pts, conc, a.area + b.area,
-                     a.perim + b.perim - 2 * shared[0], hash(faces.tobytes()))
-        for src in (a, b):
-            for k, rec in src.nbrs.items():
-                if k in (i, j):
-                    continue
-                other = clusters[k]
-                got = c.nbrs.get(k)
-                if got is None:
-                    c.nbrs[k] = list(rec)
-                else:
-                    got[0] += rec[0]
-                    got[1] += rec[1]
-                other.nbrs.pop(i, None)
-                other.nbrs.pop(j, None)
-                other.nbrs[nid] = c.nbrs[k]
-        clusters[nid] = c
-        nid += 1
-        return nid - 1
-
-    stop = 1 if target is None else target
-    while heap and len(clusters) > stop:
-        _, exact, i, j = heapq.heappop(heap)
-        if i not in clusters or j not in clusters:  # a merged cluster: its ids are never reused
-            continue
-        if not exact:
-            push_exact(i, j)
-            continue
-        k = merge(i, j)
-        for n in list(clusters[k].nbrs):
-            push(k, n)
-
-    # Small parts join the neighbour with the cheapest admissible merge.
-    changed = True
-    while changed and len(clusters) > stop:
-        changed = False
-        for i in sorted(clusters, key=lambda t: len(clusters[t].faces)):
-            c = clusters.get(i)
-            if c is None or len(c.faces) >= min_faces:
-                continue
-            best = None
-            for j in c.nbrs:
-                conc, exact, _ = m.union_conc(c, clusters[j], limit)
-                if exact and conc <= limit:
-                    cst = cost(c, clusters[j], c.nbrs[j], conc)
-                    if best is None or cst < best[0]:
-                        best = (cst, j)
-            if best is not None:
-                merge(i, best[1])
-                changed = True
-                break
-    return [c.faces for c in clusters.values()]
+    label = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
+                      int(min_faces), m.diag, *m.units(seed_labels), m.face_key, m.ef0, m.ef1,
+                      m.inner_len, m.inner_conc, *m.memo)
+    return _groups(label)
 
 
 def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed: int = 0) -> Segmentation:
@@ -604,7 +285,7 @@ def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[list[np.ndarray],
     """Parts and tau for `parts=k`: the default tau when it already gives k parts (so `segment()`
     and `segment(parts=k)` agree), else a bisection on tau from the default towards k."""
     mesh = m.mesh
-    comp = face_components(mesh.n_faces, mesh.topology)
+    comp = _union_labels(mesh.n_faces, m.ef0, m.ef1)  # edge-connected components
     n_comp = int(comp.max()) + 1
     k = int(min(max(k, n_comp), mesh.n_faces))
     g = _run(m, DEFAULT_TAU, None, seeds)
