@@ -13,59 +13,98 @@ crease, -1 at the root of a piece), `polyfold:edges_meshEdge` (twin cut edges sh
 from __future__ import annotations
 
 import json
+import math
 import os
 from typing import Sequence
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+from numba import njit
 
 from .unfold import Net
 
 FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F", fold angle 0)
 PIECE_GAP = 0.05  # gap between packed pieces, as a fraction of the model's bounding-box diagonal
+_ASSIGNMENTS = np.array(["B", "F", "M", "V"])  # edges_assignment by kind: cut, flat, mountain, valley
+
+
+@njit(cache=True)
+def _corner_labels(faces, parent, parent_edge, edges):
+    """Net vertex (F*3,) of every face corner, numbered in order of first corner (row-major).
+
+    A child's corners at the ends of its crease are joined to its parent's corners there; each
+    child corner points to at most one parent corner, so the joins form a forest over the corners
+    and a net vertex is one of its trees (found by walking up to the tree's root).
+    """
+    n = faces.shape[0]
+    link = np.arange(3 * n)
+    for f in range(n):
+        p = parent[f]
+        if p < 0:
+            continue
+        for end in range(2):
+            v = edges[parent_edge[f], end]
+            kc = 0
+            while kc < 2 and faces[f, kc] != v:
+                kc += 1
+            kp = 0
+            while kp < 2 and faces[p, kp] != v:
+                kp += 1
+            link[3 * f + kc] = 3 * p + kp
+    label = np.full(3 * n, -1)
+    count = 0
+    for c in range(3 * n):
+        r = c
+        while link[r] != r:
+            r = link[r]
+        if label[r] < 0:
+            label[r] = count
+            count += 1
+        label[c] = label[r]
+    return label
 
 
 def _net_vertices(net: Net) -> np.ndarray:
     """Net vertex id (F, 3) of every face corner: corners of one mesh vertex are the same net
     vertex when the faces are joined by creases around it."""
     faces = net.mesh.faces
-    n = len(faces)
-    child = np.flatnonzero(net.parent >= 0)
-    par = net.parent[child]
-    ends = net.mesh.topology.edges[net.parent_edge[child]]
-    rows, cols = [], []
-    for end in (ends[:, 0], ends[:, 1]):
-        kc = np.argmax(faces[child] == end[:, None], axis=1)
-        kp = np.argmax(faces[par] == end[:, None], axis=1)
-        rows.append(child * 3 + kc)
-        cols.append(par * 3 + kp)
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(3 * n, 3 * n))
-    _, labels = connected_components(graph, directed=False)
-    return labels.reshape(n, 3)
+    return _corner_labels(faces, net.parent, net.parent_edge, net.mesh.topology.edges).reshape(len(faces), 3)
 
 
 def _piece_offsets(coords: np.ndarray, piece: np.ndarray, gap: float) -> np.ndarray:
     """Shelf-pack the pieces' bounding boxes: translation (P, 2) per piece."""
     n_p = int(piece.max()) + 1
-    lo = np.full((n_p, 2), np.inf)
-    hi = np.full((n_p, 2), -np.inf)
-    pts = coords.reshape(-1, 2)
-    pid = np.repeat(piece, 3)
-    np.minimum.at(lo, pid, pts)
-    np.maximum.at(hi, pid, pts)
-    size = hi - lo
-    row_width = max(float(size[:, 0].max()), float(np.sqrt((size[:, 0] * size[:, 1]).sum()) * 1.5))
+    # boxes by segments of the faces sorted by piece (every piece has faces; faster than ufunc.at)
+    order = np.argsort(piece, kind="stable")
+    pts = coords[order].reshape(-1, 2)
+    start = 3 * np.searchsorted(piece[order], np.arange(n_p))
+    lo = np.minimum.reduceat(pts, start)
+    hi = np.maximum.reduceat(pts, start)
+    size = (hi - lo).tolist()
+    lo = lo.tolist()
+    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5)
     offsets = np.zeros((n_p, 2))
     x = y = shelf = 0.0
-    for p in np.argsort(-size[:, 1], kind="stable"):
-        if x > 0 and x + size[p, 0] > row_width:
+    # a handful of pieces: plain Python over lists is cheaper than numpy here
+    for p in sorted(range(n_p), key=lambda i: -size[i][1]):
+        w, h = size[p]
+        if x > 0 and x + w > row_width:
             x, y, shelf = 0.0, y + shelf + gap, 0.0
-        offsets[p] = (x - lo[p, 0], -(y + size[p, 1]) - lo[p, 1] + 0.0)
-        x += size[p, 0] + gap
-        shelf = max(shelf, size[p, 1])
+        offsets[p] = (x - lo[p][0], -(y + h) - lo[p][1])
+        x += w + gap
+        shelf = max(shelf, h)
     return offsets
+
+
+def _first_sides(side_v: np.ndarray, n_v: int) -> np.ndarray:
+    """Indices (ascending) of the face sides (S, 2) that are net edges: the first side of each net
+    vertex pair (a crease is shared by two faces; each side of a cut edge is an edge of its own)."""
+    u, v = side_v[:, 0], side_v[:, 1]
+    key = np.minimum(u, v) * n_v + np.maximum(u, v)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    first = np.ones(len(key), dtype=bool)
+    first[1:] = ks[1:] != ks[:-1]
+    return np.sort(order[first])
 
 
 def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | None = None) -> dict:
@@ -73,56 +112,51 @@ def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | 
     coords2d, coords3d, mesh_vertex = [], [], []
     faces_v, faces_src, faces_piece, faces_comp, faces_parent = [], [], [], [], []
     edges_v, edges_a, edges_ang, edges_mesh = [], [], [], []
-    v_off = f_off = p_off = e_off = 0
-    scale = max(max(n.mesh.bbox_diagonal for n in nets), 1e-300)
-    all_coords = []
-    for c, net in enumerate(nets):
-        mesh = net.mesh
-        topo = mesh.topology
+    v_off = f_off = p_off = e_off = mv_off = 0
+    corners, mesh_vs = [], []
+    for net in nets:
         corner_v = _net_vertices(net)
-        n_v = int(corner_v.max()) + 1
-        # Pieces are moved apart so the sheet has no overlaps between pieces either.
-        all_coords.append((net, corner_v, n_v))
-    # Pack all pieces of all components together.
-    piece_all = np.concatenate([n.piece + sum(m.n_pieces for m in nets[:i]) for i, n in enumerate(nets)])
+        mv = np.zeros(int(corner_v.max()) + 1, dtype=np.int64)
+        mv[corner_v.reshape(-1)] = net.mesh.faces.reshape(-1)
+        corners.append(corner_v)
+        mesh_vs.append(mv)
+        coords3d.append(net.mesh.vertices[mv])
+    # the net vertices' 3D points are the mesh's used vertices: their box is Mesh.bbox_diagonal's
+    scale = max(max(float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) for p in coords3d), 1e-300)
+    # Pack all pieces of all components together, so the sheet has no overlaps between pieces either.
+    n_pieces = [n.n_pieces for n in nets]
+    piece_all = np.concatenate([n.piece + sum(n_pieces[:i]) for i, n in enumerate(nets)])
     coords_all = np.concatenate([n.coords for n in nets])
     offsets = _piece_offsets(coords_all, piece_all, PIECE_GAP * scale)
-    for c, (net, corner_v, n_v) in enumerate(all_coords):
+    for c, (net, corner_v, mv) in enumerate(zip(nets, corners, mesh_vs)):
         mesh = net.mesh
         topo = mesh.topology
+        n_v = len(mv)
         placed = net.coords + offsets[net.piece + p_off][:, None, :]
         xy = np.zeros((n_v, 2))
         xy[corner_v.reshape(-1)] = placed.reshape(-1, 2)
-        mv = np.zeros(n_v, dtype=np.int64)
-        mv[corner_v.reshape(-1)] = mesh.faces.reshape(-1)
         coords2d.append(xy)
-        coords3d.append(mesh.vertices[mv])
-        mesh_vertex.append(mv + sum(len(n.mesh.vertices) for n in nets[:c]))
+        mesh_vertex.append(mv + mv_off)
         faces_v.append(corner_v + v_off)
         faces_src.append(mesh.face_source)
         faces_piece.append(net.piece + p_off)
         faces_comp.append(np.full(mesh.n_faces, c))
         faces_parent.append(np.where(net.parent >= 0, net.parent + f_off, -1))
-        # Net edges: each face side; creases are shared by two faces, cut edges appear twice.
-        side_v = np.stack([corner_v, np.roll(corner_v, -1, axis=1)], axis=2).reshape(-1, 2)
-        side_e = topo.face_edges.reshape(-1)
-        key = np.sort(side_v, axis=1)
-        uniq, first = np.unique(key, axis=0, return_index=True)
-        first = np.sort(first)
+        side_v = corner_v[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)  # (3F, 2) face sides, corner k -> k + 1
+        first = _first_sides(side_v, n_v)
         ev = side_v[first]
-        em = side_e[first]
-        crease = net.crease_mask[em]
+        em = topo.face_edges.reshape(-1)[first]
         rho = mesh.fold_angles[em]
-        assign = np.where(~crease, "B", np.where(np.abs(rho) < FLAT_EPS, "F", np.where(rho > 0, "M", "V")))
-        angle = np.where((assign == "M") | (assign == "V"), -np.degrees(rho), 0.0)
+        kind = np.where(net.crease_mask[em], np.where(np.abs(rho) < FLAT_EPS, 1, np.where(rho > 0, 2, 3)), 0)
         edges_v.append(ev + v_off)
-        edges_a.extend(assign.tolist())
-        edges_ang.append(angle)
+        edges_a.extend(_ASSIGNMENTS[kind].tolist())
+        edges_ang.append(np.where(kind >= 2, -np.degrees(rho), 0.0))
         edges_mesh.append(em + e_off)
         v_off += n_v
         f_off += mesh.n_faces
-        p_off += net.n_pieces
+        p_off += n_pieces[c]
         e_off += topo.n_edges
+        mv_off += len(mesh.vertices)
     fold = {
         "file_spec": 1.1,
         "file_creator": creator,
