@@ -80,7 +80,7 @@ def test_unfold_fold_gives_a_checked_path(folded_parts, name):
     fold = json.loads(net.read_text())
     assert fold["polyfold:path_resolutionDeg"] == 1.0
     assert fold.get("polyfold:path_contactTol", 1e-7) == 1e-7
-    assert fold["polyfold:path_planner"] in ("linear", "sequential", "lazy-prm")
+    assert fold["polyfold:path_planner"] in ("linear", "sequential", "sequential-rrt", "lazy-prm")
     assert fold["polyfold:path_linear"] == (len(fold["polyfold:path"]) == 2)
     report = check_path(net)
     assert report.ok, str(report)
@@ -249,6 +249,32 @@ def test_sequential_planner_folds_the_whole_horse(models_dir):
     assert path.planner == "sequential" and not path.linear
     _assert_monotone_discrete(tree, path)
     assert plan_fold(tree, planner="lazy-prm", time_limit=3, seed=1) is None
+
+
+def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_dir):
+    """Horse net 13: nine creases of a curled strip carrying a 67-face flap can open neither alone,
+    nor first, nor together in the discrete domain (this seed had no path before). The
+    RRT-Connect search over those creases opens them; its frames (the path's first ones, off the
+    discrete domain) are re-checked by the independent checker, the rest is discrete."""
+    fold = _whole_net(models_dir, "horse-302", 13, 302)
+    tree = fold_tree(fold)
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
+    assert path is not None and path.planner == "sequential-rrt"
+    goal = tree.goal[tree.creases]
+    cr = path.frames[:, tree.creases]
+    discrete = np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal), axis=1)
+    k = int(np.argmax(discrete[1:])) + 1  # the stuck state: where the discrete frames begin
+    assert k > 1 and not discrete[1:k].any() and discrete[k:].all()
+    folded = np.isclose(cr[k:], goal).sum(axis=1)
+    assert folded[-1] == len(goal) and np.all(np.diff(folded) > 0)
+    # only the stuck creases move in the continuous part, and they end where the discrete part starts
+    moving = np.flatnonzero(np.ptp(cr[:k + 1], axis=0) > 0)
+    assert 0 < len(moving) <= 32
+    net = FoldNet(fold, 1e-7)
+    deg = np.asarray(path.degrees_fold())
+    for s in range(k):
+        _, hit = net.segment_collision(deg[s], deg[s + 1], 0.5, skip_start=s > 0)
+        assert hit is None, f"segment {s} collides at {hit}"
 
 
 @pytest.mark.parametrize("planner", ["auto", "linear", "sequential", "lazy-prm"])

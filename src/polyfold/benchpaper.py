@@ -401,7 +401,8 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
         L.append(f"- {name}: {bound}{ours_whole / ours_parts:.1f}× ({paper_sp})")
     L += ["", "Planners: 'whole' and 'parts' rows use `plan_fold`'s default: the straight line (the paper's LC "
           "test), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
-          "the first free crease in a priority order, restarts with the stuck creases first, two base orders in turn), then Lazy PRM. "
+          "the first free crease in a priority order, restarts with the stuck creases first, two base orders in turn; "
+          "'sequential-rrt': when at most 32 creases lock, an RRT-Connect search over their continuous angles), then Lazy PRM. "
           f"'whole, paper's planner' rows: the straight line, then Lazy PRM only (ALGORITHMS.md 6.5), on the first "
           f"{PAPER_PLANNER_RUNS} seeds. The planner that found each path is named beside the path count.", "",
           "Contact tolerance 1e-3 of the model size for the fish rows (its folded shape self-intersects "

@@ -6,7 +6,9 @@ sampled at `resolution` (ALGORITHMS.md 6.3-6.5).
 
 Planners ("auto" runs them in this order):
 1. linear: the straight line C_s -> C_g (bisection order, early exit) — the paper's LC test;
-2. sequential: unfold the folded shape one crease at a time (not in the paper, see `_sequential`);
+2. sequential: unfold the folded shape one crease at a time (not in the paper, see `_sequential`),
+   with a continuous RRT-Connect search over the last few creases when they lock (the path is
+   then reported as "sequential-rrt");
 3. lazy-prm: Lazy PRM over discrete configurations (each crease either flat or at its goal angle)
    with Hamming-distance neighbours, lazily checked edges, A* search, and greedy shortcutting —
    the paper's planner (ALGORITHMS.md 6.5).
@@ -29,6 +31,10 @@ PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
 COARSE_SAMPLES = 7  # bisection levels 1-3 of a segment: the cheap first look of the Lazy PRM
 MAX_BATCH = 1600  # new roadmap samples per round at most (the batch doubles from n0 up to this)
+# The sequential planner's continuous search over the creases it cannot open (`_rrt_connect`):
+RRT_MAX_DOF = 32  # stuck sets of up to this many creases get one
+RRT_STEP_DEG = 15.0  # longest extension of a tree, per crease
+RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much on either side
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,9 +212,10 @@ def plan_fold(
         # auto: the Lazy PRM keeps a third of the time for the rare net the sequential planner
         # cannot unlock (it finds nothing on large nets, but may on a small one)
         seq_deadline = deadline if planner == "sequential" else t0 + time_limit * SEQUENTIAL_SHARE
-        frames = _sequential(tree, check, seq_deadline, np.random.default_rng(seed))
-        if frames is not None:
-            return done(frames, False, "sequential", len(frames))
+        found = _sequential(tree, check, seq_deadline, np.random.default_rng(seed))
+        if found is not None:
+            frames, continuous = found
+            return done(frames, False, "sequential-rrt" if continuous else "sequential", len(frames))
         if planner == "sequential":
             return None
     result = _lazy_prm(tree, check, deadline, np.random.default_rng(seed), n0, k_neighbours)
@@ -390,8 +397,8 @@ def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
     return states
 
 
-def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator) -> np.ndarray | None:
-    """Reverse sequential unfolding: frames flat -> goal, or None (stuck or out of time).
+def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
+    """Reverse sequential unfolding: (frames flat -> goal, continuous?), or None (stuck or out of time).
 
     Start at the folded goal and open one crease at a time (its angle to 0), always the first
     crease in priority order whose motion is collision-free; the path is that sequence reversed.
@@ -405,8 +412,12 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
     a flattened neighbour). Restarts alternate between two base orders (see `tracks`), each with
     its own promotions; a track stuck on the same creases again shuffles them (rng, so the seed
     decides). Restarts go on until the deadline.
-    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none;
-    it still fails when some creases can open neither alone, nor first, nor together.
+    When a restart is stuck with at most RRT_MAX_DOF creases left closed (a set not searched
+    before), their continuous subspace is searched by `_rrt_connect` from the stuck state to
+    flat: some creases can open neither alone, nor first, nor together in the discrete domain
+    (a tightly curled strip carrying a large flap, say) but can by partial, coordinated moves.
+    Such a path leaves the discrete domain in its first frames (`continuous?` is then True).
+    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
     """
     creases, goal = tree.creases, tree.goal
     n = len(creases)
@@ -417,6 +428,7 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
     # larger smaller side first), which unlocks some nets the first order cannot.
     tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
     tried: list[set[frozenset]] = [set(), set()]
+    searched: set[frozenset] = set()  # stuck sets given to the continuous search already
     fine = check.step / 2
     restart = 0
     while time.perf_counter() < deadline:
@@ -461,14 +473,91 @@ def _sequential(tree: FoldTree, check: _Checker, deadline: float, rng: np.random
                 break
         if is_open.all():
             frames.reverse()  # (plan_fold answers nets without creases before this runs)
-            return np.stack(frames)
+            return np.stack(frames), False
         stuck = [i for i in prio if not is_open[i]]
         if time.perf_counter() >= deadline:
             return None
-        if frozenset(stuck) in tried[track]:
+        key = frozenset(stuck)
+        if len(stuck) <= RRT_MAX_DOF and key not in searched:
+            # Locked in the discrete domain, but only a few creases are left: search their
+            # continuous subspace (once per stuck set, with half the time left).
+            searched.add(key)
+            sub_deadline = min(deadline, time.perf_counter() + 0.5 * (deadline - time.perf_counter()))
+            rest = _rrt_connect(check, q, creases[stuck], sub_deadline, rng)
+            if rest is not None:
+                frames += rest
+                frames.reverse()
+                return np.stack(frames), True
+        if key in tried[track]:
             rng.shuffle(stuck)
-        tried[track].add(frozenset(stuck))
+        tried[track].add(key)
         tracks[track] = stuck + [i for i in prio if is_open[i]]
+    return None
+
+
+def _rrt_connect(check: _Checker, start: np.ndarray, moving: np.ndarray, deadline: float,
+                 rng: np.random.Generator) -> list[np.ndarray] | None:
+    """Continuous path from the valid state `start` to `start` with the edges `moving` at 0, by
+    RRT-Connect (Kuffner & LaValle 2000) in the subspace of those edges; None when out of time.
+
+    Out: the frames after `start`, ending at the target, every move checked at half the
+    resolution (as the sequential planner's own moves). Each moving edge ranges over [0, goal]
+    widened by RRT_MARGIN_DEG (within [-pi, pi]); trees grow by at most RRT_STEP_DEG per edge
+    (distances are max-norms: a segment's check costs its largest angle change). The joined
+    path is shortened greedily (`_shortcut`) at the same resolution.
+    """
+    fine = check.step / 2
+    a = start[moving]
+    lo = np.maximum(np.minimum(a, 0.0) - math.radians(RRT_MARGIN_DEG), -math.pi)
+    hi = np.minimum(np.maximum(a, 0.0) + math.radians(RRT_MARGIN_DEG), math.pi)
+    step = math.radians(RRT_STEP_DEG)
+
+    def state(x: np.ndarray) -> np.ndarray:
+        q = start.copy()
+        q[moving] = x
+        return q
+
+    target = state(np.zeros(len(moving)))
+    if not check.valid(target):
+        return None
+    # two trees (node angles of the moving edges, parent index); tree 0 grows from start
+    nodes = [[a.copy()], [np.zeros(len(moving))]]
+    parents = [[-1], [-1]]
+
+    def extend(t: int, x: np.ndarray) -> tuple[int, bool]:
+        """Grow tree t one step towards x: (new node or -1 when blocked, x reached?)."""
+        pts = np.asarray(nodes[t])
+        i = int(np.argmin(np.abs(pts - x).max(axis=1)))
+        y = pts[i]
+        d = float(np.abs(x - y).max())
+        z = x if d <= step else y + (x - y) * (step / d)
+        if not check.valid(state(z)) or not check.segment(state(y), state(z), fine):
+            return -1, False
+        nodes[t].append(z)
+        parents[t].append(i)
+        return len(nodes[t]) - 1, d <= step
+
+    def branch(t: int, i: int) -> list[np.ndarray]:
+        out = []
+        while i >= 0:
+            out.append(nodes[t][i])
+            i = parents[t][i]
+        return out
+
+    t = 0
+    while time.perf_counter() < deadline:
+        k, _ = extend(t, lo + rng.random(len(moving)) * (hi - lo))
+        if k >= 0:
+            x = nodes[t][k]
+            while time.perf_counter() < deadline:  # connect: the other tree steps towards x
+                j, reached = extend(1 - t, x)
+                if j < 0:
+                    break
+                if reached:
+                    ends = {t: k, 1 - t: j}
+                    path = branch(0, ends[0])[::-1] + branch(1, ends[1])[1:]
+                    return list(_shortcut([state(p) for p in path], check, deadline, fine)[1:])
+        t = 1 - t
     return None
 
 
@@ -556,13 +645,14 @@ def _lazy_prm(tree: FoldTree, check: _Checker, deadline: float, rng: np.random.G
     return None
 
 
-def _shortcut(frames: list[np.ndarray], check: _Checker, deadline: float) -> np.ndarray:
-    """Greedy shortcut: from each kept frame jump to the farthest later frame reachable directly."""
+def _shortcut(frames: list[np.ndarray], check: _Checker, deadline: float, step: float | None = None) -> np.ndarray:
+    """Greedy shortcut: from each kept frame jump to the farthest later frame reachable directly
+    (checked at `step`, default the checker's resolution); after the deadline, no more jumps."""
     out = [frames[0]]
     i = 0
     while i < len(frames) - 1:
         j = len(frames) - 1
-        while j > i + 1 and (time.perf_counter() >= deadline or not check.segment(frames[i], frames[j])):
+        while j > i + 1 and (time.perf_counter() >= deadline or not check.segment(frames[i], frames[j], step)):
             j -= 1
         out.append(frames[j])
         i = j
