@@ -53,5 +53,11 @@ def test_bench_paper_quick(models_dir, tmp_path):
     md = (out / "report.md").read_text()
     for heading in ("## Table 1", "## Table 2", "## Fig. 3", "## Fig. 5"):
         assert heading in md
+    # the targets table: one verdict per Table 2 total (whole rows where the paper has one, parts rows)
+    verdicts = [line for line in md.splitlines() if line.startswith("| ") and line.rstrip().endswith(("| met |", "not met |", "sd) |"))]
+    assert len(verdicts) == sum(1 + (r["whole"] is not None) for r in t2.values())
+    # the parts rows credit the planners that folded the parts, one credit per part and run
+    for name, r in t2.items():
+        assert sum(r["parts"]["planners"].values()) == 3 * len(r["parts"]["dofs"]), name
     for png in ("fig3.png", "fig5.png"):
         assert (out / png).read_bytes().startswith(b"\x89PNG")

@@ -141,8 +141,9 @@ def _ratio(paper: float | None, ours: float) -> str:
 
 def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: list[float] | None = None) -> dict:
     """Runs over a list of part meshes: per run the sums of net and path seconds."""
-    per_run, dofs, lcs, ok = [], [], [], True
+    per_run, dofs, ok = [], [], True
     trees = []
+    planners: dict[str, int] = {}
     for seed in range(1, runs + 1):
         rows = [net_and_path(p, seed, time_limit, tol) for p in parts]
         net_s = sum(r["net_s"] for r in rows)
@@ -151,13 +152,16 @@ def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: lis
         per_run.append({"net_s": net_s, "path_s": path_s, "paths": [r["path"] for r in rows],
                         "lc": [r["lc"] for r in rows], "notes": [r["note"] for r in rows],
                         "part_net_s": [r["net_s"] for r in rows], "part_path_s": [r["path_s"] for r in rows]})
+        for r in rows:
+            if r["planner"]:
+                planners[r["planner"]] = planners.get(r["planner"], 0) + 1
         if seed == 1:
             dofs = [r["dof"] for r in rows]
             trees = [r["tree"] for r in rows]
-        lcs.append([r["lc"] for r in rows])
     seg = seg_s or [0.0] * runs
     totals = [s + r["net_s"] + r["path_s"] for s, r in zip(seg, per_run)]
-    return {"dofs": dofs, "runs": per_run, "seg_s": seg, "totals": totals, "all_paths": ok, "trees": trees}
+    return {"dofs": dofs, "runs": per_run, "seg_s": seg, "totals": totals, "all_paths": ok, "trees": trees,
+            "planners": planners}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -331,6 +335,36 @@ def _plots(out_dir: Path, f3: dict, f5: list[dict]) -> list[str]:
 # Report
 
 
+TARGET_SPEEDUP = 50  # issue 8: every Table 2 total at least 50x faster than the paper's
+
+
+def _targets(t2: dict, st: BenchSettings) -> list[str]:
+    """Markdown lines: each Table 2 total (our default planner) against paper / TARGET_SPEEDUP; a
+    whole mesh the paper could not fold must fold on every run within the time limit."""
+    L = ["", f"Targets: every total at least {TARGET_SPEEDUP}× faster than the paper's (mean ≤ paper / {TARGET_SPEEDUP}); "
+         "a whole mesh the paper could not fold gets a path on every run within the time limit.", "",
+         "| model | route | ours s | target | verdict |", "|---|---|---|---|---|"]
+    for name, r in t2.items():
+        paper = PAPER_TABLE2[name]
+        rows = []
+        if r["whole"] is not None:
+            w = r["whole"]
+            rows.append(("whole", np.asarray(w["net_s"]) + np.asarray(w["path_s"]), paper["whole"][2], w["paths"] == w["runs"]))
+        p = r["parts"]
+        rows.append(("parts", np.asarray(p["totals"]), paper["parts"][4], bool(p["all_paths"])))
+        for route, tot, ref, all_paths in rows:
+            m, sd = _mean_sd(list(tot))
+            if not math.isfinite(ref):
+                target, met = "a path on every run", "met" if all_paths else "not met"
+            else:
+                limit = ref / TARGET_SPEEDUP
+                target = f"≤ {limit:.4g}"
+                met = "met" if all_paths and m <= limit else (
+                    "not met (within one sd)" if all_paths and m - sd <= limit else "not met")
+            L.append(f"| {name} | {route} | {_fmt(m, sd, 4)} | {target} | {met} |")
+    return L
+
+
 def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, seconds: float, figs: list[str]) -> str:
     L = [f"# polyfold vs the paper (Xi & Lien 2017)", "",
          f"{st.runs} runs (seeds 1–{st.runs}) per row{' (--quick)' if st.quick else ''}; time limit "
@@ -380,9 +414,11 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
         p = r["parts"]
         n_paths = sum(all(run["paths"]) for run in p["runs"])
         pp = paper["parts"]
+        # which planner folded the parts, over all parts of all runs (linear = the part was LC)
+        found = ", ".join(f"{k} {v}" for k, v in sorted(p.get("planners", {}).items()))
         L.append(f"| {name} | parts | {len(p['dofs'])} | {' / '.join(map(str, p['dofs']))} | {_fmt(*_mean_sd(p['seg_s']))} | "
                  f"{_fmt(*_mean_sd([x['net_s'] for x in p['runs']]))} | {_fmt(*_mean_sd([x['path_s'] for x in p['runs']]))} | "
-                 f"{_fmt(*_mean_sd(p['totals']))} | {n_paths}/{st.runs} | {pp[4]:.2f} | "
+                 f"{_fmt(*_mean_sd(p['totals']))} | {n_paths}/{st.runs}{f' (part paths: {found})' if found else ''} | {pp[4]:.2f} | "
                  f"{_ratio(pp[4], float(np.mean(p['totals']))) if n_paths == st.runs else '–'} |")
     # The paper's speedup column: whole-mesh total / segmented total (both fish rows against the
     # original fish's whole mesh, as in the paper).
@@ -399,6 +435,7 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
         bound = "≥ " if w["paths"] < w["runs"] else ""  # runs without a path count the time limit
         paper_sp = "no path for the whole mesh" if not math.isfinite(paper_whole) else f"{paper_whole / paper_parts:.1f}×"
         L.append(f"- {name}: {bound}{ours_whole / ours_parts:.1f}× ({paper_sp})")
+    L += _targets(t2, st)
     L += ["", "Planners: 'whole' and 'parts' rows use `plan_fold`'s default: the straight line (the paper's LC "
           "test), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
           "the first free crease in a priority order, restarts with the stuck creases first, two base orders in turn; "
