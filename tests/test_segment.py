@@ -212,6 +212,35 @@ def test_hull_kernel_matches_qhull(models_dir):
     assert len(convex_hull(flat, FLAT_EPS)[1]) == 0
 
 
+def test_a_full_memo_is_regrown_and_the_run_redone(models_dir, monkeypatch):
+    """merge_run stops when the memo of union concavities fills up and redoes the run on a larger
+    one: starting from a memo with room for 2 unions gives the same segmentations."""
+    import polyfold.segment as S
+
+    meshes = [load_mesh(models_dir / f"{n}.obj").mesh for n in ("periscope2-44", "bunny-128")]
+    cases = [(m, k) for m in meshes for k in (None, 2, 5)]
+    want = [segment(m) if k is None else segment(m, parts=k) for m, k in cases]
+
+    def tiny_memo(n_faces):
+        return (np.full(4, -1, dtype=np.int64), np.zeros((2, 2), dtype=np.uint64), np.zeros(2),
+                np.zeros(2, dtype=bool), np.zeros((2, 2), dtype=np.int64), np.empty((4, 3)), np.zeros(2, dtype=np.int64))
+
+    slots = []
+    merge_run = S.merge_run
+
+    def recording_run(*args):
+        label, n, memo = merge_run(*args)
+        slots.append(len(memo[1]))
+        return label, n, memo
+
+    monkeypatch.setattr(S, "new_memo", tiny_memo)
+    monkeypatch.setattr(S, "merge_run", recording_run)
+    got = [segment(m) if k is None else segment(m, parts=k) for m, k in cases]
+    assert max(slots) >= 64  # the memo did grow, many times over
+    for a, b in zip(want, got):
+        assert np.array_equal(a.labels, b.labels) and a.tau == b.tau and np.array_equal(a.concavity, b.concavity)
+
+
 def test_rand_index():
     a = np.array([0, 0, 1, 1, 2])
     assert rand_index(a, a) == 1.0

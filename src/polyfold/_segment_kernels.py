@@ -1,10 +1,18 @@
 """numba kernels of the segmenter: convex hull, depth below a hull, and one merging run.
 
 `merge_run` is the whole hierarchical merging of segment.py (ALGORITHMS.md 4.4) in one call:
-clusters, their adjacency, the lazy min-heap and the small-part clean-up live in plain arrays and
-typed containers, so a run costs microseconds per merge instead of a Python object's overhead.
-The union concavities are memoized in a `Memo` that outlives one run, since `parts=K` runs the
-merging once per tau it tries and most pairs recur.
+clusters, their adjacency, the lazy min-heap and the small-part clean-up live in plain arrays, so
+a run costs well under a microsecond per heap entry. The union concavities are memoized in a memo
+(a tuple of arrays, `new_memo`) that outlives one run, since `parts=K` runs the merging once per
+tau it tries and most pairs recur.
+
+Why the loops look the way they do: numba reference-counts arrays, and its pruning of those
+counts fails in a function that takes arrays and leaves a loop early (break, or return from
+inside it), or where an array variable is reassigned inside a loop; each such call or iteration
+then pays two atomic operations per array (measured: they were over half of a run's time). So
+the kernels below exit loops through their conditions, size their arrays once per run (the heap
+and the neighbour lists are compacted in place when full, pair rows are reused), and a run that
+finds the memo full stops and is redone on a regrown memo (`merge_run`).
 """
 
 from __future__ import annotations
@@ -12,8 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.typed import Dict, List
+from numba import njit
 
 NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex
 FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
@@ -163,29 +170,35 @@ def convex_hull(p, rel_eps):
 
 
 @njit(cache=True)
-def max_depth(pts, eq, limit):
-    """max_i min_j -(eq[j, :3] . pts[i] + eq[j, 3]) (>= 0); stops early once it exceeds `limit`."""
-    best = 0.0
+def depth_from(pts, lo, hi, eq, limit, best, hint):
+    """`max_depth` continued over the points pts[lo:hi] from the running maximum `best` (<= limit),
+    with facet `hint` first (the one that bounded the previous point): (best, hint) after them;
+    stops early once best exceeds `limit`."""
     n_f = eq.shape[0]
-    hint = 0
-    for i in range(pts.shape[0]):
+    done = False
+    i = lo
+    while i < hi and not done:
         x, y, z = pts[i, 0], pts[i, 1], pts[i, 2]
         # The facet that bounded the previous point first: neighbouring points share facets.
         m = -(eq[hint, 0] * x + eq[hint, 1] * y + eq[hint, 2] * z + eq[hint, 3])
-        if m <= best:
-            continue
-        for j in range(n_f):
+        j = 0
+        while j < n_f and m > best:  # the point's depth, or any value <= best once it is known to be
             d = -(eq[j, 0] * x + eq[j, 1] * y + eq[j, 2] * z + eq[j, 3])
             if d < m:
                 m = d
                 hint = j
-                if m <= best:
-                    break
+            j += 1
         if m > best:
             best = m
-            if best > limit:
-                return best
-    return best
+            done = best > limit
+        i += 1
+    return best, hint
+
+
+@njit(cache=True)
+def max_depth(pts, eq, limit):
+    """max_i min_j -(eq[j, :3] . pts[i] + eq[j, 3]) (>= 0); stops early once it exceeds `limit`."""
+    return depth_from(pts, 0, pts.shape[0], eq, limit, 0.0, 0)[0]
 
 
 @njit(cache=True)
@@ -229,6 +242,90 @@ def union_labels(n, f0, f1):
     return label
 
 
+
+# ----------------------------------------------------------------------------------------------
+# Hash buckets and the memo of union concavities
+
+
+@njit(cache=True)
+def _hash(k0, k1):
+    """Bucket hash (int64 >= 0) of the uint64 pair (k0, k1)."""
+    h = k0 * np.uint64(0x9E3779B97F4A7C15) ^ k1 * np.uint64(0xC2B2AE3D27D4EB4F)
+    h ^= h >> np.uint64(29)
+    return np.int64(h >> np.uint64(1))
+
+
+@njit(cache=True)
+def bucket(table, keys, k0, k1):
+    """Open addressing: the bucket of `table` (power-of-two size, -1 = empty) that holds the row
+    of `keys` equal to (k0, k1) (uint64), else the empty bucket where that row goes."""
+    mask = table.shape[0] - 1
+    b = _hash(k0, k1) & mask
+    s = table[b]
+    while s >= 0 and not (keys[s, 0] == k0 and keys[s, 1] == k1):  # linear probing
+        b = (b + 1) & mask
+        s = table[b]
+    return b
+
+
+@njit(cache=True)
+def _pow2(n):
+    """The smallest power of two >= n."""
+    t = 1
+    while t < n:
+        t *= 2
+    return t
+
+
+@njit(cache=True)
+def new_memo(n_faces):
+    """Empty memo of union concavities for a mesh of n_faces faces, kept across the runs of one
+    segment() call. A tuple of arrays (it crosses the numba border in about a microsecond, where
+    typed containers cost tens): table (T,) hash buckets of slot ids (-1 empty); keys (S, 2)
+    uint64, the pair of cluster keys of each slot, smaller first; conc (S,); exact (S,) bool; hull
+    (S, 2) start and count of the slot's hull points in pool (P, 3), which also holds the units'
+    hulls; used (2,): slots and pool rows in use.
+
+    Cluster keys are sums of random 64-bit face keys: the key of a union is the sum of its parts'
+    keys, and two distinct face sets collide with probability ~2^-64."""
+    n = 8 * n_faces + 64
+    return (np.full(_pow2(2 * n), -1, dtype=np.int64), np.zeros((n, 2), dtype=np.uint64), np.zeros(n),
+            np.zeros(n, dtype=np.bool_), np.zeros((n, 2), dtype=np.int64), np.empty((32 * n_faces + 256, 3)),
+            np.zeros(2, dtype=np.int64))
+
+
+@njit(cache=True)
+def _rows(a, n, keep):
+    """A new array of n rows (n >= keep) holding a copy of a's first `keep` rows."""
+    out = np.empty((n,) + a.shape[1:], a.dtype)
+    out[:keep] = a[:keep]
+    return out
+
+
+@njit(cache=True)
+def _memo_grown(memo):
+    """The memo with twice the room (slots, buckets and pool rows), entries kept."""
+    table, keys, conc, exact, hull, pool, used = memo
+    n, p = used[0], used[1]
+    s = 2 * keys.shape[0]
+    keys, conc, exact, hull = _rows(keys, s, n), _rows(conc, s, n), _rows(exact, s, n), _rows(hull, s, n)
+    table = np.full(2 * table.shape[0], -1, dtype=np.int64)
+    for q in range(n):
+        table[bucket(table, keys, keys[q, 0], keys[q, 1])] = q
+    return table, keys, conc, exact, hull, _rows(pool, 2 * pool.shape[0], p), used
+
+
+@njit(cache=True)
+def _pool_add(pool, used, src, rows):
+    """Append the rows `rows` of src (n, 3) to the pool (the caller checked the room): their
+    (start, count) in the pool."""
+    start = used[1]
+    for q in range(rows.shape[0]):
+        pool[start + q] = src[rows[q]]
+    used[1] = start + rows.shape[0]
+    return start, rows.shape[0]
+
+
 # ----------------------------------------------------------------------------------------------
 # Clusters
 
@@ -252,78 +349,110 @@ def make_cluster(faces, mesh_faces, vertices, samples, diag):
     return pts, vpts[hv], denoise(max_depth(pts, eq, np.inf), diag)
 
 
-POINTS = types.float64[:, ::1]  # element type of the typed lists of point arrays
-IDS = types.int64[::1]
-PAIR = types.UniTuple(types.int64, 2)
-KEYPAIR = types.UniTuple(types.uint64, 2)
-
-
 @njit(cache=True)
-def new_memo():
-    """Empty memo of union concavities, kept across the runs of one segment() call: slot index
-    by the pair of cluster keys, then concavity, exact?, hull points per slot.
-
-    Cluster keys are sums of random 64-bit face keys: the key of a union is the sum of its parts'
-    keys, and two distinct face sets collide with probability ~2^-64. (Made here, not in Python:
-    numba builds typed containers faster.)"""
-    return (Dict.empty(key_type=KEYPAIR, value_type=types.int64), List.empty_list(types.float64),
-            List.empty_list(types.boolean), List.empty_list(POINTS))
-
-
-@njit(cache=True)
-def make_units(faces, start, mesh_faces, vertices, samples, diag):
-    """`make_cluster` of each face list faces[start[u]:start[u + 1]]: (points, hulls, concavities)."""
+def make_units(faces, start, mesh_faces, vertices, samples, diag, memo):
+    """`make_cluster` of each face list faces[start[u]:start[u + 1]]: (points (N, 3) of all units,
+    point start of each unit (U + 1,), hull (U, 2): start and count in the memo's pool,
+    concavity (U,), memo). The units' hull points are appended to the memo's pool."""
     n = start.shape[0] - 1
-    pts = List.empty_list(POINTS)
-    hulls = List.empty_list(POINTS)
+    parts = []
+    pstart = np.zeros(n + 1, dtype=np.int64)
+    hull = np.empty((n, 2), dtype=np.int64)
     conc = np.empty(n)
+    rows = 0
     for u in range(n):
         p, h, c = make_cluster(faces[start[u]:start[u + 1]], mesh_faces, vertices, samples, diag)
-        pts.append(p)
-        hulls.append(h)
+        parts.append((p, h))
+        pstart[u + 1] = pstart[u] + p.shape[0]
+        rows += h.shape[0]
         conc[u] = c
-    return pts, hulls, conc
+    table, keys, mconc, exact, mhull, pool, used = memo
+    if used[1] + rows > pool.shape[0]:
+        pool = _rows(pool, 2 * (used[1] + rows), used[1])
+    pts = np.empty((pstart[n], 3))
+    for u in range(n):
+        p, h = parts[u]
+        pts[pstart[u]:pstart[u + 1]] = p
+        hull[u, 0], hull[u, 1] = _pool_add(pool, used, h, np.arange(h.shape[0]))
+    return pts, pstart, hull, conc, (table, keys, mconc, exact, mhull, pool, used)
 
 
 @njit(cache=True)
-def _union_conc(a, b, limit, key, conc, n_faces, hulls, pts, diag, m_index, m_conc, m_exact, m_hull):
-    """Memo slot of (absolute concavity of a u b, exact?, hull points of a u b); inexact values
-    exceed the limit (the depth kernel stopped early, or a part alone exceeds it)."""
+def _depth_units(pts, pstart, uhead, unxt, a, b, eq, limit):
+    """`max_depth` of the points of cluster a then b: their units' points, in list order."""
+    best, hint = 0.0, 0
+    u = uhead[a]
+    in_b = False
+    while u >= 0:
+        best, hint = depth_from(pts, pstart[u], pstart[u + 1], eq, limit, best, hint)
+        u = unxt[u] if best <= limit else -1
+        if u < 0 and not in_b and best <= limit:
+            u, in_b = uhead[b], True
+    return best
+
+
+@njit(cache=True)
+def _memo_lookup(a, b, limit, key, table, keys, m_conc, m_exact):
+    """(memo slot of a u b, its bucket): the slot is -1 when the pair is new or its value is
+    inexact but not above the limit (then `_union_eval` fills that bucket). The probing of
+    `bucket` is written out and the slot's values are read unconditionally: see the module
+    docstring."""
     ka, kb = key[a], key[b]
-    mk = (ka, kb) if ka < kb else (kb, ka)
-    slot = -1
-    if mk in m_index:
-        slot = m_index[mk]
-        if m_exact[slot] or m_conc[slot] > limit:
-            return slot
+    k0, k1 = (ka, kb) if ka < kb else (kb, ka)
+    mask = table.shape[0] - 1
+    bk = _hash(k0, k1) & mask
+    slot = table[bk]
+    while slot >= 0 and not (keys[slot, 0] == k0 and keys[slot, 1] == k1):
+        bk = (bk + 1) & mask
+        slot = table[bk]
+    q = max(slot, 0)
+    decided = m_exact[q] or m_conc[q] > limit
+    return (slot if decided else -1), bk
+
+
+@njit(cache=True)
+def _union_eval(a, b, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, pts, pstart,
+                table, keys, m_conc, m_exact, m_hull, pool, used):
+    """Evaluate a u b into memo bucket bk (see `_memo_lookup`): its slot, or -1 when the memo has
+    no room left. Sets (absolute concavity of a u b, exact?, hull points of a u b); inexact values
+    exceed the limit (the depth kernel stopped early, or a part alone exceeds it) and are
+    recomputed when a later run has a larger limit."""
+    slot = table[bk]
+    na, nb = hull[a, 1], hull[b, 1]
+    if slot < 0 and (used[0] + 1 > keys.shape[0] or 2 * (used[0] + 1) > table.shape[0]):
+        return -1
+    if used[1] + na + nb > pool.shape[0]:
+        return -1
+    if slot < 0:
+        slot = used[0]
+        used[0] += 1
+        table[bk] = slot
+        ka, kb = key[a], key[b]
+        keys[slot, 0], keys[slot, 1] = (ka, kb) if ka < kb else (kb, ka)
     floor = max(conc[a], conc[b])
-    ha, hb = hulls[a], hulls[b]
     if floor > limit:  # decided without a hull (most candidate pairs once clusters grow)
-        value, exact, hull = floor, False, np.empty((0, 3))
-    elif n_faces[a] + n_faces[b] == 2:
+        m_conc[slot], m_exact[slot] = floor, False
+        m_hull[slot, 0], m_hull[slot, 1] = used[1], 0
+        return slot
+    both = np.empty((na + nb, 3))  # the hull of a u b is the hull of the two hulls' points
+    both[:na] = pool[hull[a, 0]:hull[a, 0] + na]
+    both[na:] = pool[hull[b, 0]:hull[b, 0] + nb]
+    keep = np.arange(na + nb)
+    if n_faces[a] + n_faces[b] == 2:
         # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
-        value, exact, hull = 0.0, True, np.concatenate((ha, hb))
+        value, exact = 0.0, True
     else:
-        both = np.concatenate((ha, hb))
         hv, eq = convex_hull(both, FLAT_EPS)
         if eq.shape[0] == 0:
-            value, exact, hull = 0.0, True, both
+            value, exact = 0.0, True
         else:
             # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding
             # noise must not count as exceeding it
             stop = max(limit, NOISE * diag)
-            d = max_depth(np.concatenate((pts[a], pts[b])), eq, stop)
-            value, exact, hull = denoise(d, diag), d <= stop, both[hv]
-    if slot < 0:
-        slot = len(m_conc)
-        m_index[mk] = slot
-        m_conc.append(value)
-        m_exact.append(exact)
-        m_hull.append(hull)
-    else:
-        m_conc[slot] = value
-        m_exact[slot] = exact
-        m_hull[slot] = hull
+            d = _depth_units(pts, pstart, uhead, unxt, a, b, eq, stop)
+            value, exact, keep = denoise(d, diag), d <= stop, hv
+    m_conc[slot], m_exact[slot] = value, exact
+    m_hull[slot, 0], m_hull[slot, 1] = _pool_add(pool, used, both, keep)
     return slot
 
 
@@ -334,6 +463,12 @@ def _cost(a, b, shared, conc_len, c, area, perim, w_compact, w_seam, scale):
     compact = pe * pe / (4 * math.pi * ar) - 1.0 if ar > 0 else 0.0
     seam = conc_len / shared if shared > 0 else 0.0
     return c + (w_compact * compact + w_seam * seam) * scale
+
+
+# ----------------------------------------------------------------------------------------------
+# The lazy min-heap: parallel arrays (cost, exact?, i, j), ordered lexicographically. The order
+# is total (equal entries are interchangeable), so the pop sequence does not depend on the
+# arrangement of the arrays: compaction may rebuild it.
 
 
 @njit(cache=True)
@@ -349,96 +484,161 @@ def _less(c1, e1, i1, j1, c2, e2, i2, j2):
 
 
 @njit(cache=True)
+def _swap(hc, he, hi, hj, a, b):
+    hc[a], hc[b] = hc[b], hc[a]
+    he[a], he[b] = he[b], he[a]
+    hi[a], hi[b] = hi[b], hi[a]
+    hj[a], hj[b] = hj[b], hj[a]
+
+
+@njit(cache=True)
 def _heap_push(hc, he, hi, hj, size, c, e, i, j):
+    """Add (c, e, i, j) to the heap of `size` entries (room checked by the caller): the new size."""
     k = size
     hc[k], he[k], hi[k], hj[k] = c, e, i, j
-    while k > 0:
-        p = (k - 1) >> 1
-        if not _less(hc[k], he[k], hi[k], hj[k], hc[p], he[p], hi[p], hj[p]):
-            break
-        hc[p], hc[k] = hc[k], hc[p]
-        he[p], he[k] = he[k], he[p]
-        hi[p], hi[k] = hi[k], hi[p]
-        hj[p], hj[k] = hj[k], hj[p]
-        k = p
+    while k > 0 and _less(hc[k], he[k], hi[k], hj[k], hc[(k - 1) >> 1], he[(k - 1) >> 1], hi[(k - 1) >> 1], hj[(k - 1) >> 1]):
+        _swap(hc, he, hi, hj, k, (k - 1) >> 1)
+        k = (k - 1) >> 1
     return size + 1
 
 
 @njit(cache=True)
-def _heap_pop(hc, he, hi, hj, size):
-    """Remove the smallest entry (moved to index `size - 1` for the caller to read)."""
-    size -= 1
-    hc[0], hc[size] = hc[size], hc[0]
-    he[0], he[size] = he[size], he[0]
-    hi[0], hi[size] = hi[size], hi[0]
-    hj[0], hj[size] = hj[size], hj[0]
-    k = 0
-    while True:
+def _sift_down(hc, he, hi, hj, size, k):
+    """Restore the heap order below entry k."""
+    settled = False
+    while not settled:
         c = 2 * k + 1
-        if c >= size:
-            break
         if c + 1 < size and _less(hc[c + 1], he[c + 1], hi[c + 1], hj[c + 1], hc[c], he[c], hi[c], hj[c]):
             c += 1
-        if not _less(hc[c], he[c], hi[c], hj[c], hc[k], he[k], hi[k], hj[k]):
-            break
-        hc[c], hc[k] = hc[k], hc[c]
-        he[c], he[k] = he[k], he[c]
-        hi[c], hi[k] = hi[k], hi[c]
-        hj[c], hj[k] = hj[k], hj[c]
-        k = c
+        if c < size and _less(hc[c], he[c], hi[c], hj[c], hc[k], he[k], hi[k], hj[k]):
+            _swap(hc, he, hi, hj, c, k)
+            k = c
+        else:
+            settled = True
+
+
+@njit(cache=True)
+def _heap_pop(hc, he, hi, hj, size):
+    """Remove the smallest entry (moved to index `size - 1` for the caller to read): the new size.
+    (The sift-down is written out here, not called: see the module docstring.)"""
+    size -= 1
+    _swap(hc, he, hi, hj, 0, size)
+    k = 0
+    settled = False
+    while not settled:
+        c = 2 * k + 1
+        if c + 1 < size and _less(hc[c + 1], he[c + 1], hi[c + 1], hj[c + 1], hc[c], he[c], hi[c], hj[c]):
+            c += 1
+        if c < size and _less(hc[c], he[c], hi[c], hj[c], hc[k], he[k], hi[k], hj[k]):
+            _swap(hc, he, hi, hj, c, k)
+            k = c
+        else:
+            settled = True
     return size
 
 
 @njit(cache=True)
-def _reserve(hc, he, hi, hj, need):
-    """The heap arrays with room for `need` entries (doubled when short)."""
-    if need <= hc.shape[0]:
-        return hc, he, hi, hj
-    n = max(need, 2 * hc.shape[0])
-    c2, e2, i2, j2 = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
-    m = hc.shape[0]
-    c2[:m], e2[:m], i2[:m], j2[:m] = hc, he, hi, hj
-    return c2, e2, i2, j2
-
-
-@njit(cache=True)
-def _slot(nb_id, nb_slot, i, j):
-    ids = nb_id[i]
-    for t in range(ids.shape[0]):
-        if ids[t] == j:
-            return nb_slot[i][t]
-    return -1
-
-
-@njit(cache=True)
-def _relink(nb_id, nb_slot, k, i, j, c, s):
-    """Neighbour k of the clusters i, j now merged into c: drop i and j from k's neighbours and
-    append c (slot s) unless it is there already (then it keeps its place, as a dict would)."""
-    ids, sl = nb_id[k], nb_slot[k]
-    for t in range(ids.shape[0]):
-        if ids[t] == c:
-            return
-    n = 1
-    for t in range(ids.shape[0]):
-        if ids[t] != i and ids[t] != j:
+def _heap_compact(hc, he, hi, hj, size, alive):
+    """Drop the entries of merged clusters and rebuild the heap in place: the new size. Each pair
+    of live clusters has at most one entry, so at most as many remain as there are live pairs."""
+    n = 0
+    for k in range(size):
+        if alive[hi[k]] and alive[hj[k]]:
+            hc[n], he[n], hi[n], hj[n] = hc[k], he[k], hi[k], hj[k]
             n += 1
-    new_ids = np.empty(n, np.int64)
-    new_sl = np.empty(n, np.int64)
-    q = 0
-    for t in range(ids.shape[0]):
-        if ids[t] != i and ids[t] != j:
-            new_ids[q], new_sl[q] = ids[t], sl[t]
-            q += 1
-    new_ids[q], new_sl[q] = c, s
-    nb_id[k] = new_ids
-    nb_slot[k] = new_sl
+    for k in range(n // 2 - 1, -1, -1):
+        _sift_down(hc, he, hi, hj, n, k)
+    return n
+
+
+# ----------------------------------------------------------------------------------------------
+# Cluster adjacency. Cluster c's neighbours are nb_id[nb_lo[c]:nb_lo[c] + nb_n[c]], with the row
+# of their pair (shared length, concave-weighted length) in nb_slot. The lists of new clusters go
+# to the end of the pool (nb_lo ascends with the cluster id); the number of live entries only
+# decreases as clusters merge, so compacting the pool always makes room.
 
 
 @njit(cache=True)
-def _merge(i, j, c, u, key, conc, area, perim, n_faces, alive, head, tail, nxt, pts, hulls,
-           nb_id, nb_slot, shared, conc_len, m_conc, m_hull):
-    """Merge clusters i and j (memo slot u holds their exact union) into the new cluster c."""
-    s_ij = _slot(nb_id, nb_slot, i, j)
+def _adjacency(label, n, ef0, ef1, edge_len, conc_w, cap):
+    """Adjacency of the n clusters of the face labels: one pair row per adjacent pair, in order of
+    its first inner edge, with the shared length and concave-weighted length summed in edge order;
+    each cluster lists its neighbours in pair order. (nb_lo, nb_n (cap,), nb_id, nb_slot (room for
+    twice the entries), shared, conc_len, number of pairs)."""
+    m = ef0.shape[0]
+    pair = np.empty((m, 2), dtype=np.uint64)
+    shared = np.empty(m + 1)
+    conc_len = np.empty(m + 1)
+    table = np.full(_pow2(2 * m + 2), -1, dtype=np.int64)
+    deg = np.zeros(cap, dtype=np.int64)
+    n_pairs = 0
+    for e in range(m):
+        x, y = label[ef0[e]], label[ef1[e]]
+        if x != y:
+            k0, k1 = np.uint64(min(x, y)), np.uint64(max(x, y))
+            bk = bucket(table, pair, k0, k1)
+            ps = table[bk]
+            if ps >= 0:
+                shared[ps] += edge_len[e]
+                conc_len[ps] += conc_w[e]
+            else:
+                ps = n_pairs
+                n_pairs += 1
+                table[bk] = ps
+                pair[ps, 0], pair[ps, 1] = k0, k1
+                shared[ps] = edge_len[e]
+                conc_len[ps] = conc_w[e]
+                deg[x] += 1
+                deg[y] += 1
+    nb_lo = np.zeros(cap, dtype=np.int64)
+    for c in range(1, n):
+        nb_lo[c] = nb_lo[c - 1] + deg[c - 1]
+    nb_n = np.zeros(cap, dtype=np.int64)
+    nb_id = np.empty(4 * n_pairs + 16, dtype=np.int64)
+    nb_slot = np.empty(4 * n_pairs + 16, dtype=np.int64)
+    for s in range(n_pairs):
+        x, y = np.int64(pair[s, 0]), np.int64(pair[s, 1])
+        nb_id[nb_lo[x] + nb_n[x]], nb_slot[nb_lo[x] + nb_n[x]] = y, s
+        nb_n[x] += 1
+        nb_id[nb_lo[y] + nb_n[y]], nb_slot[nb_lo[y] + nb_n[y]] = x, s
+        nb_n[y] += 1
+    return nb_lo, nb_n, nb_id, nb_slot, shared, conc_len, n_pairs
+
+
+@njit(cache=True)
+def _nb_compact(nb_lo, nb_n, nb_id, nb_slot, alive, n):
+    """Move the lists of the live clusters among 0..n-1 to the front of the pool: its new end."""
+    end = 0
+    for c in range(n):
+        if alive[c]:
+            lo = nb_lo[c]
+            nb_lo[c] = end
+            for t in range(nb_n[c]):
+                nb_id[end + t], nb_slot[end + t] = nb_id[lo + t], nb_slot[lo + t]
+            end += nb_n[c]
+    return end
+
+
+@njit(cache=True)
+def _slot(nb_lo, nb_n, nb_id, nb_slot, i, j):
+    """Pair row of the adjacent clusters i and j (-1 when not adjacent)."""
+    t, end = nb_lo[i], nb_lo[i] + nb_n[i]
+    while t < end and nb_id[t] != j:
+        t += 1
+    s = nb_slot[min(t, nb_slot.shape[0] - 1)]  # read on every path: see the module docstring
+    return s if t < end else -1
+
+
+@njit(cache=True)
+def _merge(i, j, c, u, key, conc, area, perim, n_faces, alive, hull, uhead, utail, unxt,
+           nb_lo, nb_n, nb_id, nb_slot, nb_end, shared, conc_len, m_conc, m_hull):
+    """Merge clusters i and j (memo slot u holds their exact union) into the new cluster c, whose
+    neighbour list goes to nb_end of the pool (the caller made room for deg i + deg j): the new
+    end. The pair of c and a neighbour k takes over the row of the first of (i, k), (j, k).
+    (The list searches are written out, not called: see the module docstring.)"""
+    t = nb_lo[i]
+    while nb_id[t] != j:  # the pair row of i and j
+        t += 1
+    s_ij = nb_slot[t]
     alive[i] = False
     alive[j] = False
     alive[c] = True
@@ -447,55 +647,73 @@ def _merge(i, j, c, u, key, conc, area, perim, n_faces, alive, head, tail, nxt, 
     area[c] = area[i] + area[j]
     perim[c] = perim[i] + perim[j] - 2 * shared[s_ij]
     n_faces[c] = n_faces[i] + n_faces[j]
-    head[c] = head[i]
-    nxt[tail[i]] = head[j]
-    tail[c] = tail[j]
-    pts.append(np.concatenate((pts[i], pts[j])))
-    hulls.append(m_hull[u])
-    new_ids = np.empty(nb_id[i].shape[0] + nb_id[j].shape[0], np.int64)
-    new_sl = np.empty_like(new_ids)
-    n_new = 0
+    hull[c, 0], hull[c, 1] = m_hull[u, 0], m_hull[u, 1]
+    uhead[c] = uhead[i]  # the units of c: i's, then j's (the order of the points' concatenation)
+    unxt[utail[i]] = uhead[j]
+    utail[c] = utail[j]
+    lo, n_new = nb_end, 0
     for src in (i, j):
-        ids, sl = nb_id[src], nb_slot[src]
-        for t in range(ids.shape[0]):
-            k = ids[t]
-            if k == i or k == j:
-                continue
-            pos = -1
-            for q in range(n_new):
-                if new_ids[q] == k:
-                    pos = q
-                    break
-            if pos < 0:  # the shared lengths of a u b with k: a's, plus b's below
-                s2 = len(shared)
-                shared.append(shared[sl[t]])
-                conc_len.append(conc_len[sl[t]])
-                new_ids[n_new], new_sl[n_new] = k, s2
-                n_new += 1
-            else:
-                s2 = new_sl[pos]
-                shared[s2] += shared[sl[t]]
-                conc_len[s2] += conc_len[sl[t]]
-            _relink(nb_id, nb_slot, k, i, j, c, s2)
-    nb_id.append(new_ids[:n_new].copy())
-    nb_slot.append(new_sl[:n_new].copy())
+        for t in range(nb_lo[src], nb_lo[src] + nb_n[src]):
+            k = nb_id[t]
+            if k != i and k != j:
+                pos = lo
+                while pos < lo + n_new and nb_id[pos] != k:
+                    pos += 1
+                if pos == lo + n_new:  # first seen: the shared lengths of a u b with k are a's...
+                    s2 = nb_slot[t]
+                    nb_id[pos], nb_slot[pos] = k, s2
+                    n_new += 1
+                else:  # ...plus b's
+                    s2 = nb_slot[pos]
+                    shared[s2] += shared[nb_slot[t]]
+                    conc_len[s2] += conc_len[nb_slot[t]]
+                # k's list: drop i and j, append c unless it is there already (then it keeps its
+                # place, as a dict would); in place, since k lists i or j
+                k_lo, k_end = nb_lo[k], nb_lo[k] + nb_n[k]
+                q = k_lo
+                while q < k_end and nb_id[q] != c:
+                    q += 1
+                if q == k_end:
+                    q = k_lo
+                    for r in range(k_lo, k_end):
+                        if nb_id[r] != i and nb_id[r] != j:
+                            nb_id[q], nb_slot[q] = nb_id[r], nb_slot[r]
+                            q += 1
+                    nb_id[q], nb_slot[q] = c, s2
+                    nb_n[k] = q + 1 - k_lo
+    nb_lo[c], nb_n[c] = lo, n_new
+    return lo + n_new
 
 
 @njit(cache=True)
-def merge_run(limit, scale, target, w_compact, w_seam, min_faces, diag,
-              seed_unit, sub_lo, sub_hi, unit_faces, unit_start, unit_pts, unit_hull, unit_conc,
-              unit_area, unit_perim, face_key, ef0, ef1, edge_len, conc_w,
-              m_index, m_conc, m_exact, m_hull):
-    """One merging run of segment._run: the cluster id of every face at the end (ids ascend in
-    creation order, as the parts of the Python version did).
+def merge_run(limit, scale, target, w_compact, w_seam, min_faces, diag, units, graph, memo):
+    """One merging run of segment._run: (cluster id of every face at the end, number of clusters,
+    memo). Ids ascend in creation order, as the parts of the Python version did.
 
-    Units are candidate initial clusters with precomputed points, hull, concavity, area and
-    perimeter; unit u holds faces unit_faces[unit_start[u]:unit_start[u + 1]]. Seed s is unit
-    seed_unit[s]; when its concavity exceeds the limit its polygons, units sub_lo[s]:sub_hi[s],
-    start instead. ef0, ef1, edge_len, conc_w: the inner edges' faces, lengths and concave-weighted
-    lengths. target < 0: merge while admissible pairs remain; else stop at `target` clusters.
-    m_*: the Memo's containers (read and extended).
+    units: (seed_unit, sub_lo, sub_hi, unit_faces, unit_start, unit_pts, unit_pstart, unit_hull,
+    unit_conc, unit_area, unit_perim), the candidate initial clusters with precomputed points, hull
+    (start, count in the memo's pool), concavity, area and perimeter; unit u holds the faces
+    unit_faces[unit_start[u]:unit_start[u + 1]] and the points unit_pts[unit_pstart[u]:unit_pstart[u + 1]].
+    Seed s is unit seed_unit[s]; when its concavity exceeds the limit its polygons, units
+    sub_lo[s]:sub_hi[s], start instead. graph: (face_key, ef0, ef1, edge_len, conc_w), the random
+    face keys and the inner edges' faces, lengths and concave-weighted lengths. target < 0: merge
+    while admissible pairs remain; else stop at `target` clusters. memo: `new_memo`'s tuple, read
+    and extended; returned, since a full memo is regrown (and the run redone: its entries so far
+    are valid, so the redone run takes the same steps).
     """
+    label, n, ok = _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units, graph, memo)
+    while not ok:
+        memo = _memo_grown(memo)
+        label, n, ok = _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units, graph, memo)
+    return label, n, memo
+
+
+@njit(cache=True)
+def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units, graph, memo):
+    """`merge_run` on the memo as it is: (labels, number of clusters, False when the memo filled up)."""
+    seed_unit, sub_lo, sub_hi, unit_faces, unit_start, unit_pts, unit_pstart, unit_hull, unit_conc, unit_area, unit_perim = units
+    face_key, ef0, ef1, edge_len, conc_w = graph
+    table, keys, m_conc, m_exact, m_hull, pool, used = memo
     n_fm = face_key.shape[0]
     cap = 2 * n_fm + 1
     key = np.zeros(cap, dtype=np.uint64)
@@ -504,148 +722,123 @@ def merge_run(limit, scale, target, w_compact, w_seam, min_faces, diag,
     perim = np.zeros(cap)
     n_faces = np.zeros(cap, dtype=np.int64)
     alive = np.zeros(cap, dtype=np.bool_)
-    head = np.full(cap, -1, dtype=np.int64)  # each cluster's faces: a linked list head -> nxt -> tail
-    tail = np.full(cap, -1, dtype=np.int64)
-    nxt = np.full(n_fm, -1, dtype=np.int64)
+    hull = np.zeros((cap, 2), dtype=np.int64)
+    # each cluster's units: a linked list uhead -> unxt -> utail (its points are theirs, in order)
+    uhead = np.full(cap, -1, dtype=np.int64)
+    utail = np.full(cap, -1, dtype=np.int64)
+    unxt = np.full(unit_conc.shape[0], -1, dtype=np.int64)
     label = np.empty(n_fm, dtype=np.int64)
-    pts = List.empty_list(POINTS)
-    hulls = List.empty_list(POINTS)
     nid = 0
     for s in range(seed_unit.shape[0]):
         u0 = seed_unit[s]
         lo, hi = (sub_lo[s], sub_hi[s]) if unit_conc[u0] > limit else (u0, u0 + 1)
         for u in range(lo, hi):
             k = np.uint64(0)
-            prev = -1
             for t in range(unit_start[u], unit_start[u + 1]):
                 f = unit_faces[t]
                 k += face_key[f]
                 label[f] = nid
-                if prev < 0:
-                    head[nid] = f
-                else:
-                    nxt[prev] = f
-                prev = f
-            tail[nid] = prev
             key[nid] = k
             conc[nid] = unit_conc[u]
             area[nid] = unit_area[u]
             perim[nid] = unit_perim[u]
             n_faces[nid] = unit_start[u + 1] - unit_start[u]
             alive[nid] = True
-            pts.append(unit_pts[u])
-            hulls.append(unit_hull[u])
+            hull[nid, 0], hull[nid, 1] = unit_hull[u, 0], unit_hull[u, 1]
+            uhead[nid] = u
+            utail[nid] = u
             nid += 1
-    # adjacency: one slot of (shared length, concave-weighted length) per adjacent pair, summed
-    # over the shared edges in edge order; each cluster lists its neighbours in first-seen order
-    pair_slot = Dict.empty(key_type=PAIR, value_type=types.int64)
-    shared = List.empty_list(types.float64)
-    conc_len = List.empty_list(types.float64)
-    first = np.empty((ef0.shape[0], 2), dtype=np.int64)
-    deg = np.zeros(nid, dtype=np.int64)
-    for e in range(ef0.shape[0]):
-        x, y = label[ef0[e]], label[ef1[e]]
-        if x == y:
-            continue
-        pk = (x, y) if x < y else (y, x)
-        if pk in pair_slot:
-            ps = pair_slot[pk]
-            shared[ps] += edge_len[e]
-            conc_len[ps] += conc_w[e]
-        else:
-            ps = len(shared)
-            pair_slot[pk] = ps
-            shared.append(edge_len[e])
-            conc_len.append(conc_w[e])
-            first[ps, 0], first[ps, 1] = x, y
-            deg[x] += 1
-            deg[y] += 1
-    nb_id = List.empty_list(IDS)
-    nb_slot = List.empty_list(IDS)
-    for c in range(nid):
-        nb_id.append(np.empty(deg[c], np.int64))
-        nb_slot.append(np.empty(deg[c], np.int64))
-    fill = np.zeros(nid, dtype=np.int64)
-    for s in range(len(shared)):
-        for x, y in ((first[s, 0], first[s, 1]), (first[s, 1], first[s, 0])):
-            nb_id[x][fill[x]] = y
-            nb_slot[x][fill[x]] = s
-            fill[x] += 1
+    nb_lo, nb_n, nb_id, nb_slot, shared, conc_len, n_pairs = _adjacency(label, nid, ef0, ef1, edge_len, conc_w, cap)
+    nb_end = 2 * n_pairs
 
     # the lazy heap: (cost, exact?, i, j); a lazy key is a lower bound of the cost (a u b is at
-    # least as concave as a or b); the union's hull is computed when the pair reaches the top
+    # least as concave as a or b); the union's hull is computed when the pair reaches the top.
+    # Each live pair has at most one entry, so compacting makes room for any cluster's pushes.
+    h_cap = 2 * n_pairs + 64
+    hc, he, hi_, hj = np.empty(h_cap), np.empty(h_cap, np.int64), np.empty(h_cap, np.int64), np.empty(h_cap, np.int64)
     size = 0
-    hc, he, hi_, hj = np.empty(64), np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
     for i in range(nid):
-        hc, he, hi_, hj = _reserve(hc, he, hi_, hj, size + nb_id[i].shape[0])
-        for t in range(nb_id[i].shape[0]):
-            j = nb_id[i][t]
-            if i < j:
-                floor = max(conc[i], conc[j])
-                if floor <= limit:
-                    s = nb_slot[i][t]
-                    cst = _cost(i, j, shared[s], conc_len[s], floor, area, perim, w_compact, w_seam, scale)
-                    size = _heap_push(hc, he, hi_, hj, size, cst, 0, i, j)
+        for t in range(nb_lo[i], nb_lo[i] + nb_n[i]):
+            j = nb_id[t]
+            if i < j and max(conc[i], conc[j]) <= limit:
+                s = nb_slot[t]
+                cst = _cost(i, j, shared[s], conc_len[s], max(conc[i], conc[j]), area, perim, w_compact, w_seam, scale)
+                size = _heap_push(hc, he, hi_, hj, size, cst, 0, i, j)
     stop = 1 if target < 0 else target
     n_alive = nid
-    while size > 0 and n_alive > stop:
+    ok = True
+    while size > 0 and n_alive > stop and ok:
         size = _heap_pop(hc, he, hi_, hj, size)
         ex, i, j = he[size], hi_[size], hj[size]
-        if not alive[i] or not alive[j]:  # a merged cluster: its ids are never reused
-            continue
-        if ex == 0:
-            u = _union_conc(i, j, limit, key, conc, n_faces, hulls, pts, diag, m_index, m_conc, m_exact, m_hull)
-            if m_exact[u] and m_conc[u] <= limit:  # (the memo may hold exact values from runs with a larger tau)
-                s = _slot(nb_id, nb_slot, i, j)
-                cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
-                hc, he, hi_, hj = _reserve(hc, he, hi_, hj, size + 1)
-                size = _heap_push(hc, he, hi_, hj, size, cst, 1, i, j)
-            continue
-        u = _union_conc(i, j, limit, key, conc, n_faces, hulls, pts, diag, m_index, m_conc, m_exact, m_hull)
-        c = nid
-        nid += 1
-        _merge(i, j, c, u, key, conc, area, perim, n_faces, alive, head, tail, nxt, pts, hulls,
-               nb_id, nb_slot, shared, conc_len, m_conc, m_hull)
-        n_alive -= 1
-        hc, he, hi_, hj = _reserve(hc, he, hi_, hj, size + nb_id[c].shape[0])
-        for t in range(nb_id[c].shape[0]):
-            j = nb_id[c][t]
-            floor = max(conc[c], conc[j])
-            if floor <= limit:
-                s = nb_slot[c][t]
-                cst = _cost(c, j, shared[s], conc_len[s], floor, area, perim, w_compact, w_seam, scale)
-                size = _heap_push(hc, he, hi_, hj, size, cst, 0, c, j)
+        if alive[i] and alive[j]:  # else a merged cluster: its ids are never reused
+            u, bk = _memo_lookup(i, j, limit, key, table, keys, m_conc, m_exact)
+            if u < 0:
+                u = _union_eval(i, j, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, unit_pts, unit_pstart,
+                                table, keys, m_conc, m_exact, m_hull, pool, used)
+                ok = u >= 0
+            if not ok:
+                pass
+            elif ex == 0:
+                if m_exact[u] and m_conc[u] <= limit:  # (the memo may hold exact values from runs with a larger tau)
+                    s = _slot(nb_lo, nb_n, nb_id, nb_slot, i, j)
+                    cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
+                    if size + 1 > h_cap:
+                        size = _heap_compact(hc, he, hi_, hj, size, alive)
+                    size = _heap_push(hc, he, hi_, hj, size, cst, 1, i, j)
+            else:
+                c = nid
+                nid += 1
+                if nb_end + nb_n[i] + nb_n[j] > nb_id.shape[0]:
+                    nb_end = _nb_compact(nb_lo, nb_n, nb_id, nb_slot, alive, c)
+                nb_end = _merge(i, j, c, u, key, conc, area, perim, n_faces, alive, hull, uhead, utail, unxt,
+                                nb_lo, nb_n, nb_id, nb_slot, nb_end, shared, conc_len, m_conc, m_hull)
+                n_alive -= 1
+                if size + nb_n[c] > h_cap:
+                    size = _heap_compact(hc, he, hi_, hj, size, alive)
+                for t in range(nb_lo[c], nb_lo[c] + nb_n[c]):
+                    j = nb_id[t]
+                    if max(conc[c], conc[j]) <= limit:
+                        s = nb_slot[t]
+                        cst = _cost(c, j, shared[s], conc_len[s], max(conc[c], conc[j]), area, perim, w_compact, w_seam, scale)
+                        size = _heap_push(hc, he, hi_, hj, size, cst, 0, c, j)
 
     # small parts join the neighbour with the cheapest admissible merge
     changed = True
-    while changed and n_alive > stop:
+    while changed and n_alive > stop and ok:
         changed = False
         ids = np.flatnonzero(alive[:nid])
-        for t in np.argsort(n_faces[ids], kind="mergesort"):  # stable: ties in id order
-            i = ids[t]
-            if n_faces[i] >= min_faces:
-                continue
-            best_j, best_c = -1, 0.0
-            for q in range(nb_id[i].shape[0]):
-                j = nb_id[i][q]
-                u = _union_conc(i, j, limit, key, conc, n_faces, hulls, pts, diag, m_index, m_conc, m_exact, m_hull)
-                if m_exact[u] and m_conc[u] <= limit:
-                    s = nb_slot[i][q]
-                    cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
-                    if best_j < 0 or cst < best_c:
-                        best_j, best_c = j, cst
-            if best_j >= 0:
-                u = _union_conc(i, best_j, limit, key, conc, n_faces, hulls, pts, diag, m_index, m_conc, m_exact, m_hull)
-                _merge(i, best_j, nid, u, key, conc, area, perim, n_faces, alive, head, tail, nxt, pts, hulls,
-                       nb_id, nb_slot, shared, conc_len, m_conc, m_hull)
-                nid += 1
-                n_alive -= 1
-                changed = True
-                break
+        order = np.argsort(n_faces[ids], kind="mergesort")  # stable: ties in id order
+        t = 0
+        while t < order.shape[0] and not changed and ok:
+            i = ids[order[t]]
+            t += 1
+            if n_faces[i] < min_faces:
+                best_j, best_c, best_u = -1, 0.0, -1
+                for q in range(nb_lo[i], nb_lo[i] + nb_n[i]):
+                    j = nb_id[q]
+                    u, bk = _memo_lookup(i, j, limit, key, table, keys, m_conc, m_exact)
+                    if u < 0 and ok:
+                        u = _union_eval(i, j, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, unit_pts,
+                                        unit_pstart, table, keys, m_conc, m_exact, m_hull, pool, used)
+                        ok = u >= 0
+                    if ok and m_exact[u] and m_conc[u] <= limit:
+                        s = nb_slot[q]
+                        cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
+                        if best_j < 0 or cst < best_c:
+                            best_j, best_c, best_u = j, cst, u
+                if ok and best_j >= 0:
+                    if nb_end + nb_n[i] + nb_n[best_j] > nb_id.shape[0]:
+                        nb_end = _nb_compact(nb_lo, nb_n, nb_id, nb_slot, alive, nid)
+                    nb_end = _merge(i, best_j, nid, best_u, key, conc, area, perim, n_faces, alive, hull, uhead,
+                                    utail, unxt, nb_lo, nb_n, nb_id, nb_slot, nb_end, shared, conc_len, m_conc, m_hull)
+                    nid += 1
+                    n_alive -= 1
+                    changed = True
     for c in range(nid):
         if alive[c]:
-            f = head[c]
-            while f >= 0:
-                label[f] = c
-                f = nxt[f]
-    return label
+            u = uhead[c]
+            while u >= 0:
+                for t in range(unit_start[u], unit_start[u + 1]):
+                    label[unit_faces[t]] = c
+                u = unxt[u]
+    return label, n_alive, ok

@@ -182,7 +182,7 @@ class _Merger:
         self.inner_conc = self.inner_len * np.clip(-mesh.fold_angles[inner], 0.0, None) / (math.pi / 2)
         # random 64-bit face keys: a cluster's key is their sum (see _segment_kernels.new_memo)
         self.face_key = np.random.default_rng(0x5E6).integers(0, 2**64 - 1, mesh.n_faces, dtype=np.uint64, endpoint=True)
-        self.memo = new_memo()
+        self.memo = new_memo(mesh.n_faces)
         self.polygon = _polygon_groups(mesh)
         self._units: dict[bytes, tuple] = {}
 
@@ -204,10 +204,11 @@ class _Merger:
         mesh = self.mesh
         start = np.concatenate([[0], np.cumsum([len(g) for g in groups])]).astype(np.int64)
         faces = np.concatenate(groups).astype(np.int64)
-        pts, hulls, conc = make_units(faces, start, mesh.faces, mesh.vertices, self.samples, self.diag)
+        pts, pstart, hulls, conc, self.memo = make_units(faces, start, mesh.faces, mesh.vertices, self.samples, self.diag, self.memo)
         area = np.add.reduceat(self.areas[faces], start[:-1])
         perim = np.add.reduceat(self.face_perim[faces], start[:-1])
-        got = (np.array(seed_unit), np.array(sub_lo), np.array(sub_hi), faces, start, pts, hulls, conc, area, perim)
+        got = (np.array(seed_unit, dtype=np.int64), np.array(sub_lo, dtype=np.int64), np.array(sub_hi, dtype=np.int64),
+               faces, start, pts, pstart, hulls, conc, area, perim)
         self._units[seed_labels.tobytes()] = got
         return got
 
@@ -251,9 +252,9 @@ def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
     The merging itself is `_segment_kernels.merge_run`."""
     limit = tau * m.diag * (1 - 1e-9)  # margin: the final re-measure may differ by rounding
     scale = limit if limit > 0 and math.isfinite(limit) else m.diag
-    label = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
-                      int(min_faces), m.diag, *m.units(seed_labels), m.face_key, m.ef0, m.ef1,
-                      m.inner_len, m.inner_conc, *m.memo)
+    units = m.units(seed_labels)
+    label, n, m.memo = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
+                                 int(min_faces), m.diag, units, (m.face_key, m.ef0, m.ef1, m.inner_len, m.inner_conc), m.memo)
     return _groups(label)
 
 
