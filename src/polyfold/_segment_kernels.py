@@ -24,6 +24,7 @@ from numba import njit
 
 NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex
 FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
+DENSE_EDGES = 1024  # convex_hull counts facets per directed edge in an n x n table up to this many points
 
 
 # ----------------------------------------------------------------------------------------------
@@ -52,8 +53,10 @@ def convex_hull(p, rel_eps):
     Incremental: start from a tetrahedron of extreme points; each point above some facets (by more
     than the tolerance) replaces them by a cone over their boundary edges, the horizon. The
     horizon is found as the edges whose reverse lies on a kept facet, so the surface stays closed
-    even if rounding makes the visible region odd. O(n * facets^2): meant for the small sets of
-    the merging (tens of points), where qhull's per-call set-up (about 45 us) is most of its cost.
+    even if rounding makes the visible region odd: a count of the live facets on each directed
+    edge answers that per edge (up to DENSE_EDGES points; beyond, a scan of the facets does).
+    Meant for the small sets of the merging (tens of points), where qhull's per-call set-up
+    (about 45 us) is most of its cost.
     """
     n = p.shape[0]
     empty_v = np.empty(0, dtype=np.int64)
@@ -104,6 +107,13 @@ def convex_hull(p, rel_eps):
         nf += 1
     vis = np.zeros(cap, dtype=np.bool_)
     hor = np.empty((cap, 2), dtype=np.int64)
+    dense = n <= DENSE_EDGES
+    on = np.zeros(n * n if dense else 1, dtype=np.int32)  # live facets having directed edge a->b (a * n + b)
+    seen = np.zeros_like(on)  # the same among the facets visible from the current point
+    if dense:
+        for f in range(nf):
+            for k in range(3):
+                on[F[f, k] * n + F[f, (k + 1) % 3]] += 1
     for i in range(n):
         if i == i0 or i == i1 or i == i2 or i == i3:
             continue
@@ -117,30 +127,50 @@ def convex_hull(p, rel_eps):
         if not any_vis:
             continue
         # horizon: directed edges of visible faces whose reverse lies on an alive invisible face
+        if dense:
+            for f in range(nf):
+                if vis[f]:
+                    for k in range(3):
+                        seen[F[f, k] * n + F[f, (k + 1) % 3]] += 1
         nh = 0
         for f in range(nf):
             if not vis[f]:
                 continue
             for k in range(3):
                 a, b = F[f, k], F[f, (k + 1) % 3]
-                for g in range(nf):
-                    if not alive[g] or vis[g]:
-                        continue
-                    if (F[g, 0] == b and F[g, 1] == a) or (F[g, 1] == b and F[g, 2] == a) or (F[g, 2] == b and F[g, 0] == a):
-                        hor[nh, 0], hor[nh, 1] = a, b
-                        nh += 1
-                        break
+                if dense:
+                    found = on[b * n + a] > seen[b * n + a]
+                else:
+                    found = False
+                    for g in range(nf):
+                        if not alive[g] or vis[g]:
+                            continue
+                        if (F[g, 0] == b and F[g, 1] == a) or (F[g, 1] == b and F[g, 2] == a) or (F[g, 2] == b and F[g, 0] == a):
+                            found = True
+                            break
+                if found:
+                    hor[nh, 0], hor[nh, 1] = a, b
+                    nh += 1
         if nf + nh > cap:  # cannot happen for a consistent hull; be safe
             return empty_v, empty_e
         for f in range(nf):
             if vis[f]:
                 alive[f] = False
+                if dense:
+                    for k in range(3):
+                        e = F[f, k] * n + F[f, (k + 1) % 3]
+                        seen[e] -= 1
+                        on[e] -= 1
         for h in range(nh):
             a, b = hor[h, 0], hor[h, 1]
             F[nf, 0], F[nf, 1], F[nf, 2] = a, b, i
             nx, ny, nz, d, ln = _plane(p, a, b, i)
             E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
             alive[nf] = ln > 0
+            if dense and ln > 0:
+                on[a * n + b] += 1
+                on[b * n + i] += 1
+                on[i * n + a] += 1
             nf += 1
         # compact when the dead faces dominate, so the loops stay short
         if nf > 2 * n + 64:
