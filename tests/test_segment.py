@@ -212,6 +212,35 @@ def test_hull_kernel_matches_qhull(models_dir):
     assert len(convex_hull(flat, FLAT_EPS)[1]) == 0
 
 
+def test_merging_arrays_match_their_numpy_definitions(models_dir):
+    """The per-mesh arrays of the merging come from numba kernels; bit for bit they are the numpy
+    expressions they replaced (samples, areas, perimeters, inner edges and their concave weights),
+    so costs and concavities do not move."""
+    import math
+
+    import polyfold.segment as S
+    from polyfold.mesh import face_areas
+
+    for name in ("periscope-28", "bunny-128", "paper-parts/horse/part-6", "open/tube-132"):
+        mesh = load_mesh(models_dir / f"{name}.obj").mesh
+        m = S._Merger(mesh, 0)
+        topo = mesh.topology
+        tri = mesh.vertices[mesh.faces]
+        r = np.random.default_rng(0).random((mesh.n_faces, 3, 2))
+        flip = r.sum(axis=2) > 1
+        r[flip] = 1 - r[flip]
+        samples = tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
+        edge_len = np.linalg.norm(mesh.vertices[topo.edges[:, 1]] - mesh.vertices[topo.edges[:, 0]], axis=1)
+        inner = np.flatnonzero(topo.interior)
+        conc_w = edge_len[inner] * np.clip(-mesh.fold_angles[inner], 0.0, None) / (math.pi / 2)
+        assert m.samples.tobytes() == samples.tobytes()
+        assert m.areas.tobytes() == face_areas(mesh.vertices, mesh.faces).tobytes()
+        assert m.face_perim.tobytes() == edge_len[topo.face_edges].sum(axis=1).tobytes()
+        assert m.inner_len.tobytes() == edge_len[inner].tobytes() and m.inner_conc.tobytes() == conc_w.tobytes()
+        assert np.array_equal(m.ef0, topo.edge_faces[inner, 0]) and np.array_equal(m.ef1, topo.edge_faces[inner, 1])
+        assert (conc_w > 0).any() and (conc_w == 0).any()
+
+
 def test_a_full_memo_is_regrown_and_the_run_redone(models_dir, monkeypatch):
     """merge_run stops when the memo of union concavities fills up and redoes the run on a larger
     one: starting from a memo with room for 2 unions gives the same segmentations."""
