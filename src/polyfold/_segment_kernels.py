@@ -110,7 +110,9 @@ def convex_hull(p, rel_eps):
         alive[nf] = True
         nf += 1
     vis = np.zeros(cap, dtype=np.bool_)
+    vl = np.empty(cap, dtype=np.int64)
     hor = np.empty((cap, 2), dtype=np.int64)
+    n_live, nf_kept = nf, nf
     dense = n <= DENSE_EDGES
     on = np.zeros(n * n if dense else 1, dtype=np.int32)  # live facets having directed edge a->b (a * n + b)
     seen = np.zeros_like(on)  # the same among the facets visible from the current point
@@ -122,26 +124,23 @@ def convex_hull(p, rel_eps):
         if i == i0 or i == i1 or i == i2 or i == i3:
             continue
         x, y, z = p[i, 0], p[i, 1], p[i, 2]
-        any_vis = False
+        nv = 0  # the visible faces, in face order, are vl[:nv]
         for f in range(nf):
-            vis[f] = False
-            if alive[f] and E[f, 0] * x + E[f, 1] * y + E[f, 2] * z + E[f, 3] > eps:
-                vis[f] = True
-                any_vis = True
-        if not any_vis:
+            vis[f] = alive[f] and E[f, 0] * x + E[f, 1] * y + E[f, 2] * z + E[f, 3] > eps
+            if vis[f]:
+                vl[nv] = f
+                nv += 1
+        if nv == 0:
             continue
         # horizon: directed edges of visible faces whose reverse lies on an alive invisible face
         if dense:
-            for f in range(nf):
-                if vis[f]:
-                    for k in range(3):
-                        seen[F[f, k] * n + F[f, (k + 1) % 3]] += 1
+            for q in range(nv):
+                for k in range(3):
+                    seen[F[vl[q], k] * n + F[vl[q], (k + 1) % 3]] += 1
         nh = 0
-        for f in range(nf):
-            if not vis[f]:
-                continue
+        for q in range(nv):
             for k in range(3):
-                a, b = F[f, k], F[f, (k + 1) % 3]
+                a, b = F[vl[q], k], F[vl[q], (k + 1) % 3]
                 if dense:
                     found = on[b * n + a] > seen[b * n + a]
                 else:
@@ -155,29 +154,35 @@ def convex_hull(p, rel_eps):
                 if found:
                     hor[nh, 0], hor[nh, 1] = a, b
                     nh += 1
-        if nf + nh > cap:  # cannot happen for a consistent hull; be safe
+        if nf_kept + nh > cap:  # cannot happen for a consistent hull; be safe
             return empty_v, empty_e
-        for f in range(nf):
-            if vis[f]:
-                alive[f] = False
-                if dense:
-                    for k in range(3):
-                        e = F[f, k] * n + F[f, (k + 1) % 3]
-                        seen[e] -= 1
-                        on[e] -= 1
+        for q in range(nv):
+            alive[vl[q]] = False
+            n_live -= 1
+            if dense:
+                for k in range(3):
+                    e = F[vl[q], k] * n + F[vl[q], (k + 1) % 3]
+                    seen[e] -= 1
+                    on[e] -= 1
         for h in range(nh):
             a, b = hor[h, 0], hor[h, 1]
             F[nf, 0], F[nf, 1], F[nf, 2] = a, b, i
             nx, ny, nz, d, ln = _plane(p, a, b, i)
             E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
             alive[nf] = ln > 0
+            n_live += ln > 0
             if dense and ln > 0:
                 on[a * n + b] += 1
                 on[b * n + i] += 1
                 on[i * n + a] += 1
             nf += 1
-        # compact when the dead faces dominate, so the loops stay short
-        if nf > 2 * n + 64:
+        # Compact (keeping the order) once the dead faces are half, so the loops stay short. The
+        # safety check above counts the faces as compacting at 2n + 64 kept them (nf_kept), the
+        # rule this kernel had, so it decides as before.
+        nf_kept += nh
+        if nf_kept > 2 * n + 64:
+            nf_kept = n_live
+        if nf > 2 * n_live:
             m = 0
             for f in range(nf):
                 if alive[f]:
