@@ -49,6 +49,13 @@ def _plane(p, a, b, c):
 
 
 @njit(cache=True)
+def _copy_row(dst, i, src, j):
+    """dst[i] = src[j] for rows of 3, element by element: a row assignment goes through numpy's
+    setitem (a view, a broadcast) and costs ~100 ns, this a few."""
+    dst[i, 0], dst[i, 1], dst[i, 2] = src[j, 0], src[j, 1], src[j, 2]
+
+
+@njit(cache=True)
 def convex_hull(p, rel_eps):
     """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)).
 
@@ -186,8 +193,8 @@ def convex_hull(p, rel_eps):
             m = 0
             for f in range(nf):
                 if alive[f]:
-                    F[m] = F[f]
-                    E[m] = E[f]
+                    F[m, 0], F[m, 1], F[m, 2] = F[f, 0], F[f, 1], F[f, 2]
+                    E[m, 0], E[m, 1], E[m, 2], E[m, 3] = E[f, 0], E[f, 1], E[f, 2], E[f, 3]
                     alive[m] = True
                     m += 1
             nf = m
@@ -203,7 +210,7 @@ def convex_hull(p, rel_eps):
     m = 0
     for f in range(nf):
         if alive[f]:
-            eq[m] = E[f]
+            eq[m, 0], eq[m, 1], eq[m, 2], eq[m, 3] = E[f, 0], E[f, 1], E[f, 2], E[f, 3]
             m += 1
     return np.flatnonzero(used), eq
 
@@ -507,10 +514,11 @@ def part_concavities(faces, fstart, verts, vstart, vertices, samples, diag, max_
             k = samples.shape[1]
             pts = np.empty((nv + k * nf, 3))
             for q in range(nv):
-                pts[q] = vertices[verts[vstart[p] + q]]
+                _copy_row(pts, q, vertices, verts[vstart[p] + q])
             for t in range(nf):
                 for s in range(k):
-                    pts[nv + k * t + s] = samples[faces[fstart[p] + t], s]
+                    for x in range(3):
+                        pts[nv + k * t + s, x] = samples[faces[fstart[p] + t], s, x]
             hv, eq = convex_hull(pts[:nv].copy(), FLAT_EPS)
             if eq.shape[0] > 0 and diag > 0:
                 out[p] = denoise(max_depth(pts, eq, np.inf), diag) / diag
@@ -595,7 +603,7 @@ def _pool_add(pool, used, src, rows):
     (start, count) in the pool."""
     start = used[1]
     for q in range(rows.shape[0]):
-        pool[start + q] = src[rows[q]]
+        _copy_row(pool, start + q, src, rows[q])
     used[1] = start + rows.shape[0]
     return start, rows.shape[0]
 
@@ -612,10 +620,11 @@ def make_cluster(faces, mesh_faces, vertices, samples, diag):
     n_v = verts.shape[0]
     pts = np.empty((n_v + 3 * faces.shape[0], 3))
     for k in range(n_v):
-        pts[k] = vertices[verts[k]]
+        _copy_row(pts, k, vertices, verts[k])
     for k in range(faces.shape[0]):
         for s in range(3):
-            pts[n_v + 3 * k + s] = samples[faces[k], s]
+            for x in range(3):
+                pts[n_v + 3 * k + s, x] = samples[faces[k], s, x]
     vpts = pts[:n_v].copy()
     hv, eq = convex_hull(vpts, FLAT_EPS)
     if eq.shape[0] == 0:
@@ -646,14 +655,16 @@ def make_units(faces, start, mesh_faces, vertices, samples, diag, memo):
             a, b, c = min(a, b, c), a + b + c - min(a, b, c) - max(a, b, c), max(a, b, c)
             hull[u, 0], hull[u, 1] = used[1], 3
             for q, v in enumerate((a, b, c)):
-                pts[w + q] = vertices[v]
-                pool[used[1] + q] = vertices[v]
-                pts[w + 3 + q] = samples[f, q]
+                _copy_row(pts, w + q, vertices, v)
+                _copy_row(pool, used[1] + q, vertices, v)
+                for x in range(3):
+                    pts[w + 3 + q, x] = samples[f, q, x]
             used[1] += 3
             pstart[u + 1] = w + 6
         else:
             p, h, cu = make_cluster(faces[start[u]:start[u + 1]], mesh_faces, vertices, samples, diag)
-            pts[w:w + p.shape[0]] = p
+            for q in range(p.shape[0]):
+                _copy_row(pts, w + q, p, q)
             pstart[u + 1] = w + p.shape[0]
             hull[u, 0], hull[u, 1] = _pool_add(pool, used, h, np.arange(h.shape[0]))
             conc[u] = cu
@@ -718,8 +729,10 @@ def _union_eval(a, b, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, pt
         m_hull[slot, 0], m_hull[slot, 1] = used[1], 0
         return slot
     both = np.empty((na + nb, 3))  # the hull of a u b is the hull of the two hulls' points
-    both[:na] = pool[hull[a, 0]:hull[a, 0] + na]
-    both[na:] = pool[hull[b, 0]:hull[b, 0] + nb]
+    for q in range(na):
+        _copy_row(both, q, pool, hull[a, 0] + q)
+    for q in range(nb):
+        _copy_row(both, na + q, pool, hull[b, 0] + q)
     keep = np.arange(na + nb)
     if n_faces[a] + n_faces[b] == 2:
         # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
