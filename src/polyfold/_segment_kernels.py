@@ -74,14 +74,25 @@ def convex_hull(p, rel_eps):
     empty_e = np.empty((0, 4))
     if n < 4:
         return empty_v, empty_e
+    # (min, max and argmin written out, NaN first as numpy has them: the calls cost more here)
     ext = 0.0
     for k in range(3):
-        ext = max(ext, p[:, k].max() - p[:, k].min())
+        lo, hi = p[0, k], p[0, k]
+        for i in range(1, n):
+            v = p[i, k]
+            if lo == lo and (v < lo or v != v):
+                lo = v
+            if hi == hi and (v > hi or v != v):
+                hi = v
+        ext = max(ext, hi - lo)
     eps = rel_eps * ext
     if ext <= 0:
         return empty_v, empty_e
     # initial tetrahedron: extreme x, farthest from it, farthest from their line, farthest from the plane
-    i0 = np.argmin(p[:, 0])
+    i0 = 0
+    for i in range(1, n):
+        if p[i0, 0] == p[i0, 0] and (p[i, 0] < p[i0, 0] or p[i, 0] != p[i, 0]):
+            i0 = i
     i1, best = -1, -1.0
     for i in range(n):
         d = (p[i, 0] - p[i0, 0]) ** 2 + (p[i, 1] - p[i0, 1]) ** 2 + (p[i, 2] - p[i0, 2]) ** 2
@@ -122,7 +133,7 @@ def convex_hull(p, rel_eps):
     n_live, nf_kept = nf, nf
     dense = n <= DENSE_EDGES
     on = np.zeros(n * n if dense else 1, dtype=np.int32)  # live facets having directed edge a->b (a * n + b)
-    seen = np.zeros_like(on)  # the same among the facets visible from the current point
+    seen = np.zeros(on.shape[0], dtype=np.int32)  # the same among the facets visible from the current point
     if dense:
         for f in range(nf):
             for k in range(3):
@@ -212,39 +223,54 @@ def convex_hull(p, rel_eps):
         if alive[f]:
             eq[m, 0], eq[m, 1], eq[m, 2], eq[m, 3] = E[f, 0], E[f, 1], E[f, 2], E[f, 3]
             m += 1
-    return np.flatnonzero(used), eq
+    nv = 0
+    for i in range(n):
+        nv += used[i]
+    verts = np.empty(nv, dtype=np.int64)
+    nv = 0
+    for i in range(n):
+        if used[i]:
+            verts[nv] = i
+            nv += 1
+    return verts, eq
 
 
 @njit(cache=True)
-def depth_from(pts, lo, hi, eq, limit, best, hint):
-    """`max_depth` continued over the points pts[lo:hi] from the running maximum `best` (<= limit),
-    with facet `hint` first (the one that bounded the previous point): (best, hint) after them;
-    stops early once best exceeds `limit`."""
+def depth_chain(pts, pstart, unxt, ua, ub, eq, limit):
+    """max over points of min over facets of -(eq[j, :3] . x + eq[j, 3]) (>= 0) for the points of
+    the ranges pts[pstart[u]:pstart[u + 1]] of the units u of the chain from ua, then of the chain
+    from ub (-1: none) along unxt, in that order; stops early (a lower bound) once it exceeds
+    `limit`. The loops are written out, not split into calls: see the module docstring."""
     n_f = eq.shape[0]
-    done = False
-    i = lo
-    while i < hi and not done:
-        x, y, z = pts[i, 0], pts[i, 1], pts[i, 2]
-        # The facet that bounded the previous point first: neighbouring points share facets.
-        m = -(eq[hint, 0] * x + eq[hint, 1] * y + eq[hint, 2] * z + eq[hint, 3])
-        j = 0
-        while j < n_f and m > best:  # the point's depth, or any value <= best once it is known to be
-            d = -(eq[j, 0] * x + eq[j, 1] * y + eq[j, 2] * z + eq[j, 3])
-            if d < m:
-                m = d
-                hint = j
-            j += 1
-        if m > best:
-            best = m
-            done = best > limit
-        i += 1
-    return best, hint
+    best, hint, done = 0.0, 0, False
+    u, in_b = ua, False
+    while u >= 0:
+        i = pstart[u]
+        while i < pstart[u + 1] and not done:
+            x, y, z = pts[i, 0], pts[i, 1], pts[i, 2]
+            # The facet that bounded the previous point first: neighbouring points share facets.
+            m = -(eq[hint, 0] * x + eq[hint, 1] * y + eq[hint, 2] * z + eq[hint, 3])
+            j = 0
+            while j < n_f and m > best:  # the point's depth, or any value <= best once it is known to be
+                d = -(eq[j, 0] * x + eq[j, 1] * y + eq[j, 2] * z + eq[j, 3])
+                if d < m:
+                    m = d
+                    hint = j
+                j += 1
+            if m > best:
+                best = m
+                done = best > limit
+            i += 1
+        u = unxt[u] if not done else -1
+        if u < 0 and not in_b and not done:
+            u, in_b = ub, True
+    return best
 
 
 @njit(cache=True)
 def max_depth(pts, eq, limit):
     """max_i min_j -(eq[j, :3] . pts[i] + eq[j, 3]) (>= 0); stops early once it exceeds `limit`."""
-    return depth_from(pts, 0, pts.shape[0], eq, limit, 0.0, 0)[0]
+    return depth_chain(pts, np.array([0, pts.shape[0]]), np.array([-1]), 0, -1, eq, limit)
 
 
 @njit(cache=True)
@@ -672,20 +698,6 @@ def make_units(faces, start, mesh_faces, vertices, samples, diag, memo):
 
 
 @njit(cache=True)
-def _depth_units(pts, pstart, uhead, unxt, a, b, eq, limit):
-    """`max_depth` of the points of cluster a then b: their units' points, in list order."""
-    best, hint = 0.0, 0
-    u = uhead[a]
-    in_b = False
-    while u >= 0:
-        best, hint = depth_from(pts, pstart[u], pstart[u + 1], eq, limit, best, hint)
-        u = unxt[u] if best <= limit else -1
-        if u < 0 and not in_b and best <= limit:
-            u, in_b = uhead[b], True
-    return best
-
-
-@njit(cache=True)
 def _memo_lookup(a, b, limit, key, table, keys, m_conc, m_exact):
     """(memo slot of a u b, its bucket): the slot is -1 when the pair is new or its value is
     inexact but not above the limit (then `_union_eval` fills that bucket). The probing of
@@ -702,6 +714,24 @@ def _memo_lookup(a, b, limit, key, table, keys, m_conc, m_exact):
     q = max(slot, 0)
     decided = m_exact[q] or m_conc[q] > limit
     return (slot if decided else -1), bk
+
+
+@njit(cache=True)
+def _union_value(both, two_triangles, pts, pstart, unxt, ua, ub, limit, diag):
+    """(absolute concavity, exact?, rows of `both` on the hull) of a union whose hull is the hull
+    of the points `both` and whose points are the unit chains from ua then ub (see depth_chain);
+    inexact values exceed the limit (the depth kernel stopped early)."""
+    keep = np.arange(both.shape[0])
+    if two_triangles:  # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
+        return 0.0, True, keep
+    hv, eq = convex_hull(both, FLAT_EPS)
+    if eq.shape[0] == 0:
+        return 0.0, True, keep
+    # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding noise must
+    # not count as exceeding it
+    stop = max(limit, NOISE * diag)
+    d = depth_chain(pts, pstart, unxt, ua, ub, eq, stop)
+    return denoise(d, diag), d <= stop, hv
 
 
 @njit(cache=True)
@@ -733,22 +763,14 @@ def _union_eval(a, b, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, pt
         _copy_row(both, q, pool, hull[a, 0] + q)
     for q in range(nb):
         _copy_row(both, na + q, pool, hull[b, 0] + q)
-    keep = np.arange(na + nb)
-    if n_faces[a] + n_faces[b] == 2:
-        # two triangles sharing an edge are two faces of their tetrahedron: concavity 0
-        value, exact = 0.0, True
-    else:
-        hv, eq = convex_hull(both, FLAT_EPS)
-        if eq.shape[0] == 0:
-            value, exact = 0.0, True
-        else:
-            # the kernel stops early (a lower bound) once the depth exceeds the limit; rounding
-            # noise must not count as exceeding it
-            stop = max(limit, NOISE * diag)
-            d = _depth_units(pts, pstart, uhead, unxt, a, b, eq, stop)
-            value, exact, keep = denoise(d, diag), d <= stop, hv
+    value, exact, keep = _union_value(both, n_faces[a] + n_faces[b] == 2, pts, pstart, unxt, uhead[a], uhead[b],
+                                      limit, diag)
     m_conc[slot], m_exact[slot] = value, exact
-    m_hull[slot, 0], m_hull[slot, 1] = _pool_add(pool, used, both, keep)
+    start = used[1]
+    for q in range(keep.shape[0]):
+        _copy_row(pool, start + q, both, keep[q])
+    used[1] = start + keep.shape[0]
+    m_hull[slot, 0], m_hull[slot, 1] = start, keep.shape[0]
     return slot
 
 
