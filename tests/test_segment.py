@@ -260,6 +260,8 @@ def test_a_full_memo_is_regrown_and_the_run_redone(models_dir, monkeypatch):
     def recording_run(*args):
         label, n, memo = merge_run(*args)
         slots.append(len(memo[1]))
+        # each part of the memo grows only when short: at most 4x what is in use
+        assert len(memo[1]) <= 4 * memo[6][0] + 8 and len(memo[5]) <= 4 * memo[6][1] + 8
         return label, n, memo
 
     monkeypatch.setattr(S, "new_memo", tiny_memo)

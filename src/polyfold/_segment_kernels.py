@@ -612,15 +612,21 @@ def _rows(a, n, keep):
 
 @njit(cache=True)
 def _memo_grown(memo):
-    """The memo with twice the room (slots, buckets and pool rows), entries kept."""
+    """The memo with twice the room in each of its parts (slots, buckets, pool rows) that is more
+    than half full, entries kept. A run stops for want of a slot, of buckets under half load, or
+    of pool rows for a union's hull (fewer than the rows in use), so something always grows."""
     table, keys, conc, exact, hull, pool, used = memo
     n, p = used[0], used[1]
-    s = 2 * keys.shape[0]
-    keys, conc, exact, hull = _rows(keys, s, n), _rows(conc, s, n), _rows(exact, s, n), _rows(hull, s, n)
-    table = np.full(2 * table.shape[0], -1, dtype=np.int64)
-    for q in range(n):
-        table[bucket(table, keys, keys[q, 0], keys[q, 1])] = q
-    return table, keys, conc, exact, hull, _rows(pool, 2 * pool.shape[0], p), used
+    if 2 * (n + 1) > keys.shape[0]:
+        s = 2 * keys.shape[0]
+        keys, conc, exact, hull = _rows(keys, s, n), _rows(conc, s, n), _rows(exact, s, n), _rows(hull, s, n)
+    if 4 * (n + 1) > table.shape[0]:
+        table = np.full(2 * table.shape[0], -1, dtype=np.int64)
+        for q in range(n):
+            table[bucket(table, keys, keys[q, 0], keys[q, 1])] = q
+    if 2 * p > pool.shape[0]:
+        pool = _rows(pool, 2 * pool.shape[0], p)
+    return table, keys, conc, exact, hull, pool, used
 
 
 @njit(cache=True)
@@ -1094,16 +1100,14 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
                 u = _union_eval(i, j, bk, limit, diag, key, conc, n_faces, hull, uhead, unxt, unit_pts, unit_pstart,
                                 table, keys, m_conc, m_exact, m_hull, pool, used)
                 ok = u >= 0
-            if not ok:
-                pass
-            elif ex == 0:
+            if ok and ex == 0:
                 if m_exact[u] and m_conc[u] <= limit:  # (the memo may hold exact values from runs with a larger tau)
                     s = _slot(nb_lo, nb_n, nb_id, nb_slot, i, j)
                     cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
                     if size + 1 > h_cap:
                         size = _heap_compact(hc, he, hi_, hj, size, alive)
                     size = _heap_push(hc, he, hi_, hj, size, cst, 1, i, j)
-            else:
+            elif ok:
                 c = nid
                 nid += 1
                 if nb_end + nb_n[i] + nb_n[j] > nb_id.shape[0]:

@@ -22,7 +22,9 @@ Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 A merging run is one numba kernel (`_segment_kernels.merge_run`). The union concavity uses cached
 hulls (the hull of A u B is the hull of the two hulls' vertices) and a depth kernel with early
 exit; evaluations are memoized across runs, so `parts=K` (a bisection on tau) re-uses most of
-them. Merging adjacent connected clusters keeps every part edge-connected.
+them. Merging adjacent connected clusters keeps every part edge-connected. The per-mesh arrays,
+the candidate initial clusters and the parts' tables and concavities are numba kernels as well,
+one call each per segment() (per-face or per-part numpy calls cost more than the merging).
 
 Concavity (`part_concavity`): max over the part's vertices plus SAMPLES_PER_FACE seeded surface
 samples per face of the depth below the part's own convex hull (hull of its vertices), divided by
