@@ -212,6 +212,66 @@ def test_hull_kernel_matches_qhull(models_dir):
     assert len(convex_hull(flat, FLAT_EPS)[1]) == 0
 
 
+def test_merging_arrays_match_their_numpy_definitions(models_dir):
+    """The per-mesh arrays of the merging come from numba kernels; bit for bit they are the numpy
+    expressions they replaced (samples, areas, perimeters, inner edges and their concave weights),
+    so costs and concavities do not move."""
+    import math
+
+    import polyfold.segment as S
+    from polyfold.mesh import face_areas
+
+    for name in ("periscope-28", "bunny-128", "paper-parts/horse/part-6", "open/tube-132"):
+        mesh = load_mesh(models_dir / f"{name}.obj").mesh
+        m = S._Merger(mesh, 0)
+        topo = mesh.topology
+        tri = mesh.vertices[mesh.faces]
+        r = np.random.default_rng(0).random((mesh.n_faces, 3, 2))
+        flip = r.sum(axis=2) > 1
+        r[flip] = 1 - r[flip]
+        samples = tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
+        edge_len = np.linalg.norm(mesh.vertices[topo.edges[:, 1]] - mesh.vertices[topo.edges[:, 0]], axis=1)
+        inner = np.flatnonzero(topo.interior)
+        conc_w = edge_len[inner] * np.clip(-mesh.fold_angles[inner], 0.0, None) / (math.pi / 2)
+        assert m.samples.tobytes() == samples.tobytes()
+        assert m.areas.tobytes() == face_areas(mesh.vertices, mesh.faces).tobytes()
+        assert m.face_perim.tobytes() == edge_len[topo.face_edges].sum(axis=1).tobytes()
+        assert m.inner_len.tobytes() == edge_len[inner].tobytes() and m.inner_conc.tobytes() == conc_w.tobytes()
+        assert np.array_equal(m.ef0, topo.edge_faces[inner, 0]) and np.array_equal(m.ef1, topo.edge_faces[inner, 1])
+        assert (conc_w > 0).any() and (conc_w == 0).any()
+
+
+def test_a_full_memo_is_regrown_and_the_run_redone(models_dir, monkeypatch):
+    """merge_run stops when the memo of union concavities fills up and redoes the run on a larger
+    one: starting from a memo with room for 2 unions gives the same segmentations."""
+    import polyfold.segment as S
+
+    meshes = [load_mesh(models_dir / f"{n}.obj").mesh for n in ("periscope2-44", "bunny-128")]
+    cases = [(m, k) for m in meshes for k in (None, 2, 5)]
+    want = [segment(m) if k is None else segment(m, parts=k) for m, k in cases]
+
+    def tiny_memo(n_faces):
+        return (np.full(4, -1, dtype=np.int64), np.zeros((2, 2), dtype=np.uint64), np.zeros(2),
+                np.zeros(2, dtype=bool), np.zeros((2, 2), dtype=np.int64), np.empty((4, 3)), np.zeros(2, dtype=np.int64))
+
+    slots = []
+    merge_run = S.merge_run
+
+    def recording_run(*args):
+        label, n, memo = merge_run(*args)
+        slots.append(len(memo[1]))
+        # each part of the memo grows only when short: at most 4x what is in use
+        assert len(memo[1]) <= 4 * memo[6][0] + 8 and len(memo[5]) <= 4 * memo[6][1] + 8
+        return label, n, memo
+
+    monkeypatch.setattr(S, "new_memo", tiny_memo)
+    monkeypatch.setattr(S, "merge_run", recording_run)
+    got = [segment(m) if k is None else segment(m, parts=k) for m, k in cases]
+    assert max(slots) >= 64  # the memo did grow, many times over
+    for a, b in zip(want, got):
+        assert np.array_equal(a.labels, b.labels) and a.tau == b.tau and np.array_equal(a.concavity, b.concavity)
+
+
 def test_rand_index():
     a = np.array([0, 0, 1, 1, 2])
     assert rand_index(a, a) == 1.0

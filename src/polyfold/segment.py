@@ -22,7 +22,9 @@ Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 A merging run is one numba kernel (`_segment_kernels.merge_run`). The union concavity uses cached
 hulls (the hull of A u B is the hull of the two hulls' vertices) and a depth kernel with early
 exit; evaluations are memoized across runs, so `parts=K` (a bisection on tau) re-uses most of
-them. Merging adjacent connected clusters keeps every part edge-connected.
+them. Merging adjacent connected clusters keeps every part edge-connected. The per-mesh arrays,
+the candidate initial clusters and the parts' tables and concavities are numba kernels as well,
+one call each per segment() (per-face or per-part numpy calls cost more than the merging).
 
 Concavity (`part_concavity`): max over the part's vertices plus SAMPLES_PER_FACE seeded surface
 samples per face of the depth below the part's own convex hull (hull of its vertices), divided by
@@ -38,9 +40,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._segment_kernels import FLAT_EPS, convex_hull, denoise, make_units, max_depth, merge_run, new_memo, union_labels
+from ._segment_kernels import (FLAT_EPS, convex_hull, denoise, face_groups, face_keys, face_lengths, first_face_order, inner_edges,
+                               make_units, max_depth, merge_run, new_memo, part_concavities, part_tables, sample_points, unit_groups)
 from .io import obj_text
-from .mesh import Mesh, face_areas
+from .mesh import Mesh
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
 SAMPLES_PER_FACE = 3
@@ -82,12 +85,8 @@ class Segmentation:
 
 def surface_samples(mesh: Mesh, samples_per_face: int = SAMPLES_PER_FACE, seed: int = 0) -> np.ndarray:
     """Uniform random points (F, k, 3) on every face, drawn once for the whole mesh."""
-    tri = mesh.vertices[mesh.faces]
-    rng = np.random.default_rng(seed)
-    r = rng.random((len(tri), samples_per_face, 2))
-    flip = r.sum(axis=2) > 1
-    r[flip] = 1 - r[flip]
-    return tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
+    r = np.random.default_rng(seed).random((mesh.n_faces, samples_per_face, 2))
+    return sample_points(mesh.vertices, mesh.faces, r)
 
 
 SMALL_HULL = 64  # up to this many points our kernel; beyond, qhull (its ~45 us set-up no longer dominates)
@@ -115,16 +114,29 @@ def part_concavity(mesh: Mesh, face_ids: np.ndarray, samples: np.ndarray | None 
     samples: `surface_samples(mesh, seed=seed)` (computed when None); this is the value
     `Segmentation.concavity` reports and that `segment` keeps <= tau.
     """
-    face_ids = np.asarray(face_ids, dtype=np.int64)
     if samples is None:
         samples = surface_samples(mesh, seed=seed)
-    diag = mesh.bbox_diagonal
+    return _part_concavity(mesh, np.asarray(face_ids, dtype=np.int64), samples, mesh.bbox_diagonal)
+
+
+def _part_concavity(mesh: Mesh, face_ids: np.ndarray, samples: np.ndarray, diag: float) -> float:
+    """`part_concavity` with the whole mesh's bbox diagonal given."""
     verts = mesh.vertices[np.unique(mesh.faces[face_ids])]
     hull_pts, eq = _hull(verts)
     if eq is None or diag <= 0:
         return 0.0
     pts = np.concatenate([verts, samples[face_ids].reshape(-1, 3)])
     return denoise(float(max_depth(pts, eq, np.inf)), diag) / diag
+
+
+def _parts_concavity(m: "_Merger", tables: tuple) -> np.ndarray:
+    """`part_concavity` of every part of a `part_tables` output: the small parts in one kernel
+    call, parts of more than SMALL_HULL vertices with qhull's hull."""
+    faces, fstart, verts, vstart, _ = tables
+    conc = part_concavities(faces, fstart, verts, vstart, m.mesh.vertices, m.samples, m.diag, SMALL_HULL)
+    for p in np.flatnonzero(np.isnan(conc)):
+        conc[p] = _part_concavity(m.mesh, faces[fstart[p]:fstart[p + 1]], m.samples, m.diag)
+    return conc
 
 
 # ----------------------------------------------------------------------------------------------
@@ -163,27 +175,26 @@ def rand_index(a: np.ndarray, b: np.ndarray) -> float:
 
 class _Merger:
     """Per-mesh state shared by all merging runs of one `segment` call: the dual graph's arrays,
-    the candidate initial clusters of each seed labelling, and the memo of union concavities."""
+    the face labellings (seeds, input polygons, components), the candidate initial clusters of
+    each seed labelling, and the memo of union concavities."""
 
     def __init__(self, mesh: Mesh, seed: int):
         self.mesh = mesh
         self.diag = mesh.bbox_diagonal
-        self.samples = np.ascontiguousarray(surface_samples(mesh, seed=seed))
+        self.samples = surface_samples(mesh, seed=seed)
         topo = mesh.topology
-        self.areas = face_areas(mesh.vertices, mesh.faces)
-        e = topo.edges
-        edge_len = np.linalg.norm(mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]], axis=1)
         # Perimeter of each face counted over all its edges; shared edges are subtracted on merges.
-        self.face_perim = edge_len[topo.face_edges].sum(axis=1)
-        inner = np.flatnonzero(topo.interior)
-        self.ef0 = np.ascontiguousarray(topo.edge_faces[inner, 0])
-        self.ef1 = np.ascontiguousarray(topo.edge_faces[inner, 1])
-        self.inner_len = edge_len[inner]
-        self.inner_conc = self.inner_len * np.clip(-mesh.fold_angles[inner], 0.0, None) / (math.pi / 2)
+        self.areas, self.face_perim, edge_len = face_lengths(mesh.vertices, mesh.faces, topo.edges, topo.face_edges)
+        self.ef0, self.ef1, self.inner_len, self.inner_conc = inner_edges(topo.edge_faces, edge_len, mesh.fold_angles)
         # random 64-bit face keys: a cluster's key is their sum (see _segment_kernels.new_memo)
-        self.face_key = np.random.default_rng(0x5E6).integers(0, 2**64 - 1, mesh.n_faces, dtype=np.uint64, endpoint=True)
-        self.memo = new_memo()
-        self.polygon = _polygon_groups(mesh)
+        self.face_key = face_keys(mesh.n_faces)
+        self.memo = new_memo(mesh.n_faces)
+        # seeds: faces joined across edges with rho >= -SEED_ANGLE_DEG (locally convex regions) and
+        # across the inner edges of triangulated input polygons; polygon: the triangles of one input
+        # polygon (a face of the user's file, never split between parts); components: edge-connected
+        self.seeds, self.polygon, self.components = face_groups(
+            topo.edge_faces, mesh.face_source, mesh.fold_angles, -math.radians(SEED_ANGLE_DEG))
+        self.graph = (self.face_key, self.ef0, self.ef1, self.inner_len, self.inner_conc)
         self._units: dict[bytes, tuple] = {}
 
     def units(self, seed_labels: np.ndarray) -> tuple:
@@ -192,69 +203,25 @@ class _Merger:
         got = self._units.get(seed_labels.tobytes())
         if got is not None:
             return got
-        groups = []
-        seed_unit, sub_lo, sub_hi = [], [], []
-        for g in _groups(seed_labels):
-            seed_unit.append(len(groups))
-            groups.append(g)
-            subs = _groups(self.polygon[g], g)
-            sub_lo.append(len(groups))
-            groups += subs
-            sub_hi.append(len(groups))
         mesh = self.mesh
-        start = np.concatenate([[0], np.cumsum([len(g) for g in groups])]).astype(np.int64)
-        faces = np.concatenate(groups).astype(np.int64)
-        pts, hulls, conc = make_units(faces, start, mesh.faces, mesh.vertices, self.samples, self.diag)
+        seed_unit, sub_lo, sub_hi, faces, start = unit_groups(seed_labels, self.polygon)
+        pts, pstart, hulls, conc, self.memo = make_units(faces, start, mesh.faces, mesh.vertices, self.samples, self.diag, self.memo)
         area = np.add.reduceat(self.areas[faces], start[:-1])
         perim = np.add.reduceat(self.face_perim[faces], start[:-1])
-        got = (np.array(seed_unit), np.array(sub_lo), np.array(sub_hi), faces, start, pts, hulls, conc, area, perim)
+        got = (seed_unit, sub_lo, sub_hi, faces, start, pts, pstart, hulls, conc, area, perim)
         self._units[seed_labels.tobytes()] = got
         return got
 
 
-def _union_labels(n: int, f0: np.ndarray, f1: np.ndarray) -> np.ndarray:
-    """Connected-component label of each of n faces, joined by the face pairs (f0[i], f1[i])."""
-    return union_labels(n, np.ascontiguousarray(f0, dtype=np.int64), np.ascontiguousarray(f1, dtype=np.int64))
-
-
-def _polygon_groups(mesh: Mesh) -> np.ndarray:
-    """Label of each face: triangles of one input polygon (same face_source, edge-joined) share it.
-
-    A polygon is one face of the user's file, so it must never be split between parts."""
-    topo = mesh.topology
-    ef = topo.edge_faces[topo.interior]
-    same = mesh.face_source[ef[:, 0]] == mesh.face_source[ef[:, 1]]
-    return _union_labels(mesh.n_faces, ef[same, 0], ef[same, 1])
-
-
-def _seed_clusters(mesh: Mesh, angle_deg: float) -> np.ndarray:
-    """Label of each face: faces joined across edges with rho >= -angle (locally convex regions),
-    and across the inner edges of triangulated input polygons."""
-    topo = mesh.topology
-    ef = topo.edge_faces
-    keep = topo.interior & (mesh.fold_angles >= -math.radians(angle_deg))
-    keep |= topo.interior & (mesh.face_source[ef[:, 0]] == mesh.face_source[np.maximum(ef[:, 1], 0)])
-    return _union_labels(mesh.n_faces, ef[keep, 0], ef[keep, 1])
-
-
-def _groups(labels: np.ndarray, items: np.ndarray | None = None) -> list[np.ndarray]:
-    """The items (default: indices) grouped by label, groups ordered by label value."""
-    order = np.argsort(labels, kind="stable")
-    _, start = np.unique(labels[order], return_index=True)
-    items = order if items is None else np.asarray(items)[order]
-    return np.split(items, start[1:])
-
-
 def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
-         w_compact: float = W_COMPACT, w_seam: float = W_SEAM, min_faces: int = MIN_FACES) -> list[np.ndarray]:
-    """One merging run: the face lists of the parts (tau absolute; stop at `target` clusters).
-    The merging itself is `_segment_kernels.merge_run`."""
+         w_compact: float = W_COMPACT, w_seam: float = W_SEAM, min_faces: int = MIN_FACES) -> tuple[np.ndarray, int]:
+    """One merging run: (a cluster label per face, the number of clusters) (tau absolute; stop at
+    `target` clusters). The merging itself is `_segment_kernels.merge_run`."""
     limit = tau * m.diag * (1 - 1e-9)  # margin: the final re-measure may differ by rounding
     scale = limit if limit > 0 and math.isfinite(limit) else m.diag
-    label = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
-                      int(min_faces), m.diag, *m.units(seed_labels), m.face_key, m.ef0, m.ef1,
-                      m.inner_len, m.inner_conc, *m.memo)
-    return _groups(label)
+    label, n, m.memo = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
+                                 int(min_faces), m.diag, m.units(seed_labels), m.graph, m.memo)
+    return label, n
 
 
 def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed: int = 0) -> Segmentation:
@@ -273,66 +240,68 @@ def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed
     if not (tau >= 0 and math.isfinite(tau)):
         raise ValueError(f"tau must be a non-negative number, not {tau!r}")
     m = _Merger(mesh, seed)
-    seeds = _seed_clusters(mesh, SEED_ANGLE_DEG)
     if parts is None:
-        groups = _run(m, tau, None, seeds)
+        label, _ = _run(m, tau, None, m.seeds)
     else:
-        groups, tau = _fit_parts(m, seeds, int(parts))
-    return _finish(m, groups, tau)
+        label, tau = _fit_parts(m, m.seeds, int(parts))
+    return _finish(m, label, tau)
 
 
-def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[list[np.ndarray], float]:
-    """Parts and tau for `parts=k`: the default tau when it already gives k parts (so `segment()`
-    and `segment(parts=k)` agree), else a bisection on tau from the default towards k."""
+def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[np.ndarray, float]:
+    """Cluster labels and tau for `parts=k`: the default tau when it already gives k parts (so
+    `segment()` and `segment(parts=k)` agree), else a bisection on tau from the default towards k."""
     mesh = m.mesh
-    comp = _union_labels(mesh.n_faces, m.ef0, m.ef1)  # edge-connected components
-    n_comp = int(comp.max()) + 1
+    n_comp = int(m.components.max()) + 1
     k = int(min(max(k, n_comp), mesh.n_faces))
-    g = _run(m, DEFAULT_TAU, None, seeds)
-    if len(g) == k:
+    g, n = _run(m, DEFAULT_TAU, None, seeds)
+    if n == k:
         return g, DEFAULT_TAU
-    if len(g) > k:
+    if n > k:
         lo, hi = DEFAULT_TAU, None
     else:
         lo, hi = 0.0, DEFAULT_TAU
-        g0 = _run(m, 0.0, None, seeds)
-        if len(g0) <= k:  # even tau 0 gives no more parts: already-convex pieces stay whole
+        g0, n0 = _run(m, 0.0, None, seeds)
+        if n0 <= k:  # even tau 0 gives no more parts: already-convex pieces stay whole
             return g0, 0.0
     if hi is None:
         # every component as one part is admissible at its own concavity
-        hi = max(part_concavity(mesh, np.flatnonzero(comp == c), m.samples) for c in range(n_comp)) * 1.001
+        hi = float(_parts_concavity(m, part_tables(m.components, n_comp, mesh.faces, mesh.n_vertices)).max()) * 1.001
         hi = max(hi, lo * 1.001)
-        g = _run(m, hi, None, seeds)
-        if len(g) == k:
+        g, n = _run(m, hi, None, seeds)
+        if n == k:
             return g, hi
     for _ in range(40):
         mid = 0.5 * (lo + hi)
-        g = _run(m, mid, None, seeds)
-        if len(g) == k:
+        g, n = _run(m, mid, None, seeds)
+        if n == k:
             return g, mid
-        if len(g) > k:
+        if n > k:
             lo = mid
         else:
             hi = mid
         if hi - lo < 1e-6:
             break
     # No tau gives exactly k: merge on past tau (hi) until k parts, report the largest concavity.
-    g = _run(m, hi, k, seeds)
-    conc = max(part_concavity(mesh, f, m.samples) for f in g)
+    g, n = _run(m, hi, k, seeds)
+    label, n = first_face_order(g)
+    conc = float(_parts_concavity(m, part_tables(label, n, mesh.faces, mesh.n_vertices)).max())
     return g, max(conc, lo)
 
 
-def _finish(m: _Merger, groups: list[np.ndarray], tau: float) -> Segmentation:
+def _finish(m: _Merger, label: np.ndarray, tau: float) -> Segmentation:
+    """The Segmentation of a run's cluster labels: parts ordered by their first face so labels are
+    stable and readable, faces and vertices ascending within each part."""
     mesh = m.mesh
-    # Order parts by their first face so labels are stable and readable.
-    groups = sorted((np.sort(g) for g in groups), key=lambda g: int(g[0]))
-    labels = np.empty(mesh.n_faces, dtype=np.int64)
-    for p, g in enumerate(groups):
-        labels[g] = p
-    conc = np.array([part_concavity(mesh, g, m.samples) for g in groups])
-    subs = tuple(mesh.submesh(g) for g in groups)
-    vids = tuple(np.unique(mesh.faces[g]) for g in groups)
-    return Segmentation(labels=labels, tau=float(tau), concavity=conc, parts=subs, face_ids=tuple(groups), vertex_ids=vids)
+    labels, n = first_face_order(label)
+    tables = part_tables(labels, n, mesh.faces, mesh.n_vertices)
+    faces, fstart, verts, vstart, local = tables
+    conc = _parts_concavity(m, tables)
+    face_ids = tuple(faces[fstart[p]:fstart[p + 1]] for p in range(n))
+    vids = tuple(verts[vstart[p]:vstart[p + 1]] for p in range(n))
+    # each part as mesh.submesh(face_ids[p]) builds it
+    subs = tuple(Mesh(mesh.vertices[v], local[fstart[p]:fstart[p + 1]], mesh.face_source[f])
+                 for p, (f, v) in enumerate(zip(face_ids, vids)))
+    return Segmentation(labels=labels, tau=float(tau), concavity=conc, parts=subs, face_ids=face_ids, vertex_ids=vids)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -343,7 +312,7 @@ def input_face_labels(seg: Segmentation, face_source: np.ndarray, n_input_faces:
     """Part of every face of the input FILE (length n_input_faces, file order; -1 for faces the
     loader dropped as degenerate or duplicate). face_source: the segmented mesh's face_source."""
     out = np.full(max(int(n_input_faces), int(face_source.max()) + 1 if len(face_source) else 0), -1, dtype=np.int64)
-    out[face_source] = seg.labels  # triangles of one polygon share a part (see _polygon_groups)
+    out[face_source] = seg.labels  # triangles of one polygon share a part (see _Merger.polygon)
     return out
 
 
