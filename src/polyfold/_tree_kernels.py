@@ -1,0 +1,312 @@
+"""numba kernels of `kinematics.fold_tree`: a FOLD net's edge table, crease tree and crease axes.
+
+Each kernel checks what fold_tree's one-line errors name, in the order fold_tree names them, and
+returns an error code with the indices the message needs (OK = 0 and -1 elsewhere); fold_tree
+turns the code into the message. The arrays returned next to an error code are not meaningful.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+OK = 0
+# side_table
+BAD_EDGE = 1  # (e): an endpoint outside 0..V-1, or both endpoints equal
+DUPLICATE_EDGE = 2  # (first, second, u, v): two edges join u < v
+MISSING_SIDE = 3  # (u, v, f): side u-v of face f is no edge
+THIRD_FACE = 4  # (e): edge e borders a third face
+CLOCKWISE = 5  # (f)
+# crease_tree
+INVALID_PARENT = 11  # (f, p)
+NO_COMMON_EDGE = 12  # (f, p)
+CUT_PARENT_EDGE = 13  # (f, p, e)
+PIECE_CREASE = 14  # (e, f, g): a crease joins faces of two pieces (BFS tree)
+CYCLE = 15  # (f): not below any root
+PARENT_PIECE = 16  # (f): the parent is in another piece
+PIECE_ROOTS = 17  # (piece, r0, r1): a piece with two roots
+
+
+@njit(cache=True)
+def face_errors(faces, n_v):
+    """(first face with a vertex outside 0..n_v-1, first face repeating a vertex); -1 for none."""
+    out_of_range = -1
+    repeat = -1
+    for f in range(faces.shape[0]):
+        a = faces[f, 0]
+        b = faces[f, 1]
+        c = faces[f, 2]
+        if out_of_range < 0 and (min(a, b, c) < 0 or max(a, b, c) >= n_v):
+            out_of_range = f
+        if repeat < 0 and (a == b or b == c or c == a):
+            repeat = f
+    return out_of_range, repeat
+
+
+@njit(cache=True)
+def side_table(faces, edges, n_v, xy, min_area2):
+    """Edge table of a net: (code, info (4,), face_edges (F, 3), edge_faces (E, 2), flat (F, 3, 3)).
+
+    faces (F, 3) with vertices in range; edges (E, 2); xy (V, 2) flat coordinates. face_edges[f, k]
+    is the edge of side corner k -> k+1; edge_faces[e] the faces of edge e in face order (-1 when
+    missing); flat the corners at z = 0. Checks, in this order: edge endpoints, duplicate edges
+    (the first repeat in edge order), sides that are no edge and third faces (in face / side
+    order), then clockwise faces (twice the signed area < min_area2, numpy's formula).
+    """
+    n_f = faces.shape[0]
+    n_e = edges.shape[0]
+    info = np.full(4, -1, dtype=np.int64)
+    face_edges = np.full((n_f, 3), -1, dtype=np.int64)
+    edge_faces = np.full((n_e, 2), -1, dtype=np.int64)
+    flat = np.zeros((n_f, 3, 3))
+    for e in range(n_e):
+        u = edges[e, 0]
+        v = edges[e, 1]
+        if min(u, v) < 0 or max(u, v) >= n_v or u == v:
+            info[0] = e
+            return BAD_EDGE, info, face_edges, edge_faces, flat
+    key = np.empty(n_e, dtype=np.int64)
+    for e in range(n_e):
+        key[e] = min(edges[e, 0], edges[e, 1]) * n_v + max(edges[e, 0], edges[e, 1])
+    order = np.argsort(key, kind="mergesort")
+    first_repeat = n_e
+    for r in range(1, n_e):
+        if key[order[r]] == key[order[r - 1]] and (r == 1 or key[order[r - 2]] != key[order[r]]):
+            first_repeat = min(first_repeat, order[r])  # the second edge of its group: the one named
+    if first_repeat < n_e:
+        e = first_repeat
+        u = min(edges[e, 0], edges[e, 1])
+        v = max(edges[e, 0], edges[e, 1])
+        lo = 0
+        while key[order[lo]] != key[e]:
+            lo += 1
+        info[0] = order[lo]
+        info[1] = e
+        info[2] = u
+        info[3] = v
+        return DUPLICATE_EDGE, info, face_edges, edge_faces, flat
+    sorted_key = key[order]
+    for f in range(n_f):
+        for k in range(3):
+            u = faces[f, k]
+            v = faces[f, (k + 1) % 3]
+            want = min(u, v) * n_v + max(u, v)
+            r = np.searchsorted(sorted_key, want)
+            if r >= n_e or sorted_key[r] != want:
+                info[0] = u
+                info[1] = v
+                info[2] = f
+                return MISSING_SIDE, info, face_edges, edge_faces, flat
+            e = order[r]
+            face_edges[f, k] = e
+            if edge_faces[e, 0] < 0:
+                edge_faces[e, 0] = f
+            elif edge_faces[e, 1] < 0:
+                edge_faces[e, 1] = f
+            else:
+                info[0] = e
+                return THIRD_FACE, info, face_edges, edge_faces, flat
+    for f in range(n_f):
+        for k in range(3):
+            flat[f, k, 0] = xy[faces[f, k], 0]
+            flat[f, k, 1] = xy[faces[f, k], 1]
+    for f in range(n_f):
+        area2 = ((flat[f, 1, 0] - flat[f, 0, 0]) * (flat[f, 2, 1] - flat[f, 0, 1])
+                 - (flat[f, 1, 1] - flat[f, 0, 1]) * (flat[f, 2, 0] - flat[f, 0, 0]))
+        if area2 < min_area2:
+            info[0] = f
+            return CLOCKWISE, info, face_edges, edge_faces, flat
+    return OK, info, face_edges, edge_faces, flat
+
+
+@njit(cache=True)
+def _parent_creases(parent, face_edges, cut, crease, info):
+    """Crease of every face to its given parent (first side of f that is a side of p)."""
+    n_f = parent.shape[0]
+    for f in range(n_f):
+        p = parent[f]
+        if p < -1 or p >= n_f or p == f:
+            info[0] = f
+            info[1] = p
+            return INVALID_PARENT
+        if p < 0:
+            continue
+        common = -1
+        for k in range(3):
+            e = face_edges[f, k]
+            if e == face_edges[p, 0] or e == face_edges[p, 1] or e == face_edges[p, 2]:
+                common = e
+                break
+        if common < 0:
+            info[0] = f
+            info[1] = p
+            return NO_COMMON_EDGE
+        if cut[common]:
+            info[0] = f
+            info[1] = p
+            info[2] = common
+            return CUT_PARENT_EDGE
+        crease[f] = common
+    return OK
+
+
+@njit(cache=True)
+def _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info):
+    """BFS over the creases from the lowest unvisited face; neighbours in edge order."""
+    n_f = parent.shape[0]
+    n_e = edge_faces.shape[0]
+    ptr = np.zeros(n_f + 1, dtype=np.int64)
+    for e in range(n_e):
+        if edge_faces[e, 1] >= 0 and not cut[e]:
+            ptr[edge_faces[e, 0] + 1] += 1
+            ptr[edge_faces[e, 1] + 1] += 1
+    for f in range(n_f):
+        ptr[f + 1] += ptr[f]
+    fill = ptr[:-1].copy()
+    nb_face = np.empty(ptr[n_f], dtype=np.int64)
+    nb_edge = np.empty(ptr[n_f], dtype=np.int64)
+    for e in range(n_e):
+        if edge_faces[e, 1] >= 0 and not cut[e]:
+            for s in range(2):
+                f = edge_faces[e, s]
+                nb_face[fill[f]] = edge_faces[e, 1 - s]
+                nb_edge[fill[f]] = e
+                fill[f] += 1
+    seen = np.zeros(n_f, dtype=np.bool_)
+    queue = np.empty(n_f, dtype=np.int64)
+    for root in range(n_f):
+        if seen[root]:
+            continue
+        seen[root] = True
+        queue[0] = root
+        head = 0
+        tail = 1
+        while head < tail:
+            f = queue[head]
+            head += 1
+            for r in range(ptr[f], ptr[f + 1]):
+                g = nb_face[r]
+                if seen[g]:
+                    continue
+                if has_piece and piece_in[g] != piece_in[f]:
+                    info[0] = nb_edge[r]
+                    info[1] = f
+                    info[2] = g
+                    return PIECE_CREASE
+                seen[g] = True
+                parent[g] = f
+                crease[g] = nb_edge[r]
+                queue[tail] = g
+                tail += 1
+    return OK
+
+
+@njit(cache=True)
+def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent, piece_in, has_piece, xy, min_len2):
+    """The crease tree of a net: (code, info (3,), parent, crease, order, piece, axis, short).
+
+    parent_in (F,) the given parents (has_parent), else a BFS over the non-cut edges; piece_in
+    (F,) the given pieces (has_piece), else one per tree. order (F,) BFS from the roots (ascending),
+    children in face order; axis (F, 2) the parent's corners at the crease ends, a -> b in its CCW
+    order (-1 at roots); short: the faces (ascending) whose crease may be shorter than fold_tree's
+    limit (squared xy length not above min_len2), for an exact check by the caller. Checks, in this
+    order: the given parents (range, common edge, cut edge) or the BFS's pieces, cycles, then the
+    given pieces (parent in another piece, two roots in one piece).
+    """
+    n_f = faces.shape[0]
+    info = np.full(3, -1, dtype=np.int64)
+    crease = np.full(n_f, -1, dtype=np.int64)
+    order = np.empty(n_f, dtype=np.int64)
+    piece = np.full(n_f, -1, dtype=np.int64)
+    axis = np.full((n_f, 2), -1, dtype=np.int64)
+    short = np.empty(0, dtype=np.int64)
+    if has_parent:
+        parent = parent_in.copy()
+        code = _parent_creases(parent, face_edges, cut, crease, info)
+    else:
+        parent = np.full(n_f, -1, dtype=np.int64)
+        code = _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info)
+    if code != OK:
+        return code, info, parent, crease, order, piece, axis, short
+    # children lists (CSR, face order) and the BFS order from the roots
+    ptr = np.zeros(n_f + 1, dtype=np.int64)
+    for f in range(n_f):
+        if parent[f] >= 0:
+            ptr[parent[f] + 1] += 1
+    for f in range(n_f):
+        ptr[f + 1] += ptr[f]
+    fill = ptr[:-1].copy()
+    children = np.empty(ptr[n_f], dtype=np.int64)
+    for f in range(n_f):
+        if parent[f] >= 0:
+            children[fill[parent[f]]] = f
+            fill[parent[f]] += 1
+    tree_of = np.full(n_f, -1, dtype=np.int64)
+    n_roots = 0
+    tail = 0
+    for root in range(n_f):
+        if parent[root] >= 0:
+            continue
+        tree_of[root] = root
+        piece[root] = n_roots
+        n_roots += 1
+        head = tail
+        order[tail] = root
+        tail += 1
+        while head < tail:
+            f = order[head]
+            head += 1
+            for r in range(ptr[f], ptr[f + 1]):
+                g = children[r]
+                tree_of[g] = root
+                piece[g] = piece[root]
+                order[tail] = g
+                tail += 1
+    if tail != n_f:
+        for f in range(n_f):
+            if tree_of[f] < 0:
+                info[0] = f
+                break
+        return CYCLE, info, parent, crease, order, piece, axis, short
+    if has_piece:
+        piece = piece_in
+        for f in range(n_f):
+            if parent[f] >= 0 and piece[f] != piece[parent[f]]:
+                info[0] = f
+                return PARENT_PIECE, info, parent, crease, order, piece, axis, short
+        roots = np.flatnonzero(parent < 0)
+        by_piece = np.argsort(piece[roots], kind="mergesort")  # roots of one piece stay ascending
+        for r in range(1, roots.shape[0]):
+            a = roots[by_piece[r - 1]]
+            b = roots[by_piece[r]]
+            if piece[a] == piece[b]:  # the first such pair: the lowest piece, its two lowest roots
+                info[0] = piece[a]
+                info[1] = a
+                info[2] = b
+                return PIECE_ROOTS, info, parent, crease, order, piece, axis, short
+    flags = np.zeros(n_f, dtype=np.bool_)
+    for f in range(n_f):
+        p = parent[f]
+        if p < 0:
+            continue
+        u = edges[crease[f], 0]
+        v = edges[crease[f], 1]
+        k = 0
+        while faces[p, k] != u:
+            k += 1
+        kv = 0
+        while faces[p, kv] != v:
+            kv += 1
+        if (k + 1) % 3 == kv:
+            axis[f, 0] = k
+            axis[f, 1] = kv
+        else:
+            axis[f, 0] = kv
+            axis[f, 1] = k
+        dx = xy[u, 0] - xy[v, 0]
+        dy = xy[u, 1] - xy[v, 1]
+        d2 = dx * dx + dy * dy
+        if not (d2 > min_len2 and d2 > 1e-280):  # tiny squares lose precision: leave them to the exact check
+            flags[f] = True
+    short = np.flatnonzero(flags)
+    return OK, info, parent, crease, order, piece, axis, short
