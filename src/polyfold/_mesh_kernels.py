@@ -144,18 +144,27 @@ def face_normals(vertices, faces):
 
 
 @njit(cache=True, error_model="numpy")  # a zero-length edge divides by 0 as numpy does (nan)
-def fold_angle_vectors(vertices, normals, edges, edge_faces, inner):
-    """Per interior edge inner[i]: n0 x n1 and the unit edge direction u (as run by face 0), and
-    the normals n0, n1 of its faces; all (I, 3). rho = atan2((n0 x n1) . u, n0 . n1)."""
-    n_i = inner.shape[0]
+def fold_angle_vectors(vertices, faces, edges, edge_faces):
+    """Interior edges inner (I,) ascending and, per interior edge, n0 x n1 and the unit edge
+    direction u (as run by face 0), and the unit normals n0, n1 of its faces (`face_normals`);
+    all (I, 3). rho = atan2((n0 x n1) . u, n0 . n1)."""
+    normals = face_normals(vertices, faces)
+    n_i = 0
+    for e in range(edges.shape[0]):
+        if edge_faces[e, 0] >= 0 and edge_faces[e, 1] >= 0:
+            n_i += 1
+    inner = np.empty(n_i, dtype=np.int64)
     cr = np.empty((n_i, 3))
     u = np.empty((n_i, 3))
     n0 = np.empty((n_i, 3))
     n1 = np.empty((n_i, 3))
-    for i in range(n_i):
-        e = inner[i]
+    i = 0
+    for e in range(edges.shape[0]):
         f0 = edge_faces[e, 0]
         f1 = edge_faces[e, 1]
+        if f0 < 0 or f1 < 0:
+            continue
+        inner[i] = e
         for j in range(3):
             u[i, j] = vertices[edges[e, 1], j] - vertices[edges[e, 0], j]
             n0[i, j] = normals[f0, j]
@@ -164,4 +173,5 @@ def fold_angle_vectors(vertices, normals, edges, edge_faces, inner):
         for j in range(3):
             u[i, j] = u[i, j] / norm
         _cross_into(n0[i, 0], n0[i, 1], n0[i, 2], n1[i, 0], n1[i, 1], n1[i, 2], cr, i)
-    return cr, u, n0, n1
+        i += 1
+    return inner, cr, u, n0, n1

@@ -202,18 +202,24 @@ def _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info):
 
 
 @njit(cache=True)
-def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent, piece_in, has_piece, xy, min_len2):
-    """The crease tree of a net: (code, info (3,), parent, crease, order, piece, axis, short).
+def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, has_parent, piece_in, has_piece, xy,
+                min_len2):
+    """The crease tree of a net: (code, info (3,), parent, crease, order, piece, axis, short, creases).
 
-    parent_in (F,) the given parents (has_parent), else a BFS over the non-cut edges; piece_in
+    kind (E,): assignment kind of every edge, cuts below n_cut. parent_in (F,) the given parents (has_parent), else a BFS over the non-cut edges; piece_in
     (F,) the given pieces (has_piece), else one per tree. order (F,) BFS from the roots (ascending),
     children in face order; axis (F, 2) the parent's corners at the crease ends, a -> b in its CCW
     order (-1 at roots); short: the faces (ascending) whose crease may be shorter than fold_tree's
-    limit (squared xy length not above min_len2), for an exact check by the caller. Checks, in this
+    limit (squared xy length not above min_len2), for an exact check by the caller; creases: the
+    tree's creases ascending. Checks, in this
     order: the given parents (range, common edge, cut edge) or the BFS's pieces, cycles, then the
     given pieces (parent in another piece, two roots in one piece).
     """
     n_f = faces.shape[0]
+    n_e = edges.shape[0]
+    cut = np.empty(n_e, dtype=np.bool_)
+    for e in range(n_e):
+        cut[e] = kind[e] < n_cut
     info = np.full(3, -1, dtype=np.int64)
     crease = np.full(n_f, -1, dtype=np.int64)
     order = np.empty(n_f, dtype=np.int64)
@@ -227,7 +233,7 @@ def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent
         parent = np.full(n_f, -1, dtype=np.int64)
         code = _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info)
     if code != OK:
-        return code, info, parent, crease, order, piece, axis, short
+        return code, info, parent, crease, order, piece, axis, short, short
     # children lists (CSR, face order) and the BFS order from the roots
     ptr = np.zeros(n_f + 1, dtype=np.int64)
     for f in range(n_f):
@@ -267,13 +273,13 @@ def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent
             if tree_of[f] < 0:
                 info[0] = f
                 break
-        return CYCLE, info, parent, crease, order, piece, axis, short
+        return CYCLE, info, parent, crease, order, piece, axis, short, short
     if has_piece:
         piece = piece_in
         for f in range(n_f):
             if parent[f] >= 0 and piece[f] != piece[parent[f]]:
                 info[0] = f
-                return PARENT_PIECE, info, parent, crease, order, piece, axis, short
+                return PARENT_PIECE, info, parent, crease, order, piece, axis, short, short
         roots = np.flatnonzero(parent < 0)
         by_piece = np.argsort(piece[roots], kind="mergesort")  # roots of one piece stay ascending
         for r in range(1, roots.shape[0]):
@@ -283,12 +289,14 @@ def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent
                 info[0] = piece[a]
                 info[1] = a
                 info[2] = b
-                return PIECE_ROOTS, info, parent, crease, order, piece, axis, short
+                return PIECE_ROOTS, info, parent, crease, order, piece, axis, short, short
     flags = np.zeros(n_f, dtype=np.bool_)
+    is_crease = np.zeros(n_e, dtype=np.bool_)
     for f in range(n_f):
         p = parent[f]
         if p < 0:
             continue
+        is_crease[crease[f]] = True
         u = edges[crease[f], 0]
         v = edges[crease[f], 1]
         k = 0
@@ -308,5 +316,39 @@ def crease_tree(faces, edges, face_edges, edge_faces, cut, parent_in, has_parent
         d2 = dx * dx + dy * dy
         if not (d2 > min_len2 and d2 > 1e-280):  # tiny squares lose precision: leave them to the exact check
             flags[f] = True
-    short = np.flatnonzero(flags)
-    return OK, info, parent, crease, order, piece, axis, short
+    # (a crease joins one child to its parent: no repeats)
+    return OK, info, parent, crease, order, piece, axis, np.flatnonzero(flags), np.flatnonzero(is_crease)
+
+
+@njit(cache=True)
+def extent(pts):
+    """max - min (D,) of finite points (V, D), V >= 1."""
+    lo = pts[0].copy()
+    hi = pts[0].copy()
+    for v in range(1, pts.shape[0]):
+        for i in range(pts.shape[1]):
+            lo[i] = min(lo[i], pts[v, i])
+            hi[i] = max(hi[i], pts[v, i])
+    return hi - lo
+
+
+@njit(cache=True)
+def fold_angle_errors(deg, kind, n_cut, mountain, valley, goal):
+    """First non-cut edge (kind >= n_cut) whose fold angle deg (E,) is not within [-180, 180] (nan
+    and inf included) or has the wrong sign for a mountain (<= 0) / valley (>= 0): (edge, out of
+    range), (-1, False) for none. Sets goal[e] = 0 on the cut edges."""
+    first = -1
+    out_of_range = False
+    for e in range(deg.shape[0]):
+        if kind[e] < n_cut:
+            goal[e] = 0.0
+            continue
+        if first >= 0:
+            continue
+        d = deg[e]
+        if not (abs(d) <= 180.0):
+            first = e
+            out_of_range = True
+        elif (kind[e] == mountain and d > 0) or (kind[e] == valley and d < 0):
+            first = e
+    return first, out_of_range

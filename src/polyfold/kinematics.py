@@ -344,7 +344,7 @@ def _int_array(fold: dict, key: str, shape_tail: tuple[int, ...], what: str) -> 
             arr = arr.reshape((0,) + shape_tail)
         if arr.dtype == object or arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
             raise ValueError
-        if not np.issubdtype(arr.dtype, np.integer):
+        if arr.dtype != np.int64 and not np.issubdtype(arr.dtype, np.integer):  # (JSON ints: int64)
             if not np.issubdtype(arr.dtype, np.floating) or not np.all(arr == np.round(arr)):
                 raise ValueError
         return arr.astype(np.int64)
@@ -359,21 +359,25 @@ def _float_array(value, key: str, n_cols: tuple[int, ...]) -> np.ndarray:
         raise _fail(f"{key!r} is not a list of coordinates") from None
     if arr.ndim != 2 or arr.shape[1] not in n_cols:
         raise _fail(f"{key!r} must hold {' or '.join(map(str, n_cols))} coordinates per vertex")
-    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-    if len(bad):
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = np.flatnonzero(~finite.all(axis=1))
         raise _fail(f"{key!r}: vertex {bad[0]} has a non-finite coordinate")
     return arr
 
 
 def _bbox_diagonal(pts: np.ndarray) -> float:
-    return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
+    """Bounding-box diagonal of finite points (V, 2 or 3)."""
+    return float(np.linalg.norm(TK.extent(pts))) if len(pts) else 0.0
 
 
 def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
     frames = fold.get("file_frames")
     if not frames:
         return None
-    frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frames[0])
+    frame = frames[0]  # the first foldedForm frame, else the first frame
+    if not (isinstance(frame, dict) and "foldedForm" in (frame.get("frame_classes") or [])):
+        frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frame)
     if not isinstance(frame, dict) or "vertices_coords" not in frame:
         return None
     coords = _float_array(frame["vertices_coords"], "file_frames[0].vertices_coords", (3,))
@@ -402,20 +406,20 @@ def _assignments(assign, n_e: int) -> tuple[list[str], np.ndarray]:
     if not isinstance(assign, (list, tuple)) or len(assign) != n_e:
         raise _fail(f"'edges_assignment' must have one entry per edge ({n_e})")
     if set(map(type, assign)) <= {str}:
-        assign = list(map(str.upper, assign))
-    else:
-        assign = [str(a).upper() for a in assign]
-    if not set(assign) <= _KNOWN:
-        for e, a in enumerate(assign):
-            if a not in _KNOWN:
-                raise _fail(f"edge {e} has unknown assignment {a!r}")
+        try:  # the usual case: all upper-case and known already
+            return assign, np.fromiter(map(_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
+        except KeyError:
+            pass
+    assign = [str(a).upper() for a in assign]
+    for e, a in enumerate(assign):
+        if a not in _KNOWN:
+            raise _fail(f"edge {e} has unknown assignment {a!r}")
     return assign, np.fromiter(map(_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
 
 
 def _goal_angles(fold: dict, assign: list[str], kind: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray,
                  faces: np.ndarray, folded: np.ndarray | None) -> np.ndarray:
     n_e = len(edges)
-    is_cut = kind < len(_CUT)
     if "edges_foldAngle" in fold:
         try:
             deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
@@ -423,18 +427,17 @@ def _goal_angles(fold: dict, assign: list[str], kind: np.ndarray, edges: np.ndar
             raise _fail("'edges_foldAngle' is not a list of numbers") from None
         if deg.shape != (n_e,):
             raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
-        out_of_range = ~(np.abs(deg) <= 180.0)  # nan and inf too
-        wrong_sign = ((kind == _MOUNTAIN) & (deg > 0)) | ((kind == _VALLEY) & (deg < 0))
-        bad = np.flatnonzero(~is_cut & (out_of_range | wrong_sign))
-        if len(bad):
-            e = int(bad[0])
+        goal = -np.radians(deg)
+        e, out_of_range = TK.fold_angle_errors(deg, kind, len(_CUT), _MOUNTAIN, _VALLEY, goal)  # zeroes the cuts
+        if e >= 0:
             d = deg[e]
-            if out_of_range[e]:
+            if out_of_range:
                 raise _fail(f"edge {e} has fold angle {d} (must be within [-180, 180] degrees)")
             raise _fail(f"edge {e} is a {'mountain' if assign[e] == 'M' else 'valley'} with fold angle {d} "
                         "(FOLD: valley positive, mountain negative)")
-        return np.where(is_cut, 0.0, -np.radians(deg))
+        return goal
     goal = np.zeros(n_e)
+    is_cut = kind < len(_CUT)
     for e in range(n_e):  # files without fold angles only (net_to_fold always writes them)
         if is_cut[e]:
             continue
@@ -531,8 +534,8 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
         if len(parent_in) != n_f:
             raise _fail(f"'polyfold:faces_parent' has {len(parent_in)} entries for {n_f} faces")
     none = np.empty(0, dtype=np.int64)
-    code, info, parent, crease, order, piece, axis, short = TK.crease_tree(
-        faces, edges, face_edges, edge_faces, kind < len(_CUT), none if parent_in is None else parent_in,
+    code, info, parent, crease, order, piece, axis, short, creases = TK.crease_tree(
+        faces, edges, face_edges, edge_faces, kind, len(_CUT), none if parent_in is None else parent_in,
         parent_in is not None, none if piece_in is None else piece_in, piece_in is not None, xy,
         (2e-12 * scale) ** 2)
     if code != TK.OK:
@@ -544,7 +547,6 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
             raise _fail(f"crease edge {e} (between faces {p} and {f}) has zero length")
 
     goal = _goal_angles(fold, assign, kind, edges, edge_faces, faces, folded)
-    creases = np.sort(crease[crease >= 0])
     return FoldTree(
         flat=flat, faces=faces, order=order, parent=parent, crease=crease, axis=axis,
         piece=np.ascontiguousarray(piece, dtype=np.int64), goal=goal, creases=creases, scale=scale,

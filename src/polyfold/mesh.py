@@ -158,14 +158,11 @@ def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) ->
 
     Positive on convex edges; 0 on boundary edges.
     """
+    inner, cross, u, n0, n1 = MK.fold_angle_vectors(np.ascontiguousarray(vertices, dtype=np.float64),
+                                                    np.ascontiguousarray(faces, dtype=np.int64), topo.edges, topo.edge_faces)
     rho = np.zeros(topo.n_edges)
-    inner = np.flatnonzero(topo.interior)
-    if len(inner) == 0:
-        return rho
-    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
-    normals = face_normals(vertices, faces)
-    cross, u, n0, n1 = MK.fold_angle_vectors(vertices, normals, topo.edges, topo.edge_faces, inner)
-    rho[inner] = np.arctan2(row_dots(cross, u), row_dots(n0, n1))
+    if len(inner):
+        rho[inner] = np.arctan2(row_dots(cross, u), row_dots(n0, n1))
     return rho
 
 
