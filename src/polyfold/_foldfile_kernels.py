@@ -122,18 +122,31 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
             faces[f, k] = corner_v[f, k] + v_off
             for i in range(2):
                 xy[corner_v[f, k], i] = coords[f, k, i] + offsets[piece[f], i]
+    # the first side of each net vertex pair: sides in buckets by their lower net vertex
     n_s = 3 * n_f
-    key = np.empty(n_s, dtype=np.int64)
+    start = np.zeros(n_v + 1, dtype=np.int64)
+    for s in range(n_s):
+        start[min(corner_v[s // 3, s % 3], corner_v[s // 3, (s % 3 + 1) % 3]) + 1] += 1
+    for v in range(n_v):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    bucket_hi = np.empty(n_s, dtype=np.int64)
+    first = np.zeros(n_s, dtype=np.bool_)
+    count = 0
     for s in range(n_s):
         u = corner_v[s // 3, s % 3]
         v = corner_v[s // 3, (s % 3 + 1) % 3]
-        key[s] = min(u, v) * n_v + max(u, v)
-    order = np.argsort(key, kind="mergesort")
-    first = np.zeros(n_s, dtype=np.bool_)
-    count = 0
-    for r in range(n_s):
-        if r == 0 or key[order[r]] != key[order[r - 1]]:
-            first[order[r]] = True
+        lo = min(u, v)
+        hi = max(u, v)
+        seen = False
+        for r in range(start[lo], fill[lo]):
+            if bucket_hi[r] == hi:
+                seen = True
+                break
+        if not seen:
+            bucket_hi[fill[lo]] = hi
+            fill[lo] += 1
+            first[s] = True
             count += 1
     crease = np.zeros(fold_angles.shape[0], dtype=np.bool_)
     for f in range(n_f):

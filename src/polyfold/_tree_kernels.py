@@ -1,8 +1,9 @@
 """numba kernels of `kinematics.fold_tree`: a FOLD net's edge table, crease tree and crease axes.
 
-Each kernel checks what fold_tree's one-line errors name, in the order fold_tree names them, and
-returns an error code with the indices the message needs (OK = 0 and -1 elsewhere); fold_tree
-turns the code into the message. The arrays returned next to an error code are not meaningful.
+`net_tree` checks what fold_tree's one-line errors name, in the order fold_tree names them, and
+returns an error code with the indices the message needs (OK = 0, info -1 elsewhere); fold_tree
+turns the code into the message. Outputs are arguments (returning arrays from numba costs more
+than the work on a small net); after an error code they are not meaningful.
 """
 
 from __future__ import annotations
@@ -11,13 +12,16 @@ import numpy as np
 from numba import njit
 
 OK = 0
-# side_table
+# faces
+FACE_OUT_OF_RANGE = 21  # (f): a vertex outside 0..V-1
+FACE_REPEAT = 22  # (f): a vertex twice
+# edge table
 BAD_EDGE = 1  # (e): an endpoint outside 0..V-1, or both endpoints equal
 DUPLICATE_EDGE = 2  # (first, second, u, v): two edges join u < v
 MISSING_SIDE = 3  # (u, v, f): side u-v of face f is no edge
 THIRD_FACE = 4  # (e): edge e borders a third face
 CLOCKWISE = 5  # (f)
-# crease_tree
+# crease tree
 INVALID_PARENT = 11  # (f, p)
 NO_COMMON_EDGE = 12  # (f, p)
 CUT_PARENT_EDGE = 13  # (f, p, e)
@@ -28,24 +32,51 @@ PIECE_ROOTS = 17  # (piece, r0, r1): a piece with two roots
 
 
 @njit(cache=True)
-def face_errors(faces, n_v):
-    """(first face with a vertex outside 0..n_v-1, first face repeating a vertex); -1 for none."""
-    out_of_range = -1
-    repeat = -1
+def net_tree(faces, n_v, edges, kind, n_cut, xy, min_area2, parent_in, piece_in, min_len2, mountain, valley, deg,
+             stage, info, face_edges, edge_faces, flat, parent, crease, order, piece, axis, short, creases, goal):
+    """Everything fold_tree derives from a net's arrays; returns (code, len(short), len(creases),
+    first bad fold angle edge or -1, whether it is out of range).
+
+    In: faces (F, 3) (F >= 1), n_v vertices, edges (E, 2), kind (E,) assignment kinds (cuts below
+    n_cut), xy (V, 2); parent_in / piece_in (F,) or empty when not given; deg (E,) fold angles in
+    degrees or empty. stage: how far the inputs are usable: 1 faces only, 2 + edge table (edges and
+    kinds), 3 + crease tree (parents, pieces), 4 + fold angles. Checks, in order: faces (vertex
+    range, then repeats, first face each), the edge table and clockwise faces (`_side_table`), the
+    crease tree (`_crease_tree`), and the fold angles (`_fold_angle_errors`, reported separately:
+    fold_tree checks zero-length creases before them). Fills info (4,), face_edges (F, 3),
+    edge_faces (E, 2), flat (F, 3, 3), parent, crease, order, piece, short, creases (F,), axis
+    (F, 2) and, at stage 4, goal (E,) (holding -radians(deg) on entry: zeroed on the cuts).
+    """
+    info[:] = -1
     for f in range(faces.shape[0]):
         a = faces[f, 0]
         b = faces[f, 1]
         c = faces[f, 2]
-        if out_of_range < 0 and (min(a, b, c) < 0 or max(a, b, c) >= n_v):
-            out_of_range = f
-        if repeat < 0 and (a == b or b == c or c == a):
-            repeat = f
-    return out_of_range, repeat
+        if min(a, b, c) < 0 or max(a, b, c) >= n_v:
+            info[0] = f
+            return FACE_OUT_OF_RANGE, 0, 0, -1, False
+    for f in range(faces.shape[0]):
+        if faces[f, 0] == faces[f, 1] or faces[f, 1] == faces[f, 2] or faces[f, 2] == faces[f, 0]:
+            info[0] = f
+            return FACE_REPEAT, 0, 0, -1, False
+    if stage < 2:
+        return OK, 0, 0, -1, False
+    code = _side_table(faces, edges, n_v, xy, min_area2, info, face_edges, edge_faces, flat)
+    if code != OK or stage < 3:
+        return code, 0, 0, -1, False
+    code, n_short, n_creases = _crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in,
+                                            parent_in.shape[0] > 0, piece_in, piece_in.shape[0] > 0, xy, min_len2,
+                                            info, parent, crease, order, piece, axis, short, creases)
+    if code != OK or stage < 4:
+        return code, n_short, n_creases, -1, False
+    bad, out_of_range = _fold_angle_errors(deg, kind, n_cut, mountain, valley, goal)
+    return OK, n_short, n_creases, bad, out_of_range
 
 
 @njit(cache=True)
-def side_table(faces, edges, n_v, xy, min_area2):
-    """Edge table of a net: (code, info (4,), face_edges (F, 3), edge_faces (E, 2), flat (F, 3, 3)).
+def _side_table(faces, edges, n_v, xy, min_area2, info, face_edges, edge_faces, flat):
+    """Edge table of a net; returns the error code, fills info (4,), face_edges (F, 3), edge_faces
+    (E, 2) and flat (F, 3, 3).
 
     faces (F, 3) with vertices in range; edges (E, 2); xy (V, 2) flat coordinates. face_edges[f, k]
     is the edge of side corner k -> k+1; edge_faces[e] the faces of edge e in face order (-1 when
@@ -55,49 +86,51 @@ def side_table(faces, edges, n_v, xy, min_area2):
     """
     n_f = faces.shape[0]
     n_e = edges.shape[0]
-    info = np.full(4, -1, dtype=np.int64)
-    face_edges = np.full((n_f, 3), -1, dtype=np.int64)
-    edge_faces = np.full((n_e, 2), -1, dtype=np.int64)
-    flat = np.zeros((n_f, 3, 3))
+    face_edges[:] = -1
+    edge_faces[:] = -1
     for e in range(n_e):
         u = edges[e, 0]
         v = edges[e, 1]
         if min(u, v) < 0 or max(u, v) >= n_v or u == v:
             info[0] = e
-            return BAD_EDGE, info, face_edges, edge_faces, flat
-    key = np.empty(n_e, dtype=np.int64)
+            return BAD_EDGE
+    # edges in buckets by their lower vertex (CSR, edge order within a bucket): the sides' lookup
+    start = np.zeros(n_v + 1, dtype=np.int64)
     for e in range(n_e):
-        key[e] = min(edges[e, 0], edges[e, 1]) * n_v + max(edges[e, 0], edges[e, 1])
-    order = np.argsort(key, kind="mergesort")
-    first_repeat = n_e
-    for r in range(1, n_e):
-        if key[order[r]] == key[order[r - 1]] and (r == 1 or key[order[r - 2]] != key[order[r]]):
-            first_repeat = min(first_repeat, order[r])  # the second edge of its group: the one named
-    if first_repeat < n_e:
-        e = first_repeat
-        u = min(edges[e, 0], edges[e, 1])
-        v = max(edges[e, 0], edges[e, 1])
-        lo = 0
-        while key[order[lo]] != key[e]:
-            lo += 1
-        info[0] = order[lo]
-        info[1] = e
-        info[2] = u
-        info[3] = v
-        return DUPLICATE_EDGE, info, face_edges, edge_faces, flat
-    sorted_key = key[order]
+        start[min(edges[e, 0], edges[e, 1]) + 1] += 1
+    for v in range(n_v):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    bucket = np.empty(n_e, dtype=np.int64)
+    for e in range(n_e):
+        lo = min(edges[e, 0], edges[e, 1])
+        hi = max(edges[e, 0], edges[e, 1])
+        for r in range(start[lo], fill[lo]):  # the earlier edges at lo: the first repeat is named
+            g = bucket[r]
+            if max(edges[g, 0], edges[g, 1]) == hi:
+                info[0] = g
+                info[1] = e
+                info[2] = lo
+                info[3] = hi
+                return DUPLICATE_EDGE
+        bucket[fill[lo]] = e
+        fill[lo] += 1
     for f in range(n_f):
         for k in range(3):
             u = faces[f, k]
             v = faces[f, (k + 1) % 3]
-            want = min(u, v) * n_v + max(u, v)
-            r = np.searchsorted(sorted_key, want)
-            if r >= n_e or sorted_key[r] != want:
+            lo = min(u, v)
+            hi = max(u, v)
+            e = -1
+            for r in range(start[lo], start[lo + 1]):
+                if max(edges[bucket[r], 0], edges[bucket[r], 1]) == hi:
+                    e = bucket[r]
+                    break
+            if e < 0:
                 info[0] = u
                 info[1] = v
                 info[2] = f
-                return MISSING_SIDE, info, face_edges, edge_faces, flat
-            e = order[r]
+                return MISSING_SIDE
             face_edges[f, k] = e
             if edge_faces[e, 0] < 0:
                 edge_faces[e, 0] = f
@@ -105,18 +138,19 @@ def side_table(faces, edges, n_v, xy, min_area2):
                 edge_faces[e, 1] = f
             else:
                 info[0] = e
-                return THIRD_FACE, info, face_edges, edge_faces, flat
+                return THIRD_FACE
     for f in range(n_f):
         for k in range(3):
             flat[f, k, 0] = xy[faces[f, k], 0]
             flat[f, k, 1] = xy[faces[f, k], 1]
+            flat[f, k, 2] = 0.0
     for f in range(n_f):
         area2 = ((flat[f, 1, 0] - flat[f, 0, 0]) * (flat[f, 2, 1] - flat[f, 0, 1])
                  - (flat[f, 1, 1] - flat[f, 0, 1]) * (flat[f, 2, 0] - flat[f, 0, 0]))
         if area2 < min_area2:
             info[0] = f
-            return CLOCKWISE, info, face_edges, edge_faces, flat
-    return OK, info, face_edges, edge_faces, flat
+            return CLOCKWISE
+    return OK
 
 
 @njit(cache=True)
@@ -202,9 +236,10 @@ def _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info):
 
 
 @njit(cache=True)
-def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, has_parent, piece_in, has_piece, xy,
-                min_len2):
-    """The crease tree of a net: (code, info (3,), parent, crease, order, piece, axis, short, creases).
+def _crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, has_parent, piece_in, has_piece, xy,
+                min_len2, info, parent, crease, order, piece, axis, short, creases):
+    """The crease tree of a net; returns (error code, len(short), len(creases)) and fills info (3,),
+    parent, crease, order, piece (F,), axis (F, 2), short and creases (F,, the first entries).
 
     kind (E,): assignment kind of every edge, cuts below n_cut. parent_in (F,) the given parents (has_parent), else a BFS over the non-cut edges; piece_in
     (F,) the given pieces (has_piece), else one per tree. order (F,) BFS from the roots (ascending),
@@ -220,20 +255,17 @@ def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, ha
     cut = np.empty(n_e, dtype=np.bool_)
     for e in range(n_e):
         cut[e] = kind[e] < n_cut
-    info = np.full(3, -1, dtype=np.int64)
-    crease = np.full(n_f, -1, dtype=np.int64)
-    order = np.empty(n_f, dtype=np.int64)
-    piece = np.full(n_f, -1, dtype=np.int64)
-    axis = np.full((n_f, 2), -1, dtype=np.int64)
-    short = np.empty(0, dtype=np.int64)
+    crease[:] = -1
+    piece[:] = -1
+    axis[:] = -1
     if has_parent:
-        parent = parent_in.copy()
+        parent[:] = parent_in
         code = _parent_creases(parent, face_edges, cut, crease, info)
     else:
-        parent = np.full(n_f, -1, dtype=np.int64)
+        parent[:] = -1
         code = _bfs_creases(edge_faces, cut, piece_in, has_piece, parent, crease, info)
     if code != OK:
-        return code, info, parent, crease, order, piece, axis, short, short
+        return code, 0, 0
     # children lists (CSR, face order) and the BFS order from the roots
     ptr = np.zeros(n_f + 1, dtype=np.int64)
     for f in range(n_f):
@@ -273,15 +305,15 @@ def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, ha
             if tree_of[f] < 0:
                 info[0] = f
                 break
-        return CYCLE, info, parent, crease, order, piece, axis, short, short
+        return CYCLE, 0, 0
     if has_piece:
-        piece = piece_in
+        piece[:] = piece_in
         for f in range(n_f):
             if parent[f] >= 0 and piece[f] != piece[parent[f]]:
                 info[0] = f
-                return PARENT_PIECE, info, parent, crease, order, piece, axis, short, short
+                return PARENT_PIECE, 0, 0
         roots = np.flatnonzero(parent < 0)
-        by_piece = np.argsort(piece[roots], kind="mergesort")  # roots of one piece stay ascending
+        by_piece = np.argsort(piece[roots], kind="mergesort") if n_roots > 1 else roots  # a piece's roots stay ascending
         for r in range(1, roots.shape[0]):
             a = roots[by_piece[r - 1]]
             b = roots[by_piece[r]]
@@ -289,8 +321,8 @@ def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, ha
                 info[0] = piece[a]
                 info[1] = a
                 info[2] = b
-                return PIECE_ROOTS, info, parent, crease, order, piece, axis, short, short
-    flags = np.zeros(n_f, dtype=np.bool_)
+                return PIECE_ROOTS, 0, 0
+    n_short = 0
     is_crease = np.zeros(n_e, dtype=np.bool_)
     for f in range(n_f):
         p = parent[f]
@@ -315,9 +347,14 @@ def crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, ha
         dy = xy[u, 1] - xy[v, 1]
         d2 = dx * dx + dy * dy
         if not (d2 > min_len2 and d2 > 1e-280):  # tiny squares lose precision: leave them to the exact check
-            flags[f] = True
-    # (a crease joins one child to its parent: no repeats)
-    return OK, info, parent, crease, order, piece, axis, np.flatnonzero(flags), np.flatnonzero(is_crease)
+            short[n_short] = f
+            n_short += 1
+    n_creases = 0
+    for e in range(n_e):  # (a crease joins one child to its parent: no repeats)
+        if is_crease[e]:
+            creases[n_creases] = e
+            n_creases += 1
+    return OK, n_short, n_creases
 
 
 @njit(cache=True)
@@ -333,7 +370,7 @@ def extent(pts):
 
 
 @njit(cache=True)
-def fold_angle_errors(deg, kind, n_cut, mountain, valley, goal):
+def _fold_angle_errors(deg, kind, n_cut, mountain, valley, goal):
     """First non-cut edge (kind >= n_cut) whose fold angle deg (E,) is not within [-180, 180] (nan
     and inf included) or has the wrong sign for a mountain (<= 0) / valley (>= 0): (edge, out of
     range), (-1, False) for none. Sets goal[e] = 0 on the cut edges."""

@@ -20,6 +20,7 @@ from typing import Sequence
 import numpy as np
 
 from . import _foldfile_kernels as FK
+from .mesh import vector_norm
 from .unfold import Net
 
 FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F", fold angle 0)
@@ -32,18 +33,19 @@ def _piece_offsets(lo: np.ndarray, hi: np.ndarray, gap: float) -> np.ndarray:
     n_p = len(lo)
     size = (hi - lo).tolist()
     lo = lo.tolist()
-    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5)
-    offsets = np.zeros((n_p, 2))
+    # (the row width only matters once a shelf holds a piece: not for a single piece)
+    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5) if n_p > 1 else 0.0
+    offsets = [None] * n_p
     x = y = shelf = 0.0
     # a handful of pieces: plain Python over lists is cheaper than numpy here
-    for p in sorted(range(n_p), key=lambda i: -size[i][1]):
+    for p in sorted(range(n_p), key=lambda i: -size[i][1]) if n_p > 1 else (0,):
         w, h = size[p]
         if x > 0 and x + w > row_width:
             x, y, shelf = 0.0, y + shelf + gap, 0.0
         offsets[p] = (x - lo[p][0], -(y + h) - lo[p][1])
         x += w + gap
         shelf = max(shelf, h)
-    return offsets
+    return np.array(offsets)
 
 
 def _joined(parts: list[np.ndarray]) -> list:
@@ -61,7 +63,7 @@ def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | 
                                      n.coords, n.piece, mv_off))
         mv_off += len(n.mesh.vertices)
     # the net vertices' 3D points are the mesh's used vertices: their box is Mesh.bbox_diagonal's
-    scale = max(max(float(np.linalg.norm(extent)) for _, _, _, extent, _, _ in found), 1e-300)
+    scale = max(max(vector_norm(extent) for _, _, _, extent, _, _ in found), 1e-300)
     # Pack all pieces of all components together, so the sheet has no overlaps between pieces either.
     boxes = [(lo, hi) for *_, lo, hi in found]
     lo, hi = boxes[0] if len(boxes) == 1 else (np.concatenate([b[0] for b in boxes]), np.concatenate([b[1] for b in boxes]))

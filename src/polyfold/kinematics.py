@@ -28,6 +28,7 @@ from numba import njit
 
 from . import _tree_kernels as TK
 from .errors import PolyfoldError
+from .mesh import vector_norm
 
 CONTACT_TOL = 1e-7  # contact tolerance, as a fraction of the model's bounding-box diagonal
 _AXIS_EPS2 = 1e-24  # a candidate axis is skipped when |axis| < 1e-12 * (product of the lengths crossed)
@@ -368,7 +369,7 @@ def _float_array(value, key: str, n_cols: tuple[int, ...]) -> np.ndarray:
 
 def _bbox_diagonal(pts: np.ndarray) -> float:
     """Bounding-box diagonal of finite points (V, 2 or 3)."""
-    return float(np.linalg.norm(TK.extent(pts))) if len(pts) else 0.0
+    return vector_norm(TK.extent(pts)) if len(pts) else 0.0
 
 
 def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
@@ -417,25 +418,22 @@ def _assignments(assign, n_e: int) -> tuple[list[str], np.ndarray]:
     return assign, np.fromiter(map(_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
 
 
-def _goal_angles(fold: dict, assign: list[str], kind: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray,
-                 faces: np.ndarray, folded: np.ndarray | None) -> np.ndarray:
+def _fold_angles(fold: dict, n_e: int) -> np.ndarray:
+    """'edges_foldAngle' as (E,) float64 degrees (values are checked by the kernel)."""
+    try:
+        deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
+    except (ValueError, TypeError):
+        raise _fail("'edges_foldAngle' is not a list of numbers") from None
+    if deg.shape != (n_e,):
+        raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
+    return deg
+
+
+def _goal_from_folded(assign, kind: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray, faces: np.ndarray,
+                      folded: np.ndarray | None) -> np.ndarray:
+    """Goal angles (E,) of a file without fold angles: from the foldedForm frame, else +-pi by the
+    assignment (0 on cuts)."""
     n_e = len(edges)
-    if "edges_foldAngle" in fold:
-        try:
-            deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
-        except (ValueError, TypeError):
-            raise _fail("'edges_foldAngle' is not a list of numbers") from None
-        if deg.shape != (n_e,):
-            raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
-        goal = -np.radians(deg)
-        e, out_of_range = TK.fold_angle_errors(deg, kind, len(_CUT), _MOUNTAIN, _VALLEY, goal)  # zeroes the cuts
-        if e >= 0:
-            d = deg[e]
-            if out_of_range:
-                raise _fail(f"edge {e} has fold angle {d} (must be within [-180, 180] degrees)")
-            raise _fail(f"edge {e} is a {'mountain' if assign[e] == 'M' else 'valley'} with fold angle {d} "
-                        "(FOLD: valley positive, mountain negative)")
-        return goal
     goal = np.zeros(n_e)
     is_cut = kind < len(_CUT)
     for e in range(n_e):  # files without fold angles only (net_to_fold always writes them)
@@ -457,9 +455,18 @@ def _goal_angles(fold: dict, assign: list[str], kind: np.ndarray, edges: np.ndar
     return goal
 
 
+_SIDE_ERRORS = {  # messages of the edge-table codes of _tree_kernels (info, then the edge's vertex pair)
+    TK.BAD_EDGE: "edge {0} has invalid vertices {pair}",
+    TK.DUPLICATE_EDGE: "edges {0} and {1} join the same vertices {uv}",
+    TK.MISSING_SIDE: "side {0}-{1} of face {2} is not in 'edges_vertices'",
+    TK.THIRD_FACE: "edge {0} borders more than two faces",
+    TK.CLOCKWISE: "face {0} is clockwise seen from +z (faces must be CCW, outer side up)",
+}
+
+
 def _tree_error(code: int, info: np.ndarray, parent: np.ndarray, piece: np.ndarray, assign: list[str]) -> PolyfoldError:
     """The one-line message of a `_tree_kernels.crease_tree` error code."""
-    a, b, c = (int(x) for x in info)
+    a, b, c = info[:3].tolist()
     if code == TK.INVALID_PARENT:
         return _fail(f"face {a} has invalid parent {b}")
     if code == TK.NO_COMMON_EDGE:
@@ -482,7 +489,8 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     lowest-index face of each piece. Raises PolyfoldError (one line naming the face / edge) when the
     net cannot be folded: non-triangular faces, bad indices, clockwise faces, a parent that is not
     joined by a crease, cycles, pieces inconsistent with the tree, zero-length creases, ...
-    The per-face work is done by the numba kernels of `_tree_kernels` (checks in the same order).
+    The per-face work is one numba kernel (`_tree_kernels.net_tree`); so that it runs once, the
+    later inputs are parsed first and a parse error is raised where its check comes in this order.
     """
     if not isinstance(fold, dict):
         raise _fail("not a FOLD dict")
@@ -505,53 +513,73 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     n_f = len(faces)
     if n_f == 0:
         raise _fail("no faces")
-    out_of_range, repeat = TK.face_errors(faces, n_v)
-    if out_of_range >= 0:
-        raise _fail(f"face {out_of_range} refers to a vertex outside 0..{n_v - 1}")
-    if repeat >= 0:
-        raise _fail(f"face {repeat} repeats a vertex")
-    edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
-    assign, kind = _assignments(fold["edges_assignment"], len(edges))
-    code, info, face_edges, edge_faces, flat = TK.side_table(faces, edges, n_v, xy, -1e-12 * scale * scale)
-    if code != TK.OK:
-        i = info.tolist()
-        raise _fail({
-            TK.BAD_EDGE: lambda: f"edge {i[0]} has invalid vertices {edges[i[0]].tolist()}",
-            TK.DUPLICATE_EDGE: lambda: f"edges {i[0]} and {i[1]} join the same vertices {i[2:]}",
-            TK.MISSING_SIDE: lambda: f"side {i[0]}-{i[1]} of face {i[2]} is not in 'edges_vertices'",
-            TK.THIRD_FACE: lambda: f"edge {i[0]} borders more than two faces",
-            TK.CLOCKWISE: lambda: f"face {i[0]} is clockwise seen from +z (faces must be CCW, outer side up)",
-        }[code]())
 
-    piece_in = None
-    if "polyfold:faces_piece" in fold:
-        piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
-        if len(piece_in) != n_f:
-            raise _fail(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
-    parent_in = None
-    if "polyfold:faces_parent" in fold:
-        parent_in = _int_array(fold, "polyfold:faces_parent", (), "integers")
-        if len(parent_in) != n_f:
-            raise _fail(f"'polyfold:faces_parent' has {len(parent_in)} entries for {n_f} faces")
+    # parsed ahead of their checks (errors kept for later): edges, then the tree, then fold angles
     none = np.empty(0, dtype=np.int64)
-    code, info, parent, crease, order, piece, axis, short, creases = TK.crease_tree(
-        faces, edges, face_edges, edge_faces, kind, len(_CUT), none if parent_in is None else parent_in,
-        parent_in is not None, none if piece_in is None else piece_in, piece_in is not None, xy,
-        (2e-12 * scale) ** 2)
+    edges, kind, assign, parent_in, piece_in, deg = none.reshape(0, 2), none, [], none, none, np.empty(0)
+    stage, late = 1, None
+    try:
+        edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
+        assign, kind = _assignments(fold["edges_assignment"], len(edges))
+        stage = 2
+        if "polyfold:faces_piece" in fold:
+            piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
+            if len(piece_in) != n_f:
+                raise _fail(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
+        if "polyfold:faces_parent" in fold:
+            parent_in = _int_array(fold, "polyfold:faces_parent", (), "integers")
+            if len(parent_in) != n_f:
+                raise _fail(f"'polyfold:faces_parent' has {len(parent_in)} entries for {n_f} faces")
+        stage = 3
+        if "edges_foldAngle" in fold:
+            deg = _fold_angles(fold, len(edges))
+            stage = 4
+    except Exception as exc:  # noqa: BLE001 (raised below, after the checks that come first)
+        late = exc
+    n_e = len(edges)
+    info = np.empty(4, dtype=np.int64)
+    face_edges, edge_faces, flat = np.empty((n_f, 3), dtype=np.int64), np.empty((n_e, 2), dtype=np.int64), np.empty((n_f, 3, 3))
+    parent, crease, order = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
+    piece, short, creases = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
+    axis = np.empty((n_f, 2), dtype=np.int64)
+    goal = -np.radians(deg) if stage == 4 else np.zeros(n_e)
+    code, n_short, n_creases, bad_angle, out_of_range = TK.net_tree(
+        faces, n_v, edges, kind, len(_CUT), xy, -1e-12 * scale * scale, parent_in, piece_in, (2e-12 * scale) ** 2,
+        _MOUNTAIN, _VALLEY, deg, stage, info, face_edges, edge_faces, flat, parent, crease, order, piece, axis, short,
+        creases, goal)
+    i = info.tolist()
+    if code in (TK.FACE_OUT_OF_RANGE, TK.FACE_REPEAT):
+        raise _fail(f"face {i[0]} refers to a vertex outside 0..{n_v - 1}" if code == TK.FACE_OUT_OF_RANGE
+                    else f"face {i[0]} repeats a vertex")
+    if stage < 2:
+        raise late
+    if code in _SIDE_ERRORS:
+        raise _fail(_SIDE_ERRORS[code].format(*i, pair=edges[i[0]].tolist() if code == TK.BAD_EDGE else None, uv=i[2:]))
+    if stage < 3:
+        raise late
     if code != TK.OK:
-        raise _tree_error(code, info, parent, piece_in if piece_in is not None else piece, assign)
-    for f in short.tolist():  # the exact test (as always) of the creases the kernel could not clear
+        raise _tree_error(code, info, parent, piece_in if len(piece_in) else piece, assign)
+    for f in short[:n_short].tolist():  # the exact test (as always) of the creases the kernel could not clear
         p, e = int(parent[f]), int(crease[f])
         u, v = edges[e]
         if not np.linalg.norm(xy[u] - xy[v]) > 1e-12 * scale:
             raise _fail(f"crease edge {e} (between faces {p} and {f}) has zero length")
-
-    goal = _goal_angles(fold, assign, kind, edges, edge_faces, faces, folded)
+    if late is not None:
+        raise late
+    if bad_angle >= 0:
+        d = deg[bad_angle]
+        if out_of_range:
+            raise _fail(f"edge {bad_angle} has fold angle {d} (must be within [-180, 180] degrees)")
+        raise _fail(f"edge {bad_angle} is a {'mountain' if assign[bad_angle] == 'M' else 'valley'} with fold angle {d} "
+                    "(FOLD: valley positive, mountain negative)")
+    if stage < 4:  # no fold angles in the file: from the foldedForm, else +-180 degrees
+        goal = _goal_from_folded(assign, kind, edges, edge_faces, faces, folded)
     return FoldTree(
         flat=flat, faces=faces, order=order, parent=parent, crease=crease, axis=axis,
-        piece=np.ascontiguousarray(piece, dtype=np.int64), goal=goal, creases=creases, scale=scale,
+        piece=piece, goal=goal, creases=creases[:n_creases], scale=scale,
         tol=contact_tol * scale, folded=folded,
     )
+
 
 
 # --------------------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@ from outside), negative on reflex edges, 0 on flat ones.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -130,6 +131,12 @@ def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     tri = vertices[faces]
     return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+
+
+def vector_norm(v: np.ndarray) -> float:
+    """np.linalg.norm(v) of a 1-D float64 vector, bit for bit (the sqrt of v.dot(v)), without its
+    general-case overhead (small meshes call it per heuristic and per net)."""
+    return math.sqrt(v.dot(v))
 
 
 def row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ import numpy as np
 
 from . import _unfold_kernels as K
 from . import _unfold_setup as S
-from .mesh import Mesh, row_dots
+from .mesh import Mesh, row_dots, vector_norm
 from .overlap import overlapping_pairs
 
 METHODS = ("auto", "ga", "steepest-edge", "flat-tree", "unflat-tree", "min-perimeter", "max-perimeter", "random")
@@ -98,7 +98,7 @@ class UnfoldProblem:
         inner, adj_ptr, adj_face, adj_edge, e1, e2, local, edge_vec, edge_len, box = S.problem_arrays(
             mesh.vertices, mesh.faces, topo.edges, topo.edge_faces)
         local[:, 2, 0] = row_dots(e2, e1) / local[:, 1, 0]
-        diagonal = float(np.linalg.norm(box)) if mesh.n_vertices else mesh.bbox_diagonal
+        diagonal = vector_norm(box) if mesh.n_vertices else mesh.bbox_diagonal
         return cls(
             mesh=mesh,
             adj_ptr=adj_ptr,
@@ -154,7 +154,7 @@ def local_frames(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def _random_direction(rng: np.random.Generator) -> np.ndarray:
     c = rng.normal(size=3)
-    return c / np.linalg.norm(c)
+    return c / vector_norm(c)
 
 
 def flat_tree_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
