@@ -68,11 +68,15 @@ def test_weight_rules_match_lexsort(seed):
         keep = mask[v]
         keys = np.round(rng.random(int(keep.sum())), 1)  # ties
         assert S.incident_count(inner, edges, mask) == len(keys)
+        hyperbolic = rng.random(n_v) < 0.3
         order = np.lexsort((keys, v[keep]))
         vs, es = v[keep][order], e[keep][order]
         rank = np.arange(len(vs)) - np.searchsorted(vs, vs)
         want = np.zeros(len(edges))
         want[es[rank < count]] = 1.0
         got = np.zeros(len(edges))
-        S.pick_random_incident(inner, edges, mask, count, keys, got)
+        uncut, n_next = S.pick_random_incident(inner, edges, mask, count, keys, got, hyperbolic)
         assert np.array_equal(got, want)
+        chosen = np.zeros(n_v, dtype=bool)
+        chosen[edges[got >= 1.0].reshape(-1)] = True
+        assert np.array_equal(uncut, ~chosen & ~hyperbolic) and n_next == S.incident_count(inner, edges, uncut)

@@ -1,7 +1,7 @@
 """numba kernels of `foldfile.net_to_fold`: net vertices, piece boxes and net edges of one Net.
 
-Exact operations only (gathers, sums of two numbers, min / max), so the FOLD dict is bitwise the
-one numpy's formulas gave; degrees stay in numpy.
+Exact operations only (gathers, sums of two numbers, min / max, and x * (180 / pi), which is how
+np.degrees rounds), so the FOLD dict is bitwise the one numpy's formulas gave.
 """
 
 from __future__ import annotations
@@ -107,8 +107,9 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
     first vertex, face, piece and mesh edge in the file. Out: xy (V, 2) net vertex positions;
     faces (F, 3), piece (F,), parent (F,) (-1 at roots); for every net edge (the first face side,
     in side order f*3 + k, of each net vertex pair; a cut mesh edge gives two): its net vertices
-    (S, 2), mesh edge (S,), fold angle rho (S,) where it is a mountain or valley (0 elsewhere),
-    that mask (S,) and its kind (S,) 0 cut, 1 flat (|rho| < flat_eps), 2 mountain (rho > 0), 3 valley.
+    (S, 2), mesh edge (S,), FOLD fold angle (S,) (degrees, valley positive: -degrees(rho) on
+    mountains and valleys, 0 elsewhere) and kind (S,) 0 cut, 1 flat (|rho| < flat_eps), 2 mountain
+    (rho > 0), 3 valley.
     """
     n_f = corner_v.shape[0]
     xy = np.zeros((n_v, 2))
@@ -154,8 +155,7 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
             crease[parent_edge[f]] = True
     ev = np.empty((count, 2), dtype=np.int64)
     em = np.empty(count, dtype=np.int64)
-    rho = np.zeros(count)
-    folds = np.zeros(count, dtype=np.bool_)
+    angle = np.zeros(count)
     kind = np.zeros(count, dtype=np.int64)
     j = 0
     for s in range(n_s):
@@ -171,7 +171,6 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
         if crease[e]:
             kind[j] = 1 if abs(r) < flat_eps else (2 if r > 0 else 3)
         if kind[j] >= 2:
-            rho[j] = r
-            folds[j] = True
+            angle[j] = -(r * (180.0 / np.pi))
         j += 1
-    return xy, faces, piece_out, parent_out, ev, em, rho, folds, kind
+    return xy, faces, piece_out, parent_out, ev, em, angle, kind

@@ -118,7 +118,8 @@ def corner_vectors(vertices, faces):
 
 @njit(cache=True)
 def scatter_sums(n, index, values):
-    """out (n,): out[index[i]] += values[i] in order of i (the sums of np.add.at)."""
+    """out (n,): out[index[i]] += values[i] in order of i (the sums of np.add.at; np.bincount's
+    differ in the last bits)."""
     out = np.zeros(n)
     for i in range(index.shape[0]):
         out[index[i]] += values[i]

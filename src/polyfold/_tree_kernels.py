@@ -45,7 +45,7 @@ def net_tree(faces, n_v, edges, kind, n_cut, xy, min_area2, parent_in, piece_in,
     crease tree (`_crease_tree`), and the fold angles (`_fold_angle_errors`, reported separately:
     fold_tree checks zero-length creases before them). Fills info (4,), face_edges (F, 3),
     edge_faces (E, 2), flat (F, 3, 3), parent, crease, order, piece, short, creases (F,), axis
-    (F, 2) and, at stage 4, goal (E,) (holding -radians(deg) on entry: zeroed on the cuts).
+    (F, 2) and, at stage 4, goal (E,) (-radians(deg), 0 on the cuts).
     """
     info[:] = -1
     for f in range(faces.shape[0]):
@@ -373,13 +373,15 @@ def extent(pts):
 def _fold_angle_errors(deg, kind, n_cut, mountain, valley, goal):
     """First non-cut edge (kind >= n_cut) whose fold angle deg (E,) is not within [-180, 180] (nan
     and inf included) or has the wrong sign for a mountain (<= 0) / valley (>= 0): (edge, out of
-    range), (-1, False) for none. Sets goal[e] = 0 on the cut edges."""
+    range), (-1, False) for none. Fills goal (E,): -radians(deg), 0 on the cut edges (np.radians
+    is x * (pi / 180) too: the same bits)."""
     first = -1
     out_of_range = False
     for e in range(deg.shape[0]):
         if kind[e] < n_cut:
             goal[e] = 0.0
             continue
+        goal[e] = -(deg[e] * (np.pi / 180.0))
         if first >= 0:
             continue
         d = deg[e]

@@ -14,7 +14,7 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy")  # degenerate input gives nan / inf as numpy does
-def problem_arrays(vertices, faces, edges, edge_faces):
+def problem_arrays(vertices, faces, edges, edge_faces, hyperbolic):
     """Arrays of `unfold.UnfoldProblem` that need no numpy-rounded dot products.
 
     In: vertices (n, 3), faces (F, 3), edges (E, 2), edge_faces (E, 2) of the mesh topology.
@@ -23,7 +23,8 @@ def problem_arrays(vertices, faces, edges, edge_faces):
     face 1, both ascending, as a stable argsort of the concatenation); e1, e2 (F, 3) the sides
     from corner 0; frames (F, 3, 2) local frames with |e1| and |e1 x e2| / |e1| filled (the x of
     corner 2 needs a dot product); edge_vec (E, 3) edges[e, 1] - edges[e, 0] and edge_len (E,);
-    box (3,) extent of the vertices used by faces (all vertices when there are no faces).
+    box (3,) extent of the vertices used by faces (all vertices when there are no faces);
+    the number of interior half-edges at hyperbolic vertices (the random-edge rule's first draw).
     """
     n_f = faces.shape[0]
     n_e = edges.shape[0]
@@ -62,7 +63,7 @@ def problem_arrays(vertices, faces, edges, edge_faces):
         edge_len[e] = np.sqrt(edge_vec[e, 0] * edge_vec[e, 0] + edge_vec[e, 1] * edge_vec[e, 1]
                               + edge_vec[e, 2] * edge_vec[e, 2])
     box = _used_extent(vertices, faces)
-    return inner, adj_ptr, adj_face, adj_edge, e1, e2, frames, edge_vec, edge_len, box
+    return inner, adj_ptr, adj_face, adj_edge, e1, e2, frames, edge_vec, edge_len, box, incident_count(inner, edges, hyperbolic)
 
 
 @njit(cache=True, error_model="numpy")
@@ -127,12 +128,14 @@ def incident_count(inner, edges, want):
 
 
 @njit(cache=True)
-def pick_random_incident(inner, edges, want, count, keys, weights):
+def pick_random_incident(inner, edges, want, count, keys, weights, hyperbolic):
     """Set weights[e] = 1 for up to `count` random interior edges e at every vertex in `want`.
 
     The candidates are the interior half-edges at wanted vertices, all first endpoints then all
     second ones (edge order); keys (candidates,) are their random draws. A vertex takes its
     `count` (1 or 2) smallest keys, ties by candidate position: np.lexsort((keys, vertex)) order.
+    Returns the next stage's (want, candidates): the vertices (n,) that are neither hyperbolic
+    nor an endpoint of an edge with weight >= 1 now, and their number of candidate half-edges.
     """
     n_v = want.shape[0]
     best_key = np.full((n_v, 2), np.inf)
@@ -158,10 +161,12 @@ def pick_random_incident(inner, edges, want, count, keys, weights):
         for s in range(count):
             if best_edge[v, s] >= 0:
                 weights[best_edge[v, s]] = 1.0
+    uncut = _uncut_elliptic(edges, weights, hyperbolic)
+    return uncut, incident_count(inner, edges, uncut)
 
 
 @njit(cache=True)
-def uncut_elliptic(edges, weights, hyperbolic):
+def _uncut_elliptic(edges, weights, hyperbolic):
     """Vertices (n,) bool that are not hyperbolic and not an endpoint of an edge with weight >= 1."""
     out = ~hyperbolic
     for e in range(edges.shape[0]):

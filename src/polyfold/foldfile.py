@@ -75,11 +75,9 @@ def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | 
     for c, (net, (corner_v, mv, folded, _, lo, _)) in enumerate(zip(nets, found)):
         mesh = net.mesh
         topo = mesh.topology
-        xy, fv, piece, parent, ev, em, rho, folds, kind = FK.net_edges(
+        xy, fv, piece, parent, ev, em, angle, kind = FK.net_edges(
             corner_v, len(mv), net.coords, offsets[p_off:p_off + len(lo)], net.piece, topo.face_edges, net.parent,
             net.parent_edge, mesh.fold_angles, FLAT_EPS, v_off, f_off, p_off, e_off)
-        angle = np.degrees(rho)
-        np.negative(angle, out=angle, where=folds)  # FOLD: valley positive; 0 (not -0) on cuts and flat creases
         coords2d.append(xy)
         coords3d.append(folded)
         mesh_vertex.append(mv)

@@ -542,7 +542,7 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     parent, crease, order = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
     piece, short, creases = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
     axis = np.empty((n_f, 2), dtype=np.int64)
-    goal = -np.radians(deg) if stage == 4 else np.zeros(n_e)
+    goal = np.empty(n_e)
     code, n_short, n_creases, bad_angle, out_of_range = TK.net_tree(
         faces, n_v, edges, kind, len(_CUT), xy, -1e-12 * scale * scale, parent_in, piece_in, (2e-12 * scale) ** 2,
         _MOUNTAIN, _VALLEY, deg, stage, info, face_edges, edge_faces, flat, parent, crease, order, piece, axis, short,

@@ -90,13 +90,15 @@ class UnfoldProblem:
     interior_edges: np.ndarray = field(default=None)  # type: ignore[assignment]
     edge_vec: np.ndarray = field(default=None)  # type: ignore[assignment]
     edge_len: np.ndarray = field(default=None)  # type: ignore[assignment]
+    hyperbolic_candidates: int = 0  # interior half-edges at hyperbolic vertices
 
     @classmethod
     def from_mesh(cls, mesh: Mesh, base: int = 0) -> "UnfoldProblem":
         topo = mesh.topology
         # one numba pass for everything but the numpy-rounded dot products (see _unfold_setup)
-        inner, adj_ptr, adj_face, adj_edge, e1, e2, local, edge_vec, edge_len, box = S.problem_arrays(
-            mesh.vertices, mesh.faces, topo.edges, topo.edge_faces)
+        hyperbolic = mesh.hyperbolic
+        inner, adj_ptr, adj_face, adj_edge, e1, e2, local, edge_vec, edge_len, box, candidates = S.problem_arrays(
+            mesh.vertices, mesh.faces, topo.edges, topo.edge_faces, hyperbolic)
         local[:, 2, 0] = row_dots(e2, e1) / local[:, 1, 0]
         diagonal = vector_norm(box) if mesh.n_vertices else mesh.bbox_diagonal
         return cls(
@@ -105,12 +107,13 @@ class UnfoldProblem:
             adj_face=adj_face,
             adj_edge=adj_edge,
             local=local,
-            hyperbolic=mesh.hyperbolic,
+            hyperbolic=hyperbolic,
             tol=1e-9 * max(diagonal, 1e-300),
             base=base,
             interior_edges=inner,
             edge_vec=edge_vec,
             edge_len=edge_len,
+            hyperbolic_candidates=candidates,
         )
 
     def evaluate(self, weights: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -206,11 +209,10 @@ def random_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.
     edges = problem.mesh.topology.edges
     inner = problem.interior_edges
     w = np.full(len(edges), 0.01)
-    for want, count in ((problem.hyperbolic, 2), (None, 1)):
-        if want is None:
-            want = S.uncut_elliptic(edges, w, problem.hyperbolic)
-        keys = rng.random(S.incident_count(inner, edges, want))  # one draw per candidate half-edge
-        S.pick_random_incident(inner, edges, want, count, keys, w)
+    # one random draw per candidate half-edge (an interior edge at a wanted vertex)
+    want, n = S.pick_random_incident(inner, edges, problem.hyperbolic, 2, rng.random(problem.hyperbolic_candidates), w,
+                                     problem.hyperbolic)
+    S.pick_random_incident(inner, edges, want, 1, rng.random(n), w, problem.hyperbolic)
     return w
 
 
@@ -517,7 +519,9 @@ def _net_from_tree(problem: UnfoldProblem, parent, parent_edge, order, coords, c
     if cut is not None and cut.any():
         parent[cut] = -1
         parent_edge[cut] = -1
-    piece = K.piece_labels(order, parent)
+        piece = K.piece_labels(order, parent)
+    else:  # one spanning tree: one piece
+        piece = np.zeros(len(parent), dtype=np.int64)
     return Net(mesh=problem.mesh, parent=parent, parent_edge=parent_edge, order=order.copy(), coords=coords, piece=piece)
 
 
