@@ -104,7 +104,7 @@ def test_fallback_splits_into_overlap_free_pieces(models_dir):
     mesh = component(models_dir, "bumpy-528")
     problem = UnfoldProblem.from_mesh(mesh)
     rng = np.random.default_rng(0)
-    parent, parent_edge, order, coords = problem.decode(HEURISTICS["flat-tree"](mesh, rng))
+    parent, parent_edge, order, coords = problem.decode(HEURISTICS["flat-tree"](problem, rng))
     pairs = problem.overlaps(coords, parent)
     assert len(pairs) > 0  # a plain flat tree of this bumpy mesh overlaps
     cut = split_into_pieces(parent, parent_edge, order, pairs)

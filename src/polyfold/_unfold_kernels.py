@@ -401,3 +401,33 @@ def greedy_cover(ptr, members, n):
             for m in range(ptr[r], ptr[r + 1]):
                 count[members[m]] -= 1
     return chosen
+
+
+@njit(cache=True)
+def decode_tree(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges, local):
+    """Genome (E,) -> (reached, parent, parent_edge, order, coords (F, 3, 2)): Prim's tree and its
+    layout. coords is only laid out when every face is reached (reached == F)."""
+    n = faces.shape[0]
+    parent = np.empty(n, np.int64)
+    parent_edge = np.empty(n, np.int64)
+    order = np.empty(n, np.int64)
+    coords = np.empty((n, 3, 2))
+    reached = prim_tree(weights, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+    if reached == n:
+        layout_tree(order, parent, parent_edge, faces, face_edges, local, coords)
+    return reached, parent, parent_edge, order, coords
+
+
+@njit(cache=True)
+def piece_labels(order, parent):
+    """Piece (F,) of every face: roots numbered 0, 1, ... in `order` (parents first), every other
+    face in its parent's piece."""
+    piece = np.full(parent.shape[0], -1, dtype=np.int64)
+    count = 0
+    for f in order:
+        if parent[f] < 0:
+            piece[f] = count
+            count += 1
+        else:
+            piece[f] = piece[parent[f]]
+    return piece

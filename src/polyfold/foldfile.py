@@ -18,145 +18,82 @@ import os
 from typing import Sequence
 
 import numpy as np
-from numba import njit
 
+from . import _foldfile_kernels as FK
+from .mesh import vector_norm
 from .unfold import Net
 
 FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F", fold angle 0)
 PIECE_GAP = 0.05  # gap between packed pieces, as a fraction of the model's bounding-box diagonal
-_ASSIGNMENTS = np.array(["B", "F", "M", "V"])  # edges_assignment by kind: cut, flat, mountain, valley
+_ASSIGNMENTS = ("B", "F", "M", "V")  # edges_assignment by kind: cut, flat, mountain, valley
 
 
-@njit(cache=True)
-def _corner_labels(faces, parent, parent_edge, edges):
-    """Net vertex (F*3,) of every face corner, numbered in order of first corner (row-major).
-
-    A child's corners at the ends of its crease are joined to its parent's corners there; each
-    child corner points to at most one parent corner, so the joins form a forest over the corners
-    and a net vertex is one of its trees (found by walking up to the tree's root).
-    """
-    n = faces.shape[0]
-    link = np.arange(3 * n)
-    for f in range(n):
-        p = parent[f]
-        if p < 0:
-            continue
-        for end in range(2):
-            v = edges[parent_edge[f], end]
-            kc = 0
-            while kc < 2 and faces[f, kc] != v:
-                kc += 1
-            kp = 0
-            while kp < 2 and faces[p, kp] != v:
-                kp += 1
-            link[3 * f + kc] = 3 * p + kp
-    label = np.full(3 * n, -1)
-    count = 0
-    for c in range(3 * n):
-        r = c
-        while link[r] != r:
-            r = link[r]
-        if label[r] < 0:
-            label[r] = count
-            count += 1
-        label[c] = label[r]
-    return label
-
-
-def _net_vertices(net: Net) -> np.ndarray:
-    """Net vertex id (F, 3) of every face corner: corners of one mesh vertex are the same net
-    vertex when the faces are joined by creases around it."""
-    faces = net.mesh.faces
-    return _corner_labels(faces, net.parent, net.parent_edge, net.mesh.topology.edges).reshape(len(faces), 3)
-
-
-def _piece_offsets(coords: np.ndarray, piece: np.ndarray, gap: float) -> np.ndarray:
-    """Shelf-pack the pieces' bounding boxes: translation (P, 2) per piece."""
-    n_p = int(piece.max()) + 1
-    # boxes by segments of the faces sorted by piece (every piece has faces; faster than ufunc.at)
-    order = np.argsort(piece, kind="stable")
-    pts = coords[order].reshape(-1, 2)
-    start = 3 * np.searchsorted(piece[order], np.arange(n_p))
-    lo = np.minimum.reduceat(pts, start)
-    hi = np.maximum.reduceat(pts, start)
+def _piece_offsets(lo: np.ndarray, hi: np.ndarray, gap: float) -> np.ndarray:
+    """Shelf-pack the pieces' bounding boxes (lo, hi (P, 2)): translation (P, 2) per piece."""
+    n_p = len(lo)
     size = (hi - lo).tolist()
     lo = lo.tolist()
-    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5)
-    offsets = np.zeros((n_p, 2))
+    # (the row width only matters once a shelf holds a piece: not for a single piece)
+    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5) if n_p > 1 else 0.0
+    offsets = [None] * n_p
     x = y = shelf = 0.0
     # a handful of pieces: plain Python over lists is cheaper than numpy here
-    for p in sorted(range(n_p), key=lambda i: -size[i][1]):
+    for p in sorted(range(n_p), key=lambda i: -size[i][1]) if n_p > 1 else (0,):
         w, h = size[p]
         if x > 0 and x + w > row_width:
             x, y, shelf = 0.0, y + shelf + gap, 0.0
         offsets[p] = (x - lo[p][0], -(y + h) - lo[p][1])
         x += w + gap
         shelf = max(shelf, h)
-    return offsets
+    return np.array(offsets)
 
 
-def _first_sides(side_v: np.ndarray, n_v: int) -> np.ndarray:
-    """Indices (ascending) of the face sides (S, 2) that are net edges: the first side of each net
-    vertex pair (a crease is shared by two faces; each side of a cut edge is an edge of its own)."""
-    u, v = side_v[:, 0], side_v[:, 1]
-    key = np.minimum(u, v) * n_v + np.maximum(u, v)
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    first = np.ones(len(key), dtype=bool)
-    first[1:] = ks[1:] != ks[:-1]
-    return np.sort(order[first])
+def _joined(parts: list[np.ndarray]) -> list:
+    """The parts (one per component) as one list (a single part is not copied first)."""
+    return (parts[0] if len(parts) == 1 else np.concatenate(parts)).tolist()
 
 
 def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | None = None) -> dict:
     """FOLD dict of the nets of one mesh (one Net per component, each with one or more pieces)."""
+    # per net (numba): net vertices, numbered on from the previous nets', their 3D points, piece boxes
+    found = []
+    mv_off = 0
+    for n in nets:
+        found.append(FK.net_vertices(n.mesh.faces, n.parent, n.parent_edge, n.mesh.topology.edges, n.mesh.vertices,
+                                     n.coords, n.piece, mv_off))
+        mv_off += len(n.mesh.vertices)
+    # the net vertices' 3D points are the mesh's used vertices: their box is Mesh.bbox_diagonal's
+    scale = max(max(vector_norm(extent) for _, _, _, extent, _, _ in found), 1e-300)
+    # Pack all pieces of all components together, so the sheet has no overlaps between pieces either.
+    boxes = [(lo, hi) for *_, lo, hi in found]
+    lo, hi = boxes[0] if len(boxes) == 1 else (np.concatenate([b[0] for b in boxes]), np.concatenate([b[1] for b in boxes]))
+    offsets = _piece_offsets(lo, hi, PIECE_GAP * scale)
     coords2d, coords3d, mesh_vertex = [], [], []
     faces_v, faces_src, faces_piece, faces_comp, faces_parent = [], [], [], [], []
     edges_v, edges_a, edges_ang, edges_mesh = [], [], [], []
-    v_off = f_off = p_off = e_off = mv_off = 0
-    corners, mesh_vs = [], []
-    for net in nets:
-        corner_v = _net_vertices(net)
-        mv = np.zeros(int(corner_v.max()) + 1, dtype=np.int64)
-        mv[corner_v.reshape(-1)] = net.mesh.faces.reshape(-1)
-        corners.append(corner_v)
-        mesh_vs.append(mv)
-        coords3d.append(net.mesh.vertices[mv])
-    # the net vertices' 3D points are the mesh's used vertices: their box is Mesh.bbox_diagonal's
-    scale = max(max(float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) for p in coords3d), 1e-300)
-    # Pack all pieces of all components together, so the sheet has no overlaps between pieces either.
-    n_pieces = [n.n_pieces for n in nets]
-    piece_all = np.concatenate([n.piece + sum(n_pieces[:i]) for i, n in enumerate(nets)])
-    coords_all = np.concatenate([n.coords for n in nets])
-    offsets = _piece_offsets(coords_all, piece_all, PIECE_GAP * scale)
-    for c, (net, corner_v, mv) in enumerate(zip(nets, corners, mesh_vs)):
+    v_off = f_off = p_off = e_off = 0
+    for c, (net, (corner_v, mv, folded, _, lo, _)) in enumerate(zip(nets, found)):
         mesh = net.mesh
         topo = mesh.topology
-        n_v = len(mv)
-        placed = net.coords + offsets[net.piece + p_off][:, None, :]
-        xy = np.zeros((n_v, 2))
-        xy[corner_v.reshape(-1)] = placed.reshape(-1, 2)
+        xy, fv, piece, parent, ev, em, angle, kind = FK.net_edges(
+            corner_v, len(mv), net.coords, offsets[p_off:p_off + len(lo)], net.piece, topo.face_edges, net.parent,
+            net.parent_edge, mesh.fold_angles, FLAT_EPS, v_off, f_off, p_off, e_off)
         coords2d.append(xy)
-        mesh_vertex.append(mv + mv_off)
-        faces_v.append(corner_v + v_off)
+        coords3d.append(folded)
+        mesh_vertex.append(mv)
+        faces_v.append(fv)
         faces_src.append(mesh.face_source)
-        faces_piece.append(net.piece + p_off)
-        faces_comp.append(np.full(mesh.n_faces, c))
-        faces_parent.append(np.where(net.parent >= 0, net.parent + f_off, -1))
-        side_v = corner_v[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)  # (3F, 2) face sides, corner k -> k + 1
-        first = _first_sides(side_v, n_v)
-        ev = side_v[first]
-        em = topo.face_edges.reshape(-1)[first]
-        rho = mesh.fold_angles[em]
-        kind = np.where(net.crease_mask[em], np.where(np.abs(rho) < FLAT_EPS, 1, np.where(rho > 0, 2, 3)), 0)
-        edges_v.append(ev + v_off)
-        edges_a.extend(_ASSIGNMENTS[kind].tolist())
-        edges_ang.append(np.where(kind >= 2, -np.degrees(rho), 0.0))
-        edges_mesh.append(em + e_off)
-        v_off += n_v
+        faces_piece.append(piece)
+        faces_comp.extend([c] * mesh.n_faces)
+        faces_parent.append(parent)
+        edges_v.append(ev)
+        edges_a.extend(map(_ASSIGNMENTS.__getitem__, kind.tolist()))
+        edges_ang.append(angle)
+        edges_mesh.append(em)
+        v_off += len(mv)
         f_off += mesh.n_faces
-        p_off += n_pieces[c]
+        p_off += len(lo)
         e_off += topo.n_edges
-        mv_off += len(mesh.vertices)
     fold = {
         "file_spec": 1.1,
         "file_creator": creator,
@@ -165,24 +102,24 @@ def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | 
         "frame_classes": ["creasePattern"],
         "frame_attributes": ["2D"],
         "frame_unit": "unit",
-        "vertices_coords": np.concatenate(coords2d).tolist(),
-        "faces_vertices": np.concatenate(faces_v).tolist(),
-        "edges_vertices": np.concatenate(edges_v).tolist(),
+        "vertices_coords": _joined(coords2d),
+        "faces_vertices": _joined(faces_v),
+        "edges_vertices": _joined(edges_v),
         "edges_assignment": edges_a,
-        "edges_foldAngle": np.concatenate(edges_ang).tolist(),
-        "polyfold:faces_meshFace": np.concatenate(faces_src).tolist(),
-        "polyfold:faces_piece": np.concatenate(faces_piece).tolist(),
-        "polyfold:faces_component": np.concatenate(faces_comp).tolist(),
-        "polyfold:faces_parent": np.concatenate(faces_parent).tolist(),
-        "polyfold:edges_meshEdge": np.concatenate(edges_mesh).tolist(),
-        "polyfold:vertices_meshVertex": np.concatenate(mesh_vertex).tolist(),
+        "edges_foldAngle": _joined(edges_ang),
+        "polyfold:faces_meshFace": _joined(faces_src),
+        "polyfold:faces_piece": _joined(faces_piece),
+        "polyfold:faces_component": faces_comp,
+        "polyfold:faces_parent": _joined(faces_parent),
+        "polyfold:edges_meshEdge": _joined(edges_mesh),
+        "polyfold:vertices_meshVertex": _joined(mesh_vertex),
         "file_frames": [
             {
                 "frame_classes": ["foldedForm"],
                 "frame_attributes": ["3D"],
                 "frame_inherit": True,
                 "frame_parent": 0,
-                "vertices_coords": np.concatenate(coords3d).tolist(),
+                "vertices_coords": _joined(coords3d),
             }
         ],
     }

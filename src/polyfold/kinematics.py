@@ -21,13 +21,14 @@ The numba kernels take plain arrays so a planner can call them inside its own @n
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
+from . import _tree_kernels as TK
 from .errors import PolyfoldError
+from .mesh import vector_norm
 
 CONTACT_TOL = 1e-7  # contact tolerance, as a fraction of the model's bounding-box diagonal
 _AXIS_EPS2 = 1e-24  # a candidate axis is skipped when |axis| < 1e-12 * (product of the lengths crossed)
@@ -344,7 +345,7 @@ def _int_array(fold: dict, key: str, shape_tail: tuple[int, ...], what: str) -> 
             arr = arr.reshape((0,) + shape_tail)
         if arr.dtype == object or arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
             raise ValueError
-        if not np.issubdtype(arr.dtype, np.integer):
+        if arr.dtype != np.int64 and not np.issubdtype(arr.dtype, np.integer):  # (JSON ints: int64)
             if not np.issubdtype(arr.dtype, np.floating) or not np.all(arr == np.round(arr)):
                 raise ValueError
         return arr.astype(np.int64)
@@ -359,21 +360,25 @@ def _float_array(value, key: str, n_cols: tuple[int, ...]) -> np.ndarray:
         raise _fail(f"{key!r} is not a list of coordinates") from None
     if arr.ndim != 2 or arr.shape[1] not in n_cols:
         raise _fail(f"{key!r} must hold {' or '.join(map(str, n_cols))} coordinates per vertex")
-    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-    if len(bad):
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = np.flatnonzero(~finite.all(axis=1))
         raise _fail(f"{key!r}: vertex {bad[0]} has a non-finite coordinate")
     return arr
 
 
 def _bbox_diagonal(pts: np.ndarray) -> float:
-    return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
+    """Bounding-box diagonal of finite points (V, 2 or 3)."""
+    return vector_norm(TK.extent(pts)) if len(pts) else 0.0
 
 
 def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
     frames = fold.get("file_frames")
     if not frames:
         return None
-    frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frames[0])
+    frame = frames[0]  # the first foldedForm frame, else the first frame
+    if not (isinstance(frame, dict) and "foldedForm" in (frame.get("frame_classes") or [])):
+        frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frame)
     if not isinstance(frame, dict) or "vertices_coords" not in frame:
         return None
     coords = _float_array(frame["vertices_coords"], "file_frames[0].vertices_coords", (3,))
@@ -382,52 +387,56 @@ def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
     return coords
 
 
-def _bfs_tree(n_f: int, neighbours: list[list[tuple[int, int]]], piece_in: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """Parent and crease of every face: BFS over creases from the lowest unvisited face."""
-    parent = np.full(n_f, -1, dtype=np.int64)
-    crease = np.full(n_f, -1, dtype=np.int64)
-    seen = np.zeros(n_f, dtype=bool)
-    for root in range(n_f):
-        if seen[root]:
-            continue
-        seen[root] = True
-        queue = deque([root])
-        while queue:
-            f = queue.popleft()
-            for g, e in neighbours[f]:
-                if seen[g]:
-                    continue
-                if piece_in is not None and piece_in[g] != piece_in[f]:
-                    raise _fail(f"crease edge {e} joins face {f} (piece {piece_in[f]}) to face {g} (piece {piece_in[g]})")
-                seen[g] = True
-                parent[g] = f
-                crease[g] = e
-                queue.append(g)
-    return parent, crease
+def _check_triangles(rows) -> None:
+    """Every face is a sequence of 3 corners (before the corners themselves are parsed)."""
+    # the usual case (lists of 3-lists, as JSON gives) without a Python loop over the faces
+    if type(rows) is list and set(map(type, rows)) <= {list} and set(map(len, rows)) <= {3}:
+        return
+    for f, corners in enumerate(rows):
+        if not isinstance(corners, (list, tuple, np.ndarray)) or len(corners) != 3:
+            raise _fail(f"face {f} is not a triangle (only triangulated nets can be folded)")
 
 
-def _goal_angles(fold: dict, assign: list[str], edges: np.ndarray, edge_faces: np.ndarray, faces: np.ndarray, folded: np.ndarray | None) -> np.ndarray:
+_KNOWN = frozenset(_CUT + _CREASE)
+_KIND = {a: i for i, a in enumerate(_CUT + _CREASE)}  # kind < len(_CUT): a cut
+_MOUNTAIN, _VALLEY = _KIND["M"], _KIND["V"]
+
+
+def _assignments(assign, n_e: int) -> tuple[list[str], np.ndarray]:
+    """Upper-cased assignments and their kinds (E,) int8 (index into _CUT + _CREASE)."""
+    if not isinstance(assign, (list, tuple)) or len(assign) != n_e:
+        raise _fail(f"'edges_assignment' must have one entry per edge ({n_e})")
+    if set(map(type, assign)) <= {str}:
+        try:  # the usual case: all upper-case and known already
+            return assign, np.fromiter(map(_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
+        except KeyError:
+            pass
+    assign = [str(a).upper() for a in assign]
+    for e, a in enumerate(assign):
+        if a not in _KNOWN:
+            raise _fail(f"edge {e} has unknown assignment {a!r}")
+    return assign, np.fromiter(map(_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
+
+
+def _fold_angles(fold: dict, n_e: int) -> np.ndarray:
+    """'edges_foldAngle' as (E,) float64 degrees (values are checked by the kernel)."""
+    try:
+        deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
+    except (ValueError, TypeError):
+        raise _fail("'edges_foldAngle' is not a list of numbers") from None
+    if deg.shape != (n_e,):
+        raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
+    return deg
+
+
+def _goal_from_folded(assign, kind: np.ndarray, edges: np.ndarray, edge_faces: np.ndarray, faces: np.ndarray,
+                      folded: np.ndarray | None) -> np.ndarray:
+    """Goal angles (E,) of a file without fold angles: from the foldedForm frame, else +-pi by the
+    assignment (0 on cuts)."""
     n_e = len(edges)
-    is_cut = np.array([a in _CUT for a in assign], dtype=bool)
-    if "edges_foldAngle" in fold:
-        try:
-            deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
-        except (ValueError, TypeError):
-            raise _fail("'edges_foldAngle' is not a list of numbers") from None
-        if deg.shape != (n_e,):
-            raise _fail(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
-        for e in range(n_e):
-            if is_cut[e]:
-                continue
-            d = deg[e]
-            if not np.isfinite(d) or abs(d) > 180.0:
-                raise _fail(f"edge {e} has fold angle {d} (must be within [-180, 180] degrees)")
-            if (assign[e] == "M" and d > 0) or (assign[e] == "V" and d < 0):
-                raise _fail(f"edge {e} is a {'mountain' if assign[e] == 'M' else 'valley'} with fold angle {d} "
-                            "(FOLD: valley positive, mountain negative)")
-        return np.where(is_cut, 0.0, -np.radians(deg))
     goal = np.zeros(n_e)
-    for e in range(n_e):
+    is_cut = kind < len(_CUT)
+    for e in range(n_e):  # files without fold angles only (net_to_fold always writes them)
         if is_cut[e]:
             continue
         if folded is not None and edge_faces[e, 1] >= 0:
@@ -446,6 +455,33 @@ def _goal_angles(fold: dict, assign: list[str], edges: np.ndarray, edge_faces: n
     return goal
 
 
+_SIDE_ERRORS = {  # messages of the edge-table codes of _tree_kernels (info, then the edge's vertex pair)
+    TK.BAD_EDGE: "edge {0} has invalid vertices {pair}",
+    TK.DUPLICATE_EDGE: "edges {0} and {1} join the same vertices {uv}",
+    TK.MISSING_SIDE: "side {0}-{1} of face {2} is not in 'edges_vertices'",
+    TK.THIRD_FACE: "edge {0} borders more than two faces",
+    TK.CLOCKWISE: "face {0} is clockwise seen from +z (faces must be CCW, outer side up)",
+}
+
+
+def _tree_error(code: int, info: np.ndarray, parent: np.ndarray, piece: np.ndarray, assign: list[str]) -> PolyfoldError:
+    """The one-line message of a `_tree_kernels.crease_tree` error code."""
+    a, b, c = info[:3].tolist()
+    if code == TK.INVALID_PARENT:
+        return _fail(f"face {a} has invalid parent {b}")
+    if code == TK.NO_COMMON_EDGE:
+        return _fail(f"face {a} shares no edge with its parent face {b}")
+    if code == TK.CUT_PARENT_EDGE:
+        return _fail(f"face {a} is joined to its parent face {b} by cut edge {c} (assignment {assign[c]})")
+    if code == TK.PIECE_CREASE:
+        return _fail(f"crease edge {a} joins face {b} (piece {piece[b]}) to face {c} (piece {piece[c]})")
+    if code == TK.CYCLE:
+        return _fail(f"face {a} is on a cycle of 'polyfold:faces_parent' (no path to a root)")
+    if code == TK.PARENT_PIECE:
+        return _fail(f"face {a} (piece {piece[a]}) has its parent face {parent[a]} in piece {piece[parent[a]]}")
+    return _fail(f"piece {a} is not connected by creases (faces {b} and {c} are both roots)")
+
+
 def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     """The FoldTree of a FOLD net (as written by `foldfile.net_to_fold`).
 
@@ -453,6 +489,8 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     lowest-index face of each piece. Raises PolyfoldError (one line naming the face / edge) when the
     net cannot be folded: non-triangular faces, bad indices, clockwise faces, a parent that is not
     joined by a crease, cycles, pieces inconsistent with the tree, zero-length creases, ...
+    The per-face work is one numba kernel (`_tree_kernels.net_tree`); so that it runs once, the
+    later inputs are parsed first and a parse error is raised where its check comes in this order.
     """
     if not isinstance(fold, dict):
         raise _fail("not a FOLD dict")
@@ -469,156 +507,79 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
         bad = np.flatnonzero(np.abs(xy[:, 2]) > 1e-9 * scale)
         if len(bad):
             raise _fail(f"vertex {bad[0]} of the crease pattern is not in the plane z = 0")
-        xy = xy[:, :2]
-    for f, corners in enumerate(fold["faces_vertices"]):
-        if not isinstance(corners, (list, tuple, np.ndarray)) or len(corners) != 3:
-            raise _fail(f"face {f} is not a triangle (only triangulated nets can be folded)")
+        xy = np.ascontiguousarray(xy[:, :2])
+    _check_triangles(fold["faces_vertices"])
     faces = _int_array(fold, "faces_vertices", (3,), "vertex triples")
     n_f = len(faces)
     if n_f == 0:
         raise _fail("no faces")
-    bad = np.flatnonzero(((faces < 0) | (faces >= n_v)).any(axis=1))
-    if len(bad):
-        raise _fail(f"face {bad[0]} refers to a vertex outside 0..{n_v - 1}")
-    bad = np.flatnonzero((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0]))
-    if len(bad):
-        raise _fail(f"face {bad[0]} repeats a vertex")
-    edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
+
+    # parsed ahead of their checks (errors kept for later): edges, then the tree, then fold angles
+    none = np.empty(0, dtype=np.int64)
+    edges, kind, assign, parent_in, piece_in, deg = none.reshape(0, 2), none, [], none, none, np.empty(0)
+    stage, late = 1, None
+    try:
+        edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
+        assign, kind = _assignments(fold["edges_assignment"], len(edges))
+        stage = 2
+        if "polyfold:faces_piece" in fold:
+            piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
+            if len(piece_in) != n_f:
+                raise _fail(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
+        if "polyfold:faces_parent" in fold:
+            parent_in = _int_array(fold, "polyfold:faces_parent", (), "integers")
+            if len(parent_in) != n_f:
+                raise _fail(f"'polyfold:faces_parent' has {len(parent_in)} entries for {n_f} faces")
+        stage = 3
+        if "edges_foldAngle" in fold:
+            deg = _fold_angles(fold, len(edges))
+            stage = 4
+    except Exception as exc:  # noqa: BLE001 (raised below, after the checks that come first)
+        late = exc
     n_e = len(edges)
-    assign = fold["edges_assignment"]
-    if not isinstance(assign, (list, tuple)) or len(assign) != n_e:
-        raise _fail(f"'edges_assignment' must have one entry per edge ({n_e})")
-    assign = [str(a).upper() for a in assign]
-    for e, a in enumerate(assign):
-        if a not in _CUT + _CREASE:
-            raise _fail(f"edge {e} has unknown assignment {a!r}")
-    bad = np.flatnonzero(((edges < 0) | (edges >= n_v)).any(axis=1) | (edges[:, 0] == edges[:, 1]))
-    if len(bad):
-        raise _fail(f"edge {bad[0]} has invalid vertices {edges[bad[0]].tolist()}")
-    edge_of: dict[tuple[int, int], int] = {}
-    for e, (u, v) in enumerate(edges.tolist()):
-        key = (min(u, v), max(u, v))
-        if key in edge_of:
-            raise _fail(f"edges {edge_of[key]} and {e} join the same vertices {list(key)}")
-        edge_of[key] = e
-
-    # faces' sides -> edges; edge -> faces
-    face_edges = np.empty((n_f, 3), dtype=np.int64)
-    edge_faces = np.full((n_e, 2), -1, dtype=np.int64)
-    for f, (v0, v1, v2) in enumerate(faces.tolist()):
-        for k, (u, v) in enumerate(((v0, v1), (v1, v2), (v2, v0))):
-            e = edge_of.get((min(u, v), max(u, v)))
-            if e is None:
-                raise _fail(f"side {u}-{v} of face {f} is not in 'edges_vertices'")
-            face_edges[f, k] = e
-            if edge_faces[e, 0] < 0:
-                edge_faces[e, 0] = f
-            elif edge_faces[e, 1] < 0:
-                edge_faces[e, 1] = f
-            else:
-                raise _fail(f"edge {e} borders more than two faces")
-    flat2 = xy[faces]
-    area2 = ((flat2[:, 1, 0] - flat2[:, 0, 0]) * (flat2[:, 2, 1] - flat2[:, 0, 1])
-             - (flat2[:, 1, 1] - flat2[:, 0, 1]) * (flat2[:, 2, 0] - flat2[:, 0, 0]))
-    bad = np.flatnonzero(area2 < -1e-12 * scale * scale)
-    if len(bad):
-        raise _fail(f"face {bad[0]} is clockwise seen from +z (faces must be CCW, outer side up)")
-
-    piece_in = None
-    if "polyfold:faces_piece" in fold:
-        piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
-        if len(piece_in) != n_f:
-            raise _fail(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
-
-    # the tree
-    if "polyfold:faces_parent" in fold:
-        parent = _int_array(fold, "polyfold:faces_parent", (), "integers")
-        if len(parent) != n_f:
-            raise _fail(f"'polyfold:faces_parent' has {len(parent)} entries for {n_f} faces")
-        crease = np.full(n_f, -1, dtype=np.int64)
-        for f in range(n_f):
-            p = int(parent[f])
-            if p < -1 or p >= n_f or p == f:
-                raise _fail(f"face {f} has invalid parent {p}")
-            if p < 0:
-                continue
-            common = [e for e in face_edges[f] if e in face_edges[p]]
-            if not common:
-                raise _fail(f"face {f} shares no edge with its parent face {p}")
-            e = int(common[0])
-            if assign[e] in _CUT:
-                raise _fail(f"face {f} is joined to its parent face {p} by cut edge {e} (assignment {assign[e]})")
-            crease[f] = e
-    else:
-        neighbours: list[list[tuple[int, int]]] = [[] for _ in range(n_f)]
-        for e in range(n_e):
-            f0, f1 = edge_faces[e]
-            if f1 >= 0 and assign[e] not in _CUT:
-                neighbours[f0].append((int(f1), e))
-                neighbours[f1].append((int(f0), e))
-        parent, crease = _bfs_tree(n_f, neighbours, piece_in)
-
-    # order: BFS from the roots, parents first
-    children: list[list[int]] = [[] for _ in range(n_f)]
-    for f in range(n_f):
-        if parent[f] >= 0:
-            children[parent[f]].append(f)
-    order = []
-    tree_of = np.full(n_f, -1, dtype=np.int64)
-    for root in np.flatnonzero(parent < 0).tolist():
-        tree_of[root] = root
-        queue = deque([root])
-        while queue:
-            f = queue.popleft()
-            order.append(f)
-            for g in children[f]:
-                tree_of[g] = root
-                queue.append(g)
-    if len(order) != n_f:
-        stuck = int(np.flatnonzero(tree_of < 0)[0])
-        raise _fail(f"face {stuck} is on a cycle of 'polyfold:faces_parent' (no path to a root)")
-    order = np.asarray(order, dtype=np.int64)
-
-    # pieces: one tree each
-    if piece_in is not None:
-        piece = piece_in
-        child = np.flatnonzero(parent >= 0)
-        bad = child[piece[child] != piece[parent[child]]]
-        if len(bad):
-            f = int(bad[0])
-            raise _fail(f"face {f} (piece {piece[f]}) has its parent face {parent[f]} in piece {piece[parent[f]]}")
-        roots = np.flatnonzero(parent < 0)
-        ids, counts = np.unique(piece[roots], return_counts=True)
-        if (counts > 1).any():
-            k = ids[np.argmax(counts > 1)]
-            r = roots[piece[roots] == k]
-            raise _fail(f"piece {k} is not connected by creases (faces {r[0]} and {r[1]} are both roots)")
-    else:
-        roots = np.flatnonzero(parent < 0)
-        label = np.full(n_f, -1, dtype=np.int64)
-        label[roots] = np.arange(len(roots))
-        piece = label[tree_of]
-
-    # crease axes in the parent, a -> b along the parent's CCW order
-    axis = np.full((n_f, 2), -1, dtype=np.int64)
-    for f in np.flatnonzero(parent >= 0).tolist():
+    info = np.empty(4, dtype=np.int64)
+    face_edges, edge_faces, flat = np.empty((n_f, 3), dtype=np.int64), np.empty((n_e, 2), dtype=np.int64), np.empty((n_f, 3, 3))
+    parent, crease, order = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
+    piece, short, creases = np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64), np.empty(n_f, dtype=np.int64)
+    axis = np.empty((n_f, 2), dtype=np.int64)
+    goal = np.empty(n_e)
+    code, n_short, n_creases, bad_angle, out_of_range = TK.net_tree(
+        faces, n_v, edges, kind, len(_CUT), xy, -1e-12 * scale * scale, parent_in, piece_in, (2e-12 * scale) ** 2,
+        _MOUNTAIN, _VALLEY, deg, stage, info, face_edges, edge_faces, flat, parent, crease, order, piece, axis, short,
+        creases, goal)
+    i = info.tolist()
+    if code in (TK.FACE_OUT_OF_RANGE, TK.FACE_REPEAT):
+        raise _fail(f"face {i[0]} refers to a vertex outside 0..{n_v - 1}" if code == TK.FACE_OUT_OF_RANGE
+                    else f"face {i[0]} repeats a vertex")
+    if stage < 2:
+        raise late
+    if code in _SIDE_ERRORS:
+        raise _fail(_SIDE_ERRORS[code].format(*i, pair=edges[i[0]].tolist() if code == TK.BAD_EDGE else None, uv=i[2:]))
+    if stage < 3:
+        raise late
+    if code != TK.OK:
+        raise _tree_error(code, info, parent, piece_in if len(piece_in) else piece, assign)
+    for f in short[:n_short].tolist():  # the exact test (as always) of the creases the kernel could not clear
         p, e = int(parent[f]), int(crease[f])
         u, v = edges[e]
-        k = int(np.flatnonzero(faces[p] == u)[0])
-        kv = int(np.flatnonzero(faces[p] == v)[0])
-        axis[f] = (k, kv) if (k + 1) % 3 == kv else (kv, k)
         if not np.linalg.norm(xy[u] - xy[v]) > 1e-12 * scale:
             raise _fail(f"crease edge {e} (between faces {p} and {f}) has zero length")
-
-    goal = _goal_angles(fold, assign, edges, edge_faces, faces, folded)
-    creases = np.sort(crease[crease >= 0])
-    flat = np.zeros((n_f, 3, 3))
-    flat[:, :, :2] = flat2
+    if late is not None:
+        raise late
+    if bad_angle >= 0:
+        d = deg[bad_angle]
+        if out_of_range:
+            raise _fail(f"edge {bad_angle} has fold angle {d} (must be within [-180, 180] degrees)")
+        raise _fail(f"edge {bad_angle} is a {'mountain' if assign[bad_angle] == 'M' else 'valley'} with fold angle {d} "
+                    "(FOLD: valley positive, mountain negative)")
+    if stage < 4:  # no fold angles in the file: from the foldedForm, else +-180 degrees
+        goal = _goal_from_folded(assign, kind, edges, edge_faces, faces, folded)
     return FoldTree(
-        flat=flat, faces=faces, order=order, parent=parent.astype(np.int64), crease=crease, axis=axis,
-        piece=np.ascontiguousarray(piece, dtype=np.int64), goal=goal, creases=creases, scale=scale,
+        flat=flat, faces=faces, order=order, parent=parent, crease=crease, axis=axis,
+        piece=piece, goal=goal, creases=creases[:n_creases], scale=scale,
         tol=contact_tol * scale, folded=folded,
     )
+
 
 
 # --------------------------------------------------------------------------------------------------

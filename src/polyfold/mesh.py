@@ -7,10 +7,13 @@ from outside), negative on reflex edges, 0 on flat ones.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+
+from . import _mesh_kernels as MK
 
 HYPERBOLIC_EPS = 1e-9
 
@@ -108,43 +111,21 @@ class Topology:
 
 
 def edge_topology(faces: np.ndarray) -> Topology:
-    """Build the edge table of `faces` (m, 3). Works on non-manifold input too (face_count > 2)."""
-    faces = np.asarray(faces, dtype=np.int64)
-    m = len(faces)
-    directed = np.stack([faces, np.roll(faces, -1, axis=1)], axis=2).reshape(-1, 2)  # (3m, 2)
-    key = np.sort(directed, axis=1)
-    edges, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    face_edges = inverse.reshape(m, 3)
-    edge_faces = np.full((len(edges), 2), -1, dtype=np.int64)
-    face_of = np.repeat(np.arange(m), 3)
-    forward = directed[:, 0] == key[:, 0]  # directed edge runs low -> high
-    # Slot 0 takes a face that runs the edge low->high, slot 1 the other; when orientation is
-    # inconsistent both may run the same way, then the second such face goes to the free slot.
-    order = np.lexsort((~forward, inverse))
-    for idx in order:  # O(3m), only at set-up
-        e = inverse[idx]
-        slot = 0 if forward[idx] else 1
-        if edge_faces[e, slot] >= 0:
-            slot = 1 - slot
-            if edge_faces[e, slot] >= 0:
-                continue  # non-manifold: the third face is counted in face_count only
-        edge_faces[e, slot] = face_of[idx]
-    # Normalize: slot 0 filled first for boundary edges.
-    swap = (edge_faces[:, 0] < 0) & (edge_faces[:, 1] >= 0)
-    edge_faces[swap] = edge_faces[swap][:, ::-1]
-    flip = swap.copy()
-    edges = edges.copy()
-    edges[flip] = edges[flip][:, ::-1]  # keep "slot-0 face runs edges[e,0] -> edges[e,1]"
-    return Topology(edges=edges, edge_faces=edge_faces, face_edges=face_edges, face_count=counts.astype(np.int64))
+    """Build the edge table of `faces` (m, 3). Works on non-manifold input too (face_count > 2).
+
+    Edges in lexicographic order of their sorted vertex pair; slot 0 of edge_faces takes a face
+    that runs the edge low -> high, slot 1 the other; when orientation is inconsistent both may run
+    the same way, then the second such face goes to the free slot (a third face is only counted).
+    One numba pass (`_mesh_kernels.edge_table`): this is set-up work of every mesh and part.
+    """
+    faces = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
+    edges, edge_faces, face_edges, counts = MK.edge_table(faces)
+    return Topology(edges=edges, edge_faces=edge_faces, face_edges=face_edges, face_count=counts)
 
 
 def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Unit normals (m, 3) of CCW faces; zero rows for degenerate faces."""
-    tri = vertices[faces]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    norm = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, norm, out=np.zeros_like(n), where=norm > 0)
+    return MK.face_normals(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
 
 
 def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -152,22 +133,31 @@ def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
 
 
+def vector_norm(v: np.ndarray) -> float:
+    """np.linalg.norm(v) of a 1-D float64 vector, bit for bit (the sqrt of v.dot(v)), without its
+    general-case overhead (small meshes call it per heuristic and per net)."""
+    return math.sqrt(v.dot(v))
+
+
+def row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row dot products (n,) of a, b (n, 3). Kept in numpy: einsum's SIMD loop sums in an order of
+    its own, and every stage must see the same bits."""
+    return np.einsum("ij,ij->i", a, b)
+
+
 def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Interior angle (m, 3) of each face at each corner (atan2 form, well conditioned)."""
-    tri = vertices[faces]
-    out = np.empty((len(faces), 3))
-    for k in range(3):
-        a = tri[:, (k + 1) % 3] - tri[:, k]
-        b = tri[:, (k + 2) % 3] - tri[:, k]
-        out[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+    a, b, y = MK.corner_vectors(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
+    out = np.empty((y.shape[1], 3))
+    for k in range(3):  # one numpy call per corner, on the same (m,) layout as always
+        out[:, k] = np.arctan2(y[k], row_dots(a[k], b[k]))
     return out
 
 
 def vertex_angle_sums(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Sum of corner angles at every vertex (n,)."""
-    sums = np.zeros(len(vertices))
-    np.add.at(sums, faces.reshape(-1), corner_angles(vertices, faces).reshape(-1))
-    return sums
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    return MK.scatter_sums(len(vertices), faces.reshape(-1), corner_angles(vertices, faces).reshape(-1))
 
 
 def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) -> np.ndarray:
@@ -175,17 +165,11 @@ def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) ->
 
     Positive on convex edges; 0 on boundary edges.
     """
+    inner, cross, u, n0, n1 = MK.fold_angle_vectors(np.ascontiguousarray(vertices, dtype=np.float64),
+                                                    np.ascontiguousarray(faces, dtype=np.int64), topo.edges, topo.edge_faces)
     rho = np.zeros(topo.n_edges)
-    inner = np.flatnonzero(topo.interior)
-    if len(inner) == 0:
-        return rho
-    normals = face_normals(vertices, faces)
-    f0, f1 = topo.edge_faces[inner, 0], topo.edge_faces[inner, 1]
-    a, b = topo.edges[inner, 0], topo.edges[inner, 1]
-    u = vertices[b] - vertices[a]
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    n0, n1 = normals[f0], normals[f1]
-    rho[inner] = np.arctan2(np.einsum("ij,ij->i", np.cross(n0, n1), u), np.einsum("ij,ij->i", n0, n1))
+    if len(inner):
+        rho[inner] = np.arctan2(row_dots(cross, u), row_dots(n0, n1))
     return rho
 
 

@@ -20,7 +20,8 @@ from typing import Callable
 import numpy as np
 
 from . import _unfold_kernels as K
-from .mesh import Mesh
+from . import _unfold_setup as S
+from .mesh import Mesh, row_dots, vector_norm
 from .overlap import overlapping_pairs
 
 METHODS = ("auto", "ga", "steepest-edge", "flat-tree", "unflat-tree", "min-perimeter", "max-perimeter", "random")
@@ -70,7 +71,13 @@ class UnfoldStats:
 
 @dataclass(frozen=True, eq=False)
 class UnfoldProblem:
-    """Arrays the kernels need, derived once per mesh component."""
+    """Arrays the kernels need, derived once per mesh component.
+
+    adj_ptr / adj_face / adj_edge: the dual graph (CSR); local (F, 3, 2): `local_frames`;
+    hyperbolic (n,): the mesh's hyperbolic vertices; tol: overlap tolerance (1e-9 of the bbox
+    diagonal); interior_edges (I,); edge_vec (E, 3) / edge_len (E,): each edge as a vector
+    edges[e, 0] -> edges[e, 1] and its length (for the heuristic weight rules).
+    """
 
     mesh: Mesh
     adj_ptr: np.ndarray
@@ -81,29 +88,32 @@ class UnfoldProblem:
     tol: float
     base: int = 0
     interior_edges: np.ndarray = field(default=None)  # type: ignore[assignment]
+    edge_vec: np.ndarray = field(default=None)  # type: ignore[assignment]
+    edge_len: np.ndarray = field(default=None)  # type: ignore[assignment]
+    hyperbolic_candidates: int = 0  # interior half-edges at hyperbolic vertices
 
     @classmethod
     def from_mesh(cls, mesh: Mesh, base: int = 0) -> "UnfoldProblem":
         topo = mesh.topology
-        inner = np.flatnonzero(topo.interior)
-        f0, f1 = topo.edge_faces[inner, 0], topo.edge_faces[inner, 1]
-        src = np.concatenate([f0, f1])
-        dst = np.concatenate([f1, f0])
-        eid = np.concatenate([inner, inner])
-        srt = np.argsort(src, kind="stable")
-        adj_ptr = np.zeros(mesh.n_faces + 1, dtype=np.int64)
-        np.add.at(adj_ptr, src + 1, 1)
-        adj_ptr = np.cumsum(adj_ptr)
+        # one numba pass for everything but the numpy-rounded dot products (see _unfold_setup)
+        hyperbolic = mesh.hyperbolic
+        inner, adj_ptr, adj_face, adj_edge, e1, e2, local, edge_vec, edge_len, box, candidates = S.problem_arrays(
+            mesh.vertices, mesh.faces, topo.edges, topo.edge_faces, hyperbolic)
+        local[:, 2, 0] = row_dots(e2, e1) / local[:, 1, 0]
+        diagonal = vector_norm(box) if mesh.n_vertices else mesh.bbox_diagonal
         return cls(
             mesh=mesh,
             adj_ptr=adj_ptr,
-            adj_face=dst[srt].astype(np.int64),
-            adj_edge=eid[srt].astype(np.int64),
-            local=local_frames(mesh.vertices, mesh.faces),
-            hyperbolic=mesh.hyperbolic.copy(),
-            tol=1e-9 * max(mesh.bbox_diagonal, 1e-300),
+            adj_face=adj_face,
+            adj_edge=adj_edge,
+            local=local,
+            hyperbolic=hyperbolic,
+            tol=1e-9 * max(diagonal, 1e-300),
             base=base,
             interior_edges=inner,
+            edge_vec=edge_vec,
+            edge_len=edge_len,
+            hyperbolic_candidates=candidates,
         )
 
     def evaluate(self, weights: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -118,147 +128,95 @@ class UnfoldProblem:
     def decode(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Genome -> (parent, parent_edge, order, coords) of the spanning tree."""
         n = self.mesh.n_faces
-        parent = np.empty(n, np.int64)
-        parent_edge = np.empty(n, np.int64)
-        order = np.empty(n, np.int64)
-        reached = K.prim_tree(np.ascontiguousarray(weights, np.float64), self.base, self.adj_ptr, self.adj_face,
-                              self.adj_edge, parent, parent_edge, order)
+        reached, parent, parent_edge, order, coords = K.decode_tree(
+            np.ascontiguousarray(weights, np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            self.mesh.faces, self.mesh.topology.face_edges, self.local)
         if reached != n:
             raise ValueError(f"dual graph is not connected ({reached} of {n} faces reached)")
-        coords = np.empty((n, 3, 2))
-        K.layout_tree(order, parent, parent_edge, self.mesh.faces, self.mesh.topology.face_edges, self.local, coords)
         return parent, parent_edge, order, coords
 
     def overlaps(self, coords: np.ndarray, parent: np.ndarray) -> np.ndarray:
         """All overlapping face pairs (k, 2) of a layout (crease pairs skipped)."""
-        count, _ = overlapping_pairs(coords, parent, self.tol, 0)
-        _, pairs = overlapping_pairs(coords, parent, self.tol, int(count))
+        count, pairs = overlapping_pairs(coords, parent, self.tol, 0)
+        if count:  # a second sweep to collect them (the first one counts)
+            _, pairs = overlapping_pairs(coords, parent, self.tol, int(count))
         return pairs
 
 
 def local_frames(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Each triangle in its own 2D frame (F, 3, 2): corner 0 at the origin, corner 1 on +x, CCW."""
-    tri = vertices[faces]
-    e1 = tri[:, 1] - tri[:, 0]
-    e2 = tri[:, 2] - tri[:, 0]
-    l1 = np.linalg.norm(e1, axis=1)
-    x2 = np.einsum("ij,ij->i", e2, e1) / l1
-    y2 = np.linalg.norm(np.cross(e1, e2), axis=1) / l1
-    out = np.zeros((len(faces), 3, 2))
-    out[:, 1, 0] = l1
-    out[:, 2, 0] = x2
-    out[:, 2, 1] = y2
+    e1, e2, out = S.frame_parts(np.ascontiguousarray(vertices, np.float64), np.ascontiguousarray(faces, np.int64))
+    out[:, 2, 0] = row_dots(e2, e1) / out[:, 1, 0]
     return out
 
 
 # --------------------------------------------------------------------------------------------
-# Heuristic edge weights (ALGORITHMS.md 5.3). Low weight = keep as crease.
+# Heuristic edge weights (ALGORITHMS.md 5.3). Low weight = keep as crease. Each rule takes the
+# problem (its per-mesh arrays are built once) and the generator, and returns weights (E,).
 
 
 def _random_direction(rng: np.random.Generator) -> np.ndarray:
     c = rng.normal(size=3)
-    return c / np.linalg.norm(c)
+    return c / vector_norm(c)
 
 
-def _edge_vectors(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    e = mesh.topology.edges
-    d = mesh.vertices[e[:, 1]] - mesh.vertices[e[:, 0]]
-    return d, np.linalg.norm(d, axis=1)
-
-
-def flat_tree_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+def flat_tree_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
     """Edges orthogonal to a random direction are kept, edges along it are cut."""
-    d, length = _edge_vectors(mesh)
-    return np.abs(d @ _random_direction(rng)) / length
+    return np.abs(problem.edge_vec @ _random_direction(rng)) / problem.edge_len
 
 
-def unflat_tree_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
-    w = flat_tree_weights(mesh, rng)
+def unflat_tree_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    w = flat_tree_weights(problem, rng)
     return np.where(w > 0, 1.0 - w, w)
 
 
-def min_perimeter_weights(mesh: Mesh, rng: np.random.Generator | None = None) -> np.ndarray:
+def min_perimeter_weights(problem: UnfoldProblem, rng: np.random.Generator | None = None) -> np.ndarray:
     """Long edges kept: short total cut length."""
-    _, length = _edge_vectors(mesh)
+    length = problem.edge_len
     span = max(length.max() - length.min(), 1e-300)
     return 1.0 - (length - length.min()) / span
 
 
-def max_perimeter_weights(mesh: Mesh, rng: np.random.Generator | None = None) -> np.ndarray:
-    _, length = _edge_vectors(mesh)
+def max_perimeter_weights(problem: UnfoldProblem, rng: np.random.Generator | None = None) -> np.ndarray:
+    length = problem.edge_len
     span = max(length.max() - length.min(), 1e-300)
     return (length - length.min()) / span
 
 
-def _steepest(mesh: Mesh, rng: np.random.Generator, un: bool) -> np.ndarray:
+def _steepest(problem: UnfoldProblem, rng: np.random.Generator, un: bool) -> np.ndarray:
     """Every vertex but the top one cuts its steepest upward edge (un=True: the least steep)."""
     c = _random_direction(rng)
-    e = mesh.topology.edges
-    d, length = _edge_vectors(mesh)
-    slope = (d @ c) / length  # from e0 toward e1
-    # directed edges v -> w with score; each vertex picks its best
-    v = np.concatenate([e[:, 0], e[:, 1]])
-    score = np.concatenate([slope, -slope])
-    if un:
-        score = 1.0 - np.abs(score)
-    eid = np.concatenate([np.arange(len(e)), np.arange(len(e))])
-    height = mesh.vertices @ c
-    top = int(np.argmax(height))
-    order = np.lexsort((-score, v))  # per vertex, best score first
-    first = np.ones(len(order), dtype=bool)
-    first[1:] = v[order][1:] != v[order][:-1]
-    pick = order[first]
-    pick = pick[v[pick] != top]
-    w = np.zeros(len(e))
-    w[eid[pick]] = 1.0
-    return w
+    mesh = problem.mesh
+    slope = (problem.edge_vec @ c) / problem.edge_len  # from e0 toward e1
+    top = int(np.argmax(mesh.vertices @ c))
+    return S.steepest_cuts(slope, mesh.topology.edges, mesh.n_vertices, top, un)
 
 
-def steepest_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
-    return _steepest(mesh, rng, un=False)
+def steepest_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(problem, rng, un=False)
 
 
-def unsteepest_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
-    return _steepest(mesh, rng, un=True)
+def unsteepest_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(problem, rng, un=True)
 
 
-def random_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
-    return rng.random(mesh.topology.n_edges) + 0.01
+def random_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return rng.random(problem.mesh.topology.n_edges) + 0.01
 
 
-def _pick_random_incident(ends: np.ndarray, edge_ids: np.ndarray, vertices: np.ndarray, count: int,
-                          rng: np.random.Generator) -> np.ndarray:
-    """Up to `count` distinct random incident edges (from edge_ids, endpoints ends) per vertex in
-    `vertices`, vectorized: random keys sorted within each vertex."""
-    v = np.concatenate([ends[:, 0], ends[:, 1]])
-    e = np.concatenate([edge_ids, edge_ids])
-    want = np.zeros(int(v.max(initial=-1)) + 1 if len(v) else 0, dtype=bool)
-    want[vertices[vertices < len(want)]] = True
-    keep = want[v]
-    v, e = v[keep], e[keep]
-    order = np.lexsort((rng.random(len(v)), v))
-    v, e = v[order], e[order]
-    rank = np.arange(len(v)) - np.searchsorted(v, v)  # position within the vertex's group
-    return e[rank < count]
-
-
-def random_edge_weights(mesh: Mesh, rng: np.random.Generator) -> np.ndarray:
+def random_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
     """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none."""
-    topo = mesh.topology
-    w = np.full(topo.n_edges, 0.01)
-    e_ids = np.flatnonzero(topo.interior)
-    ends = topo.edges[e_ids]
-    hyper = mesh.hyperbolic
-    w[_pick_random_incident(ends, e_ids, np.flatnonzero(hyper), 2, rng)] = 1.0
-    chosen = np.zeros(mesh.n_vertices, dtype=bool)
-    cut = w >= 1.0
-    chosen[topo.edges[cut, 0]] = True
-    chosen[topo.edges[cut, 1]] = True
-    w[_pick_random_incident(ends, e_ids, np.flatnonzero(~chosen & ~hyper), 1, rng)] = 1.0
+    edges = problem.mesh.topology.edges
+    inner = problem.interior_edges
+    w = np.full(len(edges), 0.01)
+    # one random draw per candidate half-edge (an interior edge at a wanted vertex)
+    want, n = S.pick_random_incident(inner, edges, problem.hyperbolic, 2, rng.random(problem.hyperbolic_candidates), w,
+                                     problem.hyperbolic)
+    S.pick_random_incident(inner, edges, want, 1, rng.random(n), w, problem.hyperbolic)
     return w
 
 
-HEURISTICS: dict[str, Callable[[Mesh, np.random.Generator], np.ndarray]] = {
+HEURISTICS: dict[str, Callable[[UnfoldProblem, np.random.Generator], np.ndarray]] = {
     "steepest-edge": steepest_edge_weights,
     "unsteepest-edge": unsteepest_edge_weights,
     "flat-tree": flat_tree_weights,
@@ -313,7 +271,7 @@ def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _
         stop = min(start + size, population)
         size = min(2 * size, 25)
         for i in range(start, stop):
-            pop[i] = HEURISTICS[origin[i]](mesh, rng)
+            pop[i] = HEURISTICS[origin[i]](problem, rng)
         G, L = problem.evaluate(pop[start:stop])
         fit[start:stop] = _fitness(G, L)
         evaluations += stop - start
@@ -506,7 +464,7 @@ def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator, b
     best_w, best_fit, tries = None, -np.inf, 0
     make = HEURISTICS[name]
     while tries < 100 and (tries == 0 or time.perf_counter() < budget.deadline):
-        w = make(problem.mesh, rng)[None, :]
+        w = make(problem, rng)[None, :]
         G, L = problem.evaluate(w)
         tries += 1
         f = float(_fitness(G, L)[0])
@@ -561,14 +519,9 @@ def _net_from_tree(problem: UnfoldProblem, parent, parent_edge, order, coords, c
     if cut is not None and cut.any():
         parent[cut] = -1
         parent_edge[cut] = -1
-    piece = np.full(len(parent), -1, dtype=np.int64)
-    n_pieces = 0
-    for f in order:
-        if parent[f] < 0:
-            piece[f] = n_pieces
-            n_pieces += 1
-        else:
-            piece[f] = piece[parent[f]]
+        piece = K.piece_labels(order, parent)
+    else:  # one spanning tree: one piece
+        piece = np.zeros(len(parent), dtype=np.int64)
     return Net(mesh=problem.mesh, parent=parent, parent_edge=parent_edge, order=order.copy(), coords=coords, piece=piece)
 
 
@@ -607,7 +560,7 @@ def unfold(
             def accept_genome(genome: np.ndarray) -> bool:
                 return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
         # Large meshes: a smaller seed population, so the local search gets the time budget.
-        population = int(np.clip(200_000 // mesh.n_faces, 50, 400))
+        population = min(max(200_000 // mesh.n_faces, 50), 400)
         weights, fitness, generations, evaluations, winner = run_memetic(
             problem, rng, budget, population=population, progress=progress, accept=accept_genome)
     elif method == "ga":
@@ -645,14 +598,7 @@ def cut_creases(net: Net, faces: np.ndarray) -> Net:
     parent_edge = net.parent_edge.copy()
     parent[faces] = -1
     parent_edge[faces] = -1
-    piece = np.full(len(parent), -1, dtype=np.int64)
-    n_pieces = 0
-    for f in net.order:  # parents come first, so a child's piece is known when it is reached
-        if parent[f] < 0:
-            piece[f] = n_pieces
-            n_pieces += 1
-        else:
-            piece[f] = piece[parent[f]]
+    piece = K.piece_labels(net.order, parent)
     return Net(mesh=net.mesh, parent=parent, parent_edge=parent_edge, order=net.order.copy(),
                coords=net.coords.copy(), piece=piece)
 

@@ -1,0 +1,82 @@
+"""The set-up kernels (edge table, heuristic weight rules) against plain numpy formulations."""
+
+import numpy as np
+import pytest
+
+from polyfold import _unfold_setup as S
+from polyfold.mesh import edge_topology
+
+
+def _reference_topology(faces):
+    """Edge table by np.unique of the sorted sides and a loop over the sides (lexsort order)."""
+    m = len(faces)
+    directed = np.stack([faces, np.roll(faces, -1, axis=1)], axis=2).reshape(-1, 2)
+    key = np.sort(directed, axis=1)
+    edges, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.reshape(-1)
+    edge_faces = np.full((len(edges), 2), -1, dtype=np.int64)
+    forward = directed[:, 0] == key[:, 0]
+    for idx in np.lexsort((~forward, inverse)):
+        e, slot = inverse[idx], 0 if forward[idx] else 1
+        if edge_faces[e, slot] >= 0:
+            slot = 1 - slot
+            if edge_faces[e, slot] >= 0:
+                continue
+        edge_faces[e, slot] = idx // 3
+    swap = (edge_faces[:, 0] < 0) & (edge_faces[:, 1] >= 0)
+    edge_faces[swap] = edge_faces[swap][:, ::-1]
+    edges = edges.copy()
+    edges[swap] = edges[swap][:, ::-1]
+    return edges, edge_faces, inverse.reshape(m, 3), counts
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_edge_table_matches_unique_and_lexsort(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 10))
+    faces = rng.integers(0, n, size=(int(rng.integers(0, 25)), 3))  # non-manifold, unoriented, degenerate
+    topo = edge_topology(faces)
+    for got, want in zip((topo.edges, topo.edge_faces, topo.face_edges, topo.face_count), _reference_topology(faces)):
+        assert got.dtype == np.int64 and np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_weight_rules_match_lexsort(seed):
+    rng = np.random.default_rng(seed)
+    n_v = 12
+    edges = rng.integers(0, n_v, size=(30, 2))
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    slope = np.round(rng.normal(size=len(edges)), 1)  # ties
+    slope[rng.random(len(edges)) < 0.1] = np.nan
+    for un in (False, True):
+        v = np.concatenate([edges[:, 0], edges[:, 1]])
+        score = np.concatenate([slope, -slope])
+        score = 1.0 - np.abs(score) if un else score
+        order = np.lexsort((-score, v))
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = v[order][1:] != v[order][:-1]
+        pick = order[first]
+        pick = pick[v[pick] != 3]
+        want = np.zeros(len(edges))
+        want[np.concatenate([np.arange(len(edges))] * 2)[pick]] = 1.0
+        assert np.array_equal(S.steepest_cuts(slope, edges, n_v, 3, un), want)
+    inner = np.flatnonzero(rng.random(len(edges)) < 0.8)
+    mask = rng.random(n_v) < 0.5
+    for count in (1, 2):
+        v = np.concatenate([edges[inner, 0], edges[inner, 1]])
+        e = np.concatenate([inner, inner])
+        keep = mask[v]
+        keys = np.round(rng.random(int(keep.sum())), 1)  # ties
+        assert S.incident_count(inner, edges, mask) == len(keys)
+        hyperbolic = rng.random(n_v) < 0.3
+        order = np.lexsort((keys, v[keep]))
+        vs, es = v[keep][order], e[keep][order]
+        rank = np.arange(len(vs)) - np.searchsorted(vs, vs)
+        want = np.zeros(len(edges))
+        want[es[rank < count]] = 1.0
+        got = np.zeros(len(edges))
+        uncut, n_next = S.pick_random_incident(inner, edges, mask, count, keys, got, hyperbolic)
+        assert np.array_equal(got, want)
+        chosen = np.zeros(n_v, dtype=bool)
+        chosen[edges[got >= 1.0].reshape(-1)] = True
+        assert np.array_equal(uncut, ~chosen & ~hyperbolic) and n_next == S.incident_count(inner, edges, uncut)
