@@ -321,8 +321,8 @@ def collision_work(n_faces):
     """Work arrays of `config_collides_cached` for one tree of n_faces faces, reused across calls:
     (geo, sb, si, last, R, T, out, meta).
 
-    geo (F, _G_SIZE): per-face geometry and AABB; sb (6, F): the AABBs (lo x, hi x, lo y, hi y,
-    lo z, hi z) in sweep order; si (6, F) int: si[0] the sweep order (face ids by lo x; kept from
+    geo (F, _G_SIZE): per-face geometry and AABB; sb (7, F): the AABBs (lo x, hi x, lo y, hi y,
+    lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep order (face ids by lo x; kept from
     call to call, it is the next call's starting guess), then per position parent, piece, rigid
     group, non-degenerate flag, and scratch for the candidates of one face; last (F, 2), R, T,
     out: the folded state of the previous call (see `_fold`); meta (1,): the tol geo was filled
@@ -330,7 +330,7 @@ def collision_work(n_faces):
     """
     si = np.empty((6, n_faces), dtype=np.int64)
     si[0] = np.arange(n_faces)
-    return (np.empty((n_faces, _G_SIZE)), np.empty((6, n_faces)), si, np.full((n_faces, 2), np.nan),
+    return (np.empty((n_faces, _G_SIZE)), np.empty((7, n_faces)), si, np.full((n_faces, 2), np.nan),
             np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), np.full(1, np.nan))
 
 
@@ -381,11 +381,15 @@ def _sort_by_lo_x(geo, sb, si):
 @njit(cache=True, inline="always")
 def _gather(geo, parent, piece, rigid, sb, si):
     """Fill sb and si[1:5] for the sweep order si[0] (see `collision_work`): contiguous rows for
-    the sweep's inner loop. rigid (F,) groups, or None (no group)."""
+    the sweep's inner loop, and sb[6] = running maximum of hi x. rigid (F,) groups, or None (no
+    group)."""
+    top = -np.inf
     for p in range(si.shape[1]):
         f = si[0, p]
         for r in range(6):
             sb[r, p] = geo[f, _G_LO + (r >> 1) + 3 * (r & 1)]
+        top = max(top, sb[1, p])
+        sb[6, p] = top
         si[1, p] = parent[f]
         si[2, p] = piece[f]
         si[3, p] = -1 if rigid is None else rigid[f]
@@ -393,7 +397,24 @@ def _gather(geo, parent, piece, rigid, sb, si):
 
 
 @njit(cache=True, inline="always")
-def _sweep(tris, geo, sb, si, tol, max_pairs, pairs):
+def _largest_group(rigid, counts):
+    """The rigid group holding more than half of the faces, or -1 (also when a label is not a
+    face id); counts (F,) scratch."""
+    n = rigid.shape[0]
+    counts[:] = 0
+    for f in range(n):
+        g = rigid[f]
+        if g >= n:
+            return -1
+        if g >= 0:
+            counts[g] += 1
+            if 2 * counts[g] > n:
+                return g
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _sweep(tris, geo, sb, si, tol, max_pairs, pairs, big):
     """Sort-and-sweep on x over the faces' AABBs in the order si[0] (filled by `_gather`).
 
     A pair is tested (`_faces_cross`, the face earlier in the order as a) unless its boxes are
@@ -401,39 +422,57 @@ def _sweep(tris, geo, sb, si, tol, max_pairs, pairs):
     both faces are in the same rigid group (rigid >= 0: their relative pose is fixed, see
     `config_collides_moving`), or a face is degenerate. Stops after max_pairs hits, recording the
     first ones (i < j) in pairs (None: none recorded); returns the number of hits found.
-    sb rows: lo x, hi x, lo y, hi y, lo z, hi z; si rows: face, parent, piece, rigid, non-degenerate, scratch.
+    big >= 0: a rigid group of most faces, whose own pairs are not tested: only the other faces
+    are swept, forward and backward (big = -1: forward from every face).
+    sb rows: lo x, hi x, lo y, hi y, lo z, hi z, running max of hi x; si rows: face, parent,
+    piece, rigid, non-degenerate, scratch.
     """
     n = tris.shape[0]
     count = 0
     for ii in range(n):
-        if si[4, ii] == 0:
-            continue  # a degenerate face crosses nothing
+        if si[4, ii] == 0 or (big >= 0 and si[3, ii] == big):
+            continue  # a degenerate face crosses nothing; big's faces are met from the others
         i = si[0, ii]
-        end = ii + 1
-        while end < n and not (sb[0, end] - sb[1, ii] > tol):
-            end += 1
-        # Branch-free box filter into si[5]: whether boxes overlap in y and z is hard to predict,
-        # and a mispredicted branch costs more than all four comparisons.
         loy = sb[2, ii]
         hiy = sb[3, ii]
         loz = sb[4, ii]
         hiz = sb[5, ii]
+        # Branch-free box filters into si[5]: whether boxes overlap in y and z is hard to
+        # predict, and a mispredicted branch costs more than all four comparisons.
+        end = ii + 1
+        while end < n and not (sb[0, end] - sb[1, ii] > tol):  # later faces overlapping in x
+            end += 1
         k = 0
         for jj in range(ii + 1, end):
             apart = (sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol) | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol)
             si[5, k] = jj
             k += 1 - np.int64(apart)
+        later = k
+        if big >= 0:
+            # earlier faces of big overlapping in x (the others were swept from themselves); no
+            # face before jj reaches past the running maximum of hi x
+            jj = ii - 1
+            while jj >= 0 and not (sb[0, ii] - sb[6, jj] > tol):
+                apart = ((sb[0, ii] - sb[1, jj] > tol) | (sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
+                         | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol) | (si[3, jj] != big))
+                si[5, k] = jj
+                k += 1 - np.int64(apart)
+                jj -= 1
         if k == 0:
             continue
-        a = _corners(tris, i)
-        ga = _load_face(geo, i)
+        t = _corners(tris, i)
+        gt = _load_face(geo, i)
         for c in range(k):
             jj = si[5, c]
             j = si[0, jj]
             if (si[4, jj] == 0 or si[2, jj] != si[2, ii] or si[1, jj] == i or si[1, ii] == j
                     or (si[3, ii] >= 0 and si[3, jj] == si[3, ii])):
                 continue
-            if _faces_cross(a, _corners(tris, j), ga, _load_face(geo, j), tol):
+            if c < later:
+                crosses = _faces_cross(t, _corners(tris, j), gt, _load_face(geo, j), tol)
+            else:
+                crosses = _faces_cross(_corners(tris, j), t, _load_face(geo, j), gt, tol)
+            if crosses:
                 if pairs is not None and count < pairs.shape[0]:
                     pairs[count, 0] = min(i, j)
                     pairs[count, 1] = max(i, j)
@@ -451,7 +490,7 @@ def _collisions(tris, parent, piece, tol, max_pairs, pairs):
     _fill_faces(tris, tol, geo, None)
     si[0, :] = np.argsort(geo[:, _G_LO])
     _gather(geo, parent, piece, None, sb, si)
-    return _sweep(tris, geo, sb, si, tol, max_pairs, pairs)
+    return _sweep(tris, geo, sb, si, tol, max_pairs, pairs, -1)
 
 
 @njit(cache=True)
@@ -479,7 +518,8 @@ def _tris_collide(tris, parent, piece, rigid, tol, geo, sb, si, last):
     _fill_faces(tris, tol, geo, last)
     _sort_by_lo_x(geo, sb, si)
     _gather(geo, parent, piece, rigid, sb, si)
-    return _sweep(tris, geo, sb, si, tol, 1, None) > 0
+    big = -1 if rigid is None else _largest_group(rigid, si[5])
+    return _sweep(tris, geo, sb, si, tol, 1, None, big) > 0
 
 
 @njit(cache=True)
