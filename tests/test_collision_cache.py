@@ -80,7 +80,7 @@ def test_cached_verdicts_and_faces_equal_fresh_ones(tree):
         rigid = rigid_groups(tree, moving)
         fresh = config_collides(q, *args, tree.tol, R, T, out)
         fresh_moving = config_collides_moving(q, *args, rigid, tree.tol, R, T, out)
-        assert config_collides_cached(q, *args, None, tree.tol, work) == fresh
+        assert config_collides_cached(q, *args, np.full(tree.n_faces, -1), tree.tol, work) == fresh
         assert np.array_equal(work[6], fold_positions(tree, q))
         assert config_collides_cached(q, *args, rigid, tree.tol, work) == fresh_moving
         verdicts.add(fresh)
@@ -95,7 +95,7 @@ def test_cached_verdicts_agree_with_brute_force(tree):
         # segments moving a few creases: one big rigid group (the sweep then starts from the others)
         moving = np.zeros(tree.n_edges, dtype=bool)
         moving[rng.choice(tree.creases, size=min(2, len(tree.creases)), replace=False)] = True
-        for rigid in (None, rigid_groups(tree, moving)):
+        for rigid in (np.full(tree.n_faces, -1), rigid_groups(tree, moving)):
             assert config_collides_cached(q, *args, rigid, tree.tol, work) == expected(tree, q, rigid)
 
 
@@ -105,4 +105,5 @@ def test_another_tol_refreshes_the_cache(tree):
     R, T, out = tree.buffers()
     q = tree.goal * 0.7
     for tol in (tree.tol, 0.05 * tree.scale, tree.tol, 0.0):
-        assert config_collides_cached(q, *args, None, tol, work) == config_collides(q, *args, tol, R, T, out)
+        fresh = config_collides(q, *args, tol, R, T, out)
+        assert config_collides_cached(q, *args, np.full(tree.n_faces, -1), tol, work) == fresh

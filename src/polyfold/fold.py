@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .kinematics import FoldTree, collision_work, config_collides_cached
+from .kinematics import FoldTree, collision_work, config_collides_cached, segment_collides
 
 PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
@@ -93,17 +93,9 @@ def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, q,
             rigid[f] = f
         else:
             rigid[f] = rigid[parent[f]]
-    checked = 0
-    for k in _bisection_order(m):
-        if checked >= max_samples:
-            break
-        t = k / m
-        for i in range(qa.shape[0]):
-            q[i] = qa[i] + t * (qb[i] - qa[i])
-        checked += 1
-        if config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work):
-            return False, checked
-    return True, checked
+    hit, checked = segment_collides(qa, qb, _bisection_order(m)[:max_samples], m, order, parent, crease, axis, flat,
+                                    piece, rigid, tol, work, q)
+    return not hit, checked
 
 
 class _Checker:
@@ -114,13 +106,15 @@ class _Checker:
         self.step = resolution
         self.q = np.empty(len(tree.goal))
         self.work = collision_work(len(tree.order))
+        self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
         self.configs = 0
         self.edges = 0
 
     def valid(self, q: np.ndarray) -> bool:
         t = self.tree
         self.configs += 1
-        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, None, t.tol, self.work)
+        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
+                                          t.tol, self.work)
 
     def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
         t = self.tree

@@ -15,7 +15,9 @@ collide (paper cannot pass through paper). Every pair of faces of one piece is t
 crease pairs (parent, child), including faces that share a net vertex and twins of a cut edge.
 
 The numba kernels take plain arrays so a planner can call them inside its own @njit loops:
-`forward_kinematics`, `triangles_collide`, `first_collision`, `config_collides`.
+`forward_kinematics`, `triangles_collide`, `first_collision`, `config_collides`, and for planners
+`collision_work` + `segment_collides` (all the samples of a segment in one call, reusing what did
+not change from one configuration to the next).
 """
 
 from __future__ import annotations
@@ -237,8 +239,7 @@ def _face_geometry(t, tol):
 def _faces_cross(a, b, ga, gb, tol):
     """True if non-degenerate triangles a, b cross (the test of `triangles_collide`); ga, gb their
     _Face. The verdict does not depend on the order of the axes (any axis proving no contact
-    decides): the cheapest and likeliest go first, the normals (a pair sharing a vertex is mostly
-    told apart by one)."""
+    decides): the normals go first, they tell most pairs apart (a pair sharing a vertex by one)."""
     o = a[0]
     if ga.uok:
         bmin, bmax = _span(b, ga.u, o)
@@ -249,17 +250,24 @@ def _faces_cross(a, b, ga, gb, tol):
         bmin, bmax = _span(b, gb.u, o)
         if _no_contact_spans(amin, amax, bmin, bmax, tol):
             return False
+    return not _edge_axes_prove_no_contact(a, b, ga, gb, tol)
+
+
+@njit(cache=True)
+def _edge_axes_prove_no_contact(a, b, ga, gb, tol):
+    """True when one of the 15 edge axes of `_faces_cross` proves a, b do not cross. Rarely
+    reached, so a call (of tuples: no reference counting), not inlined (keeps compiling fast)."""
     for k in range(3):
         # in-plane edge normals n_A x e_A and n_B x e_B
         if _no_contact_on(a, b, _cross(ga.n, ga.e[k]), ga.n2 * ga.l[k], tol):
-            return False
+            return True
         if _no_contact_on(a, b, _cross(gb.n, gb.e[k]), gb.n2 * gb.l[k], tol):
-            return False
+            return True
     for i in range(3):
         for j in range(3):
             if _no_contact_on(a, b, _cross(ga.e[i], gb.e[j]), ga.l[i] * gb.l[j], tol):
-                return False
-    return True
+                return True
+    return False
 
 
 @njit(cache=True)
@@ -299,8 +307,8 @@ def _store_face(geo, f, g):
 @njit(cache=True, inline="always")
 def _load_face(geo, f):
     """The _Face stored in geo[f] by `_store_face`."""
-    return _Face(((geo[f, 0], geo[f, 1], geo[f, 2]), (geo[f, 3], geo[f, 4], geo[f, 5]), (geo[f, 6], geo[f, 7], geo[f, 8])),
-                 (geo[f, 9], geo[f, 10], geo[f, 11]), (geo[f, 12], geo[f, 13], geo[f, 14]), geo[f, 15],
+    e = ((geo[f, 0], geo[f, 1], geo[f, 2]), (geo[f, 3], geo[f, 4], geo[f, 5]), (geo[f, 6], geo[f, 7], geo[f, 8]))
+    return _Face(e, (geo[f, 9], geo[f, 10], geo[f, 11]), (geo[f, 12], geo[f, 13], geo[f, 14]), geo[f, 15],
                  geo[f, 19] > 0.0, (geo[f, 16], geo[f, 17], geo[f, 18]), (geo[f, 20], geo[f, 21]), geo[f, 22] > 0.0)
 
 
@@ -318,28 +326,34 @@ def _boxes(tris):
 
 @njit(cache=True)
 def collision_work(n_faces):
-    """Work arrays of `config_collides_cached` for one tree of n_faces faces, reused across calls:
+    """Work arrays of `segment_collides` for one tree of n_faces faces, reused across calls:
     (geo, sb, si, last, R, T, out, meta).
 
     geo (F, _G_SIZE): per-face geometry and AABB; sb (7, F): the AABBs (lo x, hi x, lo y, hi y,
-    lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep order (face ids by lo x; kept from
-    call to call, it is the next call's starting guess), then per position parent, piece, rigid
-    group, non-degenerate flag, and scratch for the candidates of one face; last (F, 2), R, T,
+    lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep
+    order (face ids by lo x; kept from call to call, it is the next call's starting guess), then
+    per position parent, piece, rigid group, non-degenerate flag, and scratch for the candidates
+    of one face; last (F, 2), R, T,
     out: the folded state of the previous call (see `_fold`); meta (1,): the tol geo was filled
     with (NaN: geo not of out). The state changes only the cost, never a verdict.
     """
     si = np.empty((6, n_faces), dtype=np.int64)
-    si[0] = np.arange(n_faces)
-    return (np.empty((n_faces, _G_SIZE)), np.empty((7, n_faces)), si, np.full((n_faces, 2), np.nan),
-            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), np.full(1, np.nan))
+    last = np.empty((n_faces, 2))
+    meta = np.empty(1)
+    for f in range(n_faces):  # (loops, not np.full: that takes seconds to compile)
+        si[0, f] = f
+        last[f, 0] = np.nan
+    meta[0] = np.nan
+    return (np.empty((n_faces, _G_SIZE)), np.empty((7, n_faces)), si, last,
+            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), meta)
 
 
 @njit(cache=True, inline="always")
 def _fill_faces(tris, tol, geo, last):
-    """geo[f] = the _Face of tris[f] (F, 3, 3) and its AABB, for every face, or (last: see
-    `_fold`) only for the faces the last forward kinematics changed."""
+    """geo[f] = the _Face of tris[f] (F, 3, 3) and its AABB, for the faces the last forward
+    kinematics changed (last: see `_fold`); the other rows still hold their faces."""
     for f in range(tris.shape[0]):
-        if last is not None and last[f, 1] == 0.0:
+        if last[f, 1] == 0.0:
             continue
         _store_face(geo, f, _face_geometry(_corners(tris, f), tol))
         for i in range(3):
@@ -372,17 +386,23 @@ def _sort_by_lo_x(geo, sb, si):
         si[0, q + 1] = f
         budget -= p - 1 - q
         if budget < 0:
-            si[0, :] = np.argsort(geo[:, _G_LO], kind="mergesort")
-            for r in range(n):
-                sb[0, r] = geo[si[0, r], _G_LO]
+            _merge_sort_by_lo_x(geo, sb, si)
             return
+
+
+@njit(cache=True)
+def _merge_sort_by_lo_x(geo, sb, si):
+    """si[0] = face ids sorted by (lo x, face id) by a stable merge sort, sb[0] = their lo x (the
+    rare fallback of `_sort_by_lo_x`: a call, not inlined, keeps compiling fast)."""
+    si[0, :] = np.argsort(geo[:, _G_LO], kind="mergesort")
+    for r in range(si.shape[1]):
+        sb[0, r] = geo[si[0, r], _G_LO]
 
 
 @njit(cache=True, inline="always")
 def _gather(geo, parent, piece, rigid, sb, si):
     """Fill sb and si[1:5] for the sweep order si[0] (see `collision_work`): contiguous rows for
-    the sweep's inner loop, and sb[6] = running maximum of hi x. rigid (F,) groups, or None (no
-    group)."""
+    the sweep's inner loop, and sb[6] = running maximum of hi x. rigid (F,) groups (-1: none)."""
     top = -np.inf
     for p in range(si.shape[1]):
         f = si[0, p]
@@ -392,14 +412,14 @@ def _gather(geo, parent, piece, rigid, sb, si):
         sb[6, p] = top
         si[1, p] = parent[f]
         si[2, p] = piece[f]
-        si[3, p] = -1 if rigid is None else rigid[f]
+        si[3, p] = rigid[f]
         si[4, p] = 0 if geo[f, 22] > 0.0 else 1  # _Face.sliver
 
 
 @njit(cache=True, inline="always")
 def _largest_group(rigid, counts):
     """The rigid group holding more than half of the faces, or -1 (also when a label is not a
-    face id); counts (F,) scratch."""
+    face id); counts (F,) int scratch."""
     n = rigid.shape[0]
     counts[:] = 0
     for f in range(n):
@@ -414,21 +434,19 @@ def _largest_group(rigid, counts):
 
 
 @njit(cache=True, inline="always")
-def _sweep(tris, geo, sb, si, tol, max_pairs, pairs, big):
+def _sweep(tris, geo, sb, si, tol, big):
     """Sort-and-sweep on x over the faces' AABBs in the order si[0] (filled by `_gather`).
 
     A pair is tested (`_faces_cross`, the face earlier in the order as a) unless its boxes are
     apart by more than tol on x, y or z, or it is not in one piece, or it is a crease pair, or
     both faces are in the same rigid group (rigid >= 0: their relative pose is fixed, see
-    `config_collides_moving`), or a face is degenerate. Stops after max_pairs hits, recording the
-    first ones (i < j) in pairs (None: none recorded); returns the number of hits found.
+    `config_collides_moving`), or a face is degenerate. True at the first pair that crosses.
     big >= 0: a rigid group of most faces, whose own pairs are not tested: only the other faces
     are swept, forward and backward (big = -1: forward from every face).
     sb rows: lo x, hi x, lo y, hi y, lo z, hi z, running max of hi x; si rows: face, parent,
     piece, rigid, non-degenerate, scratch.
     """
     n = tris.shape[0]
-    count = 0
     for ii in range(n):
         if si[4, ii] == 0 or (big >= 0 and si[3, ii] == big):
             continue  # a degenerate face crosses nothing; big's faces are met from the others
@@ -444,7 +462,8 @@ def _sweep(tris, geo, sb, si, tol, max_pairs, pairs, big):
             end += 1
         k = 0
         for jj in range(ii + 1, end):
-            apart = (sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol) | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol)
+            apart = ((sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
+                     | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol))
             si[5, k] = jj
             k += 1 - np.int64(apart)
         later = k
@@ -468,12 +487,40 @@ def _sweep(tris, geo, sb, si, tol, max_pairs, pairs, big):
             if (si[4, jj] == 0 or si[2, jj] != si[2, ii] or si[1, jj] == i or si[1, ii] == j
                     or (si[3, ii] >= 0 and si[3, jj] == si[3, ii])):
                 continue
-            if c < later:
-                crosses = _faces_cross(t, _corners(tris, j), gt, _load_face(geo, j), tol)
-            else:
-                crosses = _faces_cross(_corners(tris, j), t, _load_face(geo, j), gt, tol)
-            if crosses:
-                if pairs is not None and count < pairs.shape[0]:
+            u = _corners(tris, j)
+            gu = _load_face(geo, j)
+            # a: the face earlier in the order (i for the forward sweep, j for the backward one)
+            a, b, ga, gb = (t, u, gt, gu) if c < later else (u, t, gu, gt)
+            if _faces_cross(a, b, ga, gb, tol):
+                return True
+    return False
+
+
+@njit(cache=True)
+def _collisions(tris, parent, piece, tol, max_pairs, pairs):
+    """Colliding pairs for reports (first_collision, all_collisions): sort-and-sweep on x in the
+    order of np.argsort of the boxes' lo x, `triangles_collide` on each candidate (the face
+    earlier in the order as a), as this module always did, so the pairs reported and their order
+    are the ones it always reported (the planners' test is `segment_collides`). Stops after
+    max_pairs hits, the first ones (i < j) written to pairs; returns the number of hits."""
+    n = tris.shape[0]
+    lo, hi = _boxes(tris)
+    xs = np.argsort(lo[:, 0])
+    count = 0
+    for ii in range(n):
+        i = xs[ii]
+        for jj in range(ii + 1, n):
+            j = xs[jj]
+            if lo[j, 0] - hi[i, 0] > tol:
+                break
+            if lo[j, 1] - hi[i, 1] > tol or lo[i, 1] - hi[j, 1] > tol:
+                continue
+            if lo[j, 2] - hi[i, 2] > tol or lo[i, 2] - hi[j, 2] > tol:
+                continue
+            if piece[i] != piece[j] or parent[i] == j or parent[j] == i:
+                continue
+            if triangles_collide(tris[i], tris[j], tol):
+                if count < pairs.shape[0]:
                     pairs[count, 0] = min(i, j)
                     pairs[count, 1] = max(i, j)
                 count += 1
@@ -483,21 +530,10 @@ def _sweep(tris, geo, sb, si, tol, max_pairs, pairs, big):
 
 
 @njit(cache=True)
-def _collisions(tris, parent, piece, tol, max_pairs, pairs):
-    """`_sweep` in the order of np.argsort of the boxes' lo x, as this module always did, so the
-    pairs reported (first_collision, all_collisions) are the ones it always reported."""
-    geo, sb, si = collision_work(tris.shape[0])[:3]
-    _fill_faces(tris, tol, geo, None)
-    si[0, :] = np.argsort(geo[:, _G_LO])
-    _gather(geo, parent, piece, None, sb, si)
-    return _sweep(tris, geo, sb, si, tol, max_pairs, pairs, -1)
-
-
-@njit(cache=True)
 def first_collision(tris, parent, piece, tol):
     """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1)."""
     pairs = np.empty((1, 2), dtype=np.int64)
-    if _collisions(tris, parent, piece, tol, 1, pairs) > 0:
+    if _collisions(tris, parent, piece, tol, np.int64(1), pairs) > 0:
         return pairs[0, 0], pairs[0, 1]
     return -1, -1
 
@@ -510,24 +546,47 @@ def all_collisions(tris, parent, piece, tol, max_pairs):
     return count, pairs[: min(count, max_pairs)]
 
 
-@njit(cache=True, inline="always")
-def _tris_collide(tris, parent, piece, rigid, tol, geo, sb, si, last):
-    """True if some pair of folded faces tris crosses (pairs in one rigid group skipped; rigid may
-    be None); geo, sb, si: `collision_work` arrays, geo rows of the faces unchanged since the last
-    call kept (last: see `_fold`) or all refilled (last None)."""
-    _fill_faces(tris, tol, geo, last)
-    _sort_by_lo_x(geo, sb, si)
-    _gather(geo, parent, piece, rigid, sb, si)
-    big = -1 if rigid is None else _largest_group(rigid, si[5])
-    return _sweep(tris, geo, sb, si, tol, 1, None, big) > 0
+@njit(cache=True)
+def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, rigid, tol, work, q):
+    """The planners' collision test, at the configurations q = qa + (k / m) (qb - qa) for k in ks,
+    in that order (m = 0: q = qa), up to the first that self-intersects: (collides, checked).
+
+    Pairs with rigid[i] == rigid[j] >= 0 are not tested (see `config_collides_moving`; -1 for
+    none). work: `collision_work(F)` of this tree, reused across calls: the faces and sweep order
+    of the previous configuration are the starting point (work's out holds the last configuration
+    folded). q (E,) scratch. All the samples of a segment in one call: a call between compiled
+    functions updates the reference count of every array argument, which per configuration
+    would cost a tenth of a small net's test.
+    """
+    geo, sb, si, last, R, T, out, meta = work
+    if not (meta[0] == tol):
+        last[:, 0] = np.nan  # geo rows of another tol: recompute every face
+        meta[0] = tol
+    big = _largest_group(rigid, si[5])
+    checked = 0
+    for k in ks:
+        if m == 0:
+            q[:] = qa
+        else:
+            t = k / m
+            for i in range(qa.shape[0]):
+                q[i] = qa[i] + t * (qb[i] - qa[i])
+        checked += 1
+        _fold(q, order, parent, crease, axis, flat, R, T, out, last)
+        _fill_faces(out, tol, geo, last)
+        _sort_by_lo_x(geo, sb, si)
+        _gather(geo, parent, piece, rigid, sb, si)
+        if _sweep(out, geo, sb, si, tol, big):
+            return True, checked
+    return False, checked
 
 
 @njit(cache=True)
-def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
-    """forward_kinematics into (R, T, out), then the collision test: True if q self-intersects."""
-    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
-    geo, sb, si = collision_work(order.shape[0])[:3]
-    return _tris_collide(out, parent, piece, None, tol, geo, sb, si, None)
+def config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work):
+    """`config_collides_moving` with the work arrays of `segment_collides` (rigid -1: no group)."""
+    # np.int64(0), not 0: a literal would compile another specialization of segment_collides
+    return segment_collides(q, q, np.zeros(1, dtype=np.int64), np.int64(0), order, parent, crease, axis, flat,
+                            piece, rigid, tol, work, np.empty(q.shape[0]))[0]
 
 
 @njit(cache=True)
@@ -538,23 +597,20 @@ def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, t
     their relative pose; if both endpoints are collision-free such pairs never collide, so a
     planner can label those rigid groups once per segment and skip them.
     """
-    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
-    geo, sb, si = collision_work(order.shape[0])[:3]
-    return _tris_collide(out, parent, piece, rigid, tol, geo, sb, si, None)
+    work = collision_work(order.shape[0])
+    hit = config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work)
+    R[:] = work[4]
+    T[:] = work[5]
+    out[:] = work[6]
+    return hit
 
 
-@njit(cache=True, inline="always")
-def config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work):
-    """`config_collides_moving` (rigid may be None: `config_collides`) for planners: folds into
-    the arrays of work (`collision_work(F)`, one per tree; its out holds the folded faces after
-    the call) and reuses what did not change since the previous call (faces, sweep order).
-    Inlined into compiled callers (no per-call reference counting of its arrays)."""
-    geo, sb, si, last, R, T, out, meta = work
-    if not (meta[0] == tol):
-        last[:, 0] = np.nan  # geo rows of another tol: recompute every face
-        meta[0] = tol
-    _fold(q, order, parent, crease, axis, flat, R, T, out, last)
-    return _tris_collide(out, parent, piece, rigid, tol, geo, sb, si, last)
+@njit(cache=True)
+def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+    """forward_kinematics into (R, T, out), then the collision test: True if q self-intersects."""
+    no_groups = np.empty(order.shape[0], dtype=np.int64)
+    no_groups[:] = -1
+    return config_collides_moving(q, order, parent, crease, axis, flat, piece, no_groups, tol, R, T, out)
 
 
 # --------------------------------------------------------------------------------------------------
