@@ -147,23 +147,23 @@ def _corners(tris, f):
             (tris[f, 2, 0], tris[f, 2, 1], tris[f, 2, 2]))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _edge(t, k):
     k1 = (k + 1) % 3
     return (t[k1][0] - t[k][0], t[k1][1] - t[k][1], t[k1][2] - t[k][2])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _dot(u, v):
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _cross(u, v):
     return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _is_sliver(n2, l2, tol):
     """Degenerate triangle: |n| = 2 area ~ 0 relative to its sides, or height over the longest side
     <= tol (as `overlap.triangles_overlap`); n2 = |n|^2, l2 = squared side lengths."""
@@ -192,7 +192,7 @@ def _no_contact_spans(amin, amax, bmin, bmax, tol):
     return False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _unit(n, ref2):
     """(usable, n / |n|): an axis is usable when |n|^2 > _AXIS_EPS2 * ref2 (ref2: the product of
     the squared lengths crossed); near-zero axes prove nothing."""
@@ -203,7 +203,7 @@ def _unit(n, ref2):
     return True, (n[0] * inv, n[1] * inv, n[2] * inv)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _no_contact_on(a, b, n, ref2, tol):
     """True when axis n (any length) proves triangles a, b do not cross (`_no_contact_spans`;
     origin a's first corner)."""
