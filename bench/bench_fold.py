@@ -7,6 +7,15 @@ every paper part gets a verified path; the 7 horse parts <= 0.25 s total net + p
 119 s). Times are wall-clock seconds in one process with the numba kernels already compiled.
 
     .venv/bin/python bench/bench_fold.py [--seeds 1] [--time-limit 60] [--prefer-linear] [--contact-tol 1e-7]
+    .venv/bin/python bench/bench_fold.py --collision   # the collision test alone, us per configuration
+
+--collision: microseconds per configuration of the planners' collision test, thread time, best of
+15: "line" = the 0.5 degree samples of the straight line flat -> goal in order, up to the first
+that collides (`kinematics.segment_collides`); "path" = the segments of plan_fold's own path
+checked at 0.5 degree as the planners do (`fold.segment_free`: bisection order, rigid groups).
+Target (perf-coll): at least 2x faster than 057cf99 on small and mid nets, no slower on big ones;
+the 057cf99 columns hold that commit's times measured the same way on the development machine
+(2 shared cores, so compare runs made at the same time).
 
 fish/part-4 (from the paper's own data) intersects itself in its folded goal shape by ~2.4e-4 of the
 model size, so no path exists at the default contact tolerance; `--contact-tol 1e-3` (0.15 mm on a
@@ -71,13 +80,96 @@ def run(path: Path, seed: int, time_limit: float, prefer_linear: bool, contact_t
     return row
 
 
+# us per configuration at 057cf99 (line, path) on the dev machine, measured as collision_table does
+# (057cf99 checked a segment with one config_collides_moving call per sample)
+COLLISION_BEFORE = {
+    "periscope-28 part 0": (2.48, 2.22), "periscope-28 part 1": (1.70, None), "periscope2-44 part 0": (3.6, 2.4),
+    "horse-302 part 1": (24.3, None), "horse-302 part 3": (19.0, 10.3), "bunny-128": (33.3, 14.2),
+    "horse-302": (99.5, 38.4), "fish-472": (160.0, None),
+}
+
+
+def collision_table() -> None:
+    """Print us per configuration of the collision test (see the module docstring)."""
+    import math
+
+    from numba import njit
+
+    from polyfold.fold import segment_free
+    from polyfold.kinematics import collision_work, segment_collides
+    from polyfold.segment import segment
+
+    def best_of(fn) -> float:
+        fn()
+        best = math.inf
+        for _ in range(15):
+            t = time.thread_time()
+            fn()
+            best = min(best, time.thread_time() - t)
+        return best
+
+    def line_us(tree) -> float:
+        """The straight line's 0.5 degree samples in order, up to the first that collides, in one
+        call (as a segment)."""
+        m = int(math.ceil(np.abs(tree.goal).max() / math.radians(0.5) - 1e-12))
+        zero, ks = np.zeros(tree.n_edges), np.arange(1, m)
+        work = collision_work(tree.n_faces)
+        args = (zero, tree.goal, ks, m, tree.order, tree.parent, tree.crease, tree.axis, tree.flat, tree.piece,
+                np.arange(tree.n_faces), tree.tol, work, np.empty(tree.n_edges))
+        checked = segment_collides(*args)[1]
+        return best_of(lambda: segment_collides(*args)) / checked * 1e6
+
+    def path_us(tree, frames) -> float:
+        """The path's segments at 0.5 degree, as the planner checks them (one call per segment)."""
+        work = collision_work(tree.n_faces)
+        q = np.empty(tree.n_edges)
+        t = tree
+        checked = sum(segment_free(a, b, math.radians(0.5), t.order, t.parent, t.crease, t.axis, t.flat, t.piece,
+                                   t.tol, q, 1 << 40, work)[1] for a, b in zip(frames[:-1], frames[1:]))
+
+        def run():
+            for a, b in zip(frames[:-1], frames[1:]):
+                segment_free(a, b, math.radians(0.5), t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, q,
+                             1 << 40, work)
+        return best_of(run) / checked * 1e6
+
+    nets = []
+    for name, parts, keep in (("periscope-28", 2, None), ("periscope2-44", 3, (0,)), ("horse-302", 7, (1, 3)),
+                              ("bunny-128", None, None), ("horse-302", None, None), ("fish-472", None, None)):
+        mesh = load_mesh(MODELS / f"{name}.obj").mesh
+        if parts is None:
+            nets.append((name, mesh))
+            continue
+        for i, part in enumerate(segment(mesh, parts=parts).parts):
+            if keep is None or i in keep:
+                nets.append((f"{name} part {i}", part))
+    print(f"{'net':<22} {'faces':>5} {'line us':>8} {'057cf99':>8} {'path us':>8} {'057cf99':>8}  path planner")
+    for label, mesh in nets:
+        net, _ = unfold(mesh, seed=1, time_limit=20)
+        tree = fold_tree(net_to_fold([net]))
+        us_path, planner = None, "-"
+        if not collides(tree, tree.goal):
+            path = plan_fold(tree, seed=1)
+            if path is not None:
+                planner = path.planner
+                if len(path.frames) > 2:
+                    us_path = path_us(tree, path.frames)
+        before = COLLISION_BEFORE.get(label, (None, None))
+        cells = " ".join(f"{v:>8.2f}" if v is not None else f"{'-':>8}" for v in (line_us(tree), before[0], us_path, before[1]))
+        print(f"{label:<22} {tree.n_faces:>5} {cells}  {planner}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=1)
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--prefer-linear", action="store_true")
     ap.add_argument("--contact-tol", type=float, default=1e-7, help="contact tolerance, fraction of the model size")
+    ap.add_argument("--collision", action="store_true", help="only the table of the collision test's cost")
     args = ap.parse_args()
+    if args.collision:
+        collision_table()
+        return
     run(MODELS / "tetrahedron-4.obj", 0, 10, False)  # compile / load the numba caches first
     print(f"{'part':<22} {'seed':>4} {'DOF':>4} {'pcs':>3} {'LC':>5} {'net s':>7} {'path s':>7} {'total':>7} {'frames':>6}  planner / note")
     totals: dict[tuple[str, int], float] = {}

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .kinematics import FoldTree, config_collides, config_collides_moving
+from .kinematics import FoldTree, collision_work, config_collides_cached, segment_collides
 
 PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
@@ -80,12 +80,12 @@ def _bisection_order(m: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, R, T, out, q, max_samples) -> tuple:
+def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, q, max_samples, work) -> tuple:
     """Check the straight segment qa -> qb at interior samples k/m, m = ceil(max|qb - qa| / step).
 
     Samples go in bisection order; only the first `max_samples` are checked (a cheap coarse test
-    when small; pass a huge number for the full check). Endpoints are assumed valid. Returns
-    (free, configurations checked).
+    when small; pass a huge number for the full check). Endpoints are assumed valid. q (E,)
+    scratch; work: the tree's `collision_work` arrays. Returns (free, configurations checked).
     """
     span = 0.0
     for i in range(qa.shape[0]):
@@ -99,17 +99,9 @@ def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, R,
             rigid[f] = f
         else:
             rigid[f] = rigid[parent[f]]
-    checked = 0
-    for k in _bisection_order(m):
-        if checked >= max_samples:
-            break
-        t = k / m
-        for i in range(qa.shape[0]):
-            q[i] = qa[i] + t * (qb[i] - qa[i])
-        checked += 1
-        if config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out):
-            return False, checked
-    return True, checked
+    hit, checked = segment_collides(qa, qb, _bisection_order(m)[:max_samples], m, order, parent, crease, axis, flat,
+                                    piece, rigid, tol, work, q)
+    return not hit, checked
 
 
 class _Checker:
@@ -118,24 +110,23 @@ class _Checker:
     def __init__(self, tree: FoldTree, resolution: float):
         self.tree = tree
         self.step = resolution
-        n_f = len(tree.order)
-        self.R = np.empty((n_f, 3, 3))
-        self.T = np.empty((n_f, 3))
-        self.out = np.empty((n_f, 3, 3))
         self.q = np.empty(len(tree.goal))
+        self.work = collision_work(len(tree.order))
+        self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
         self.configs = 0
         self.edges = 0
 
     def valid(self, q: np.ndarray) -> bool:
         t = self.tree
         self.configs += 1
-        return not config_collides(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, self.R, self.T, self.out)
+        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
+                                          t.tol, self.work)
 
     def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
         t = self.tree
         self.edges += 1
         free, n = segment_free(qa, qb, self.step if step is None else step, t.order, t.parent, t.crease, t.axis,
-                               t.flat, t.piece, t.tol, self.R, self.T, self.out, self.q, max_samples)
+                               t.flat, t.piece, t.tol, self.q, max_samples, self.work)
         self.configs += n
         return bool(free)
 

@@ -15,12 +15,15 @@ collide (paper cannot pass through paper). Every pair of faces of one piece is t
 crease pairs (parent, child), including faces that share a net vertex and twins of a cut edge.
 
 The numba kernels take plain arrays so a planner can call them inside its own @njit loops:
-`forward_kinematics`, `triangles_collide`, `first_collision`, `config_collides`.
+`forward_kinematics`, `triangles_collide`, `first_collision`, `config_collides`, and for planners
+`collision_work` + `segment_collides` (all the samples of a segment in one call, reusing what did
+not change from one configuration to the next).
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,9 +52,33 @@ def forward_kinematics(q, order, parent, crease, axis, flat, R, T, out):
     axis (F, 2) corners of the parent at the crease ends, a -> b in the parent's CCW order;
     flat (F, 3, 3) flat corners (z = 0). R (F, 3, 3), T (F, 3), out (F, 3, 3) are overwritten.
     """
+    _fold(q, order, parent, crease, axis, flat, R, T, out, None)
+    return out
+
+
+# The per-configuration kernels below are inlined into their callers (inline="always"): a call
+# between compiled functions updates the reference count of every array argument atomically
+# (~5 ns each), which summed to about a third of a small net's collision test.
+
+
+@njit(cache=True, inline="always")
+def _fold(q, order, parent, crease, axis, flat, R, T, out, last):
+    """`forward_kinematics`, inlined. last: None, or (F, 2) per face the crease angle R, T, out
+    of the face were last computed with (NaN: never; roots 0.0) and whether this call changed
+    them (1.0) or not (0.0). A face whose parent did not change and whose angle is the same, bit
+    for bit, would be recomputed to the same values, so it is skipped: a planner's segment often
+    moves only a few creases. (R, T, out must then hold the result of the previous call.)"""
     for ii in range(order.shape[0]):
         f = order[ii]
         p = parent[f]
+        if last is not None:
+            angle = 0.0 if p < 0 else q[crease[f]]
+            if ((p < 0 or last[p, 1] == 0.0) and angle == last[f, 0]
+                    and math.copysign(1.0, angle) == math.copysign(1.0, last[f, 0])):  # sin(-0.0) = -0.0
+                last[f, 1] = 0.0
+                continue
+            last[f, 0] = angle
+            last[f, 1] = 1.0
         if p < 0:
             for i in range(3):
                 for j in range(3):
@@ -107,26 +134,38 @@ def forward_kinematics(q, order, parent, crease, axis, flat, R, T, out):
             z = flat[f, k, 2]
             for i in range(3):
                 out[f, k, i] = R[f, i, 0] * x + R[f, i, 1] * y + R[f, i, 2] * z + T[f, i]
-    return out
+
+
+# Triangles in the collision kernels are tuples of corner tuples ((x, y, z) x 3), loaded from the
+# arrays by scalar reads: an array view (tris[i]) costs two atomic reference-count updates, more
+# than the cheap pair tests themselves.
 
 
 @njit(cache=True, inline="always")
+def _corners(tris, f):
+    """Triangle f of tris (F, 3, 3) as a tuple of corner tuples."""
+    return ((tris[f, 0, 0], tris[f, 0, 1], tris[f, 0, 2]),
+            (tris[f, 1, 0], tris[f, 1, 1], tris[f, 1, 2]),
+            (tris[f, 2, 0], tris[f, 2, 1], tris[f, 2, 2]))
+
+
+@njit(cache=True)
 def _edge(t, k):
     k1 = (k + 1) % 3
-    return (t[k1, 0] - t[k, 0], t[k1, 1] - t[k, 1], t[k1, 2] - t[k, 2])
+    return (t[k1][0] - t[k][0], t[k1][1] - t[k][1], t[k1][2] - t[k][2])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _dot(u, v):
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _cross(u, v):
     return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _is_sliver(n2, l2, tol):
     """Degenerate triangle: |n| = 2 area ~ 0 relative to its sides, or height over the longest side
     <= tol (as `overlap.triangles_overlap`); n2 = |n|^2, l2 = squared side lengths."""
@@ -135,28 +174,18 @@ def _is_sliver(n2, l2, tol):
 
 
 @njit(cache=True, inline="always")
-def _no_contact_on(a, b, ox, oy, oz, n, ref2, tol):
-    """True when axis n proves the triangles do not cross: a gap > tol, or a touching witness
-    (depth <= tol, unless both projections are thinner than tol). Near-zero axes prove nothing."""
-    nx, ny, nz = n
-    l2 = nx * nx + ny * ny + nz * nz
-    if not (l2 > _AXIS_EPS2 * ref2):
-        return False
-    inv = 1.0 / math.sqrt(l2)
-    nx *= inv
-    ny *= inv
-    nz *= inv
-    amin = np.inf
-    amax = -np.inf
-    bmin = np.inf
-    bmax = -np.inf
-    for k in range(3):
-        s = nx * (a[k, 0] - ox) + ny * (a[k, 1] - oy) + nz * (a[k, 2] - oz)
-        t = nx * (b[k, 0] - ox) + ny * (b[k, 1] - oy) + nz * (b[k, 2] - oz)
-        amin = min(amin, s)
-        amax = max(amax, s)
-        bmin = min(bmin, t)
-        bmax = max(bmax, t)
+def _span(t, n, o):
+    """(min, max) of the corners of triangle t projected on axis n (unit), origin o."""
+    s0 = n[0] * (t[0][0] - o[0]) + n[1] * (t[0][1] - o[1]) + n[2] * (t[0][2] - o[2])
+    s1 = n[0] * (t[1][0] - o[0]) + n[1] * (t[1][1] - o[1]) + n[2] * (t[1][2] - o[2])
+    s2 = n[0] * (t[2][0] - o[0]) + n[1] * (t[2][1] - o[1]) + n[2] * (t[2][2] - o[2])
+    return min(min(s0, s1), s2), max(max(s0, s1), s2)
+
+
+@njit(cache=True, inline="always")
+def _no_contact_spans(amin, amax, bmin, bmax, tol):
+    """True when the projections [amin, amax], [bmin, bmax] on one axis prove the triangles do not
+    cross: a gap > tol, or a touching witness (depth <= tol, unless both are thinner than tol)."""
     depth = min(amax - bmin, bmax - amin)
     if depth < -tol:
         return True  # strictly apart
@@ -166,43 +195,123 @@ def _no_contact_on(a, b, ox, oy, oz, n, ref2, tol):
 
 
 @njit(cache=True)
+def _unit(n, ref2):
+    """(usable, n / |n|): an axis is usable when |n|^2 > _AXIS_EPS2 * ref2 (ref2: the product of
+    the squared lengths crossed); near-zero axes prove nothing."""
+    l2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+    if not (l2 > _AXIS_EPS2 * ref2):
+        return False, (0.0, 0.0, 0.0)
+    inv = 1.0 / math.sqrt(l2)
+    return True, (n[0] * inv, n[1] * inv, n[2] * inv)
+
+
+@njit(cache=True)
+def _no_contact_on(a, b, n, ref2, tol):
+    """True when axis n (any length) proves triangles a, b do not cross (`_no_contact_spans`;
+    origin a's first corner)."""
+    ok, u = _unit(n, ref2)
+    if not ok:
+        return False
+    amin, amax = _span(a, u, a[0])
+    bmin, bmax = _span(b, u, a[0])
+    return _no_contact_spans(amin, amax, bmin, bmax, tol)
+
+
+# What every pair test of a face needs from that face alone (one configuration), so a face in k
+# candidate pairs computes it once, not k times: e = edge vectors e_k = v_{k+1} - v_k, l = their
+# squared lengths, n = e_0 x e_1, n2 = |n|^2, (uok, u) = `_unit(n, l_0 l_1)`, span = (min, max)
+# of the face's own corners on u (origin: its first corner), sliver = degenerate (never collides).
+_Face = namedtuple("_Face", ["e", "l", "n", "n2", "uok", "u", "span", "sliver"])
+_G_SIZE = 29  # values per face in a `geo` row: the 23 of a _Face, then the AABB (lo x y z, hi x y z)
+_G_LO = 23
+
+
+@njit(cache=True, inline="always")
+def _face_geometry(t, tol):
+    """The _Face of triangle t."""
+    e = (_edge(t, 0), _edge(t, 1), _edge(t, 2))
+    l2 = (_dot(e[0], e[0]), _dot(e[1], e[1]), _dot(e[2], e[2]))
+    n = _cross(e[0], e[1])
+    n2 = _dot(n, n)
+    uok, u = _unit(n, l2[0] * l2[1])
+    return _Face(e, l2, n, n2, uok, u, _span(t, u, t[0]), _is_sliver(n2, l2, tol))
+
+
+@njit(cache=True, inline="always")
+def _faces_cross(a, b, ga, gb, tol):
+    """True if non-degenerate triangles a, b cross (the test of `triangles_collide`); ga, gb their
+    _Face. The verdict does not depend on the order of the axes (any axis proving no contact
+    decides): the normals go first, they tell most pairs apart (a pair sharing a vertex by one)."""
+    o = a[0]
+    if ga.uok:
+        bmin, bmax = _span(b, ga.u, o)
+        if _no_contact_spans(ga.span[0], ga.span[1], bmin, bmax, tol):
+            return False
+    if gb.uok:
+        amin, amax = _span(a, gb.u, o)
+        bmin, bmax = _span(b, gb.u, o)
+        if _no_contact_spans(amin, amax, bmin, bmax, tol):
+            return False
+    return not _edge_axes_prove_no_contact(a, b, ga, gb, tol)
+
+
+@njit(cache=True)
+def _edge_axes_prove_no_contact(a, b, ga, gb, tol):
+    """True when one of the 15 edge axes of `_faces_cross` proves a, b do not cross. Rarely
+    reached, so a call (of tuples: no reference counting), not inlined (keeps compiling fast)."""
+    for k in range(3):
+        # in-plane edge normals n_A x e_A and n_B x e_B
+        if _no_contact_on(a, b, _cross(ga.n, ga.e[k]), ga.n2 * ga.l[k], tol):
+            return True
+        if _no_contact_on(a, b, _cross(gb.n, gb.e[k]), gb.n2 * gb.l[k], tol):
+            return True
+    for i in range(3):
+        for j in range(3):
+            if _no_contact_on(a, b, _cross(ga.e[i], gb.e[j]), ga.l[i] * gb.l[j], tol):
+                return True
+    return False
+
+
+@njit(cache=True)
 def triangles_collide(a, b, tol):
     """True if 3D triangles a, b (3, 3) cross each other (relative interiors meet, beyond tol).
 
     Separating-axis test on the 17 candidate axes (2 normals, 6 in-plane edge normals, 9 edge x
-    edge; in that order, likeliest verdicts first). Touching (shared vertex or edge, contact
-    without crossing) is not a collision; coplanar overlapping interiors are. Degenerate triangles (zero area, or every corner within tol
-    of the line of the longest side) never collide.
+    edge). Touching (shared vertex or edge, contact without crossing) is not a collision; coplanar
+    overlapping interiors are. Degenerate triangles (zero area, or every corner within tol of the
+    line of the longest side) never collide.
     """
-    ox = a[0, 0]
-    oy = a[0, 1]
-    oz = a[0, 2]
-    # edges e_k = v_{k+1} - v_k as tuples (no heap allocation in the hot loop)
-    ea = (_edge(a, 0), _edge(a, 1), _edge(a, 2))
-    eb = (_edge(b, 0), _edge(b, 1), _edge(b, 2))
-    la = (_dot(ea[0], ea[0]), _dot(ea[1], ea[1]), _dot(ea[2], ea[2]))
-    lb = (_dot(eb[0], eb[0]), _dot(eb[1], eb[1]), _dot(eb[2], eb[2]))
-    na = _cross(ea[0], ea[1])
-    nb = _cross(eb[0], eb[1])
-    na2 = _dot(na, na)
-    nb2 = _dot(nb, nb)
-    if _is_sliver(na2, la, tol) or _is_sliver(nb2, lb, tol):
+    ta = ((a[0, 0], a[0, 1], a[0, 2]), (a[1, 0], a[1, 1], a[1, 2]), (a[2, 0], a[2, 1], a[2, 2]))
+    tb = ((b[0, 0], b[0, 1], b[0, 2]), (b[1, 0], b[1, 1], b[1, 2]), (b[2, 0], b[2, 1], b[2, 2]))
+    ga = _face_geometry(ta, tol)
+    gb = _face_geometry(tb, tol)
+    if ga.sliver or gb.sliver:
         return False  # (near) zero-area triangle: no interior
-    if _no_contact_on(a, b, ox, oy, oz, na, la[0] * la[1], tol):
-        return False
-    if _no_contact_on(a, b, ox, oy, oz, nb, lb[0] * lb[1], tol):
-        return False
+    return _faces_cross(ta, tb, ga, gb, tol)
+
+
+@njit(cache=True, inline="always")
+def _store_face(geo, f, g):
+    """geo[f, :23] = the _Face g (the layout `_load_face` reads)."""
     for k in range(3):
-        # in-plane edge normals n_A x e_A and n_B x e_B
-        if _no_contact_on(a, b, ox, oy, oz, _cross(na, ea[k]), na2 * la[k], tol):
-            return False
-        if _no_contact_on(a, b, ox, oy, oz, _cross(nb, eb[k]), nb2 * lb[k], tol):
-            return False
-    for i in range(3):
-        for j in range(3):
-            if _no_contact_on(a, b, ox, oy, oz, _cross(ea[i], eb[j]), la[i] * lb[j], tol):
-                return False
-    return True
+        for c in range(3):
+            geo[f, 3 * k + c] = g.e[k][c]
+        geo[f, 9 + k] = g.l[k]
+        geo[f, 12 + k] = g.n[k]
+        geo[f, 16 + k] = g.u[k]
+    geo[f, 15] = g.n2
+    geo[f, 19] = 1.0 if g.uok else 0.0
+    geo[f, 20] = g.span[0]
+    geo[f, 21] = g.span[1]
+    geo[f, 22] = 1.0 if g.sliver else 0.0
+
+
+@njit(cache=True, inline="always")
+def _load_face(geo, f):
+    """The _Face stored in geo[f] by `_store_face`."""
+    e = ((geo[f, 0], geo[f, 1], geo[f, 2]), (geo[f, 3], geo[f, 4], geo[f, 5]), (geo[f, 6], geo[f, 7], geo[f, 8]))
+    return _Face(e, (geo[f, 9], geo[f, 10], geo[f, 11]), (geo[f, 12], geo[f, 13], geo[f, 14]), geo[f, 15],
+                 geo[f, 19] > 0.0, (geo[f, 16], geo[f, 17], geo[f, 18]), (geo[f, 20], geo[f, 21]), geo[f, 22] > 0.0)
 
 
 @njit(cache=True)
@@ -218,11 +327,184 @@ def _boxes(tris):
 
 
 @njit(cache=True)
-def _sweep(tris, parent, piece, tol, max_pairs, pairs, rigid):
-    """Sort-and-sweep on x over the faces' AABBs; a pair is a candidate unless its boxes are apart
-    by more than tol on x, y or z; same piece, not a crease pair, and not in the same rigid group
-    (rigid[i] == rigid[j] >= 0: their relative pose is fixed, see `config_collides_moving`).
-    Stops after max_pairs hits (writing them to pairs); returns the number of hits found."""
+def collision_work(n_faces):
+    """Work arrays of `segment_collides` for one tree of n_faces faces, reused across calls:
+    (geo, sb, si, last, R, T, out, meta).
+
+    geo (F, _G_SIZE): per-face geometry and AABB; sb (7, F): the AABBs (lo x, hi x, lo y, hi y,
+    lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep
+    order (face ids by lo x; kept from call to call, it is the next call's starting guess), then
+    per position parent, piece, rigid group, non-degenerate flag, and scratch for the candidates
+    of one face; last (F, 2), R, T,
+    out: the folded state of the previous call (see `_fold`); meta (1,): the tol geo was filled
+    with (NaN: geo not of out). The state changes only the cost, never a verdict.
+    """
+    si = np.empty((6, n_faces), dtype=np.int64)
+    last = np.empty((n_faces, 2))
+    meta = np.empty(1)
+    for f in range(n_faces):  # (loops, not np.full: that takes seconds to compile)
+        si[0, f] = f
+        last[f, 0] = np.nan
+    meta[0] = np.nan
+    return (np.empty((n_faces, _G_SIZE)), np.empty((7, n_faces)), si, last,
+            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), meta)
+
+
+@njit(cache=True, inline="always")
+def _fill_faces(tris, tol, geo, last):
+    """geo[f] = the _Face of tris[f] (F, 3, 3) and its AABB, for the faces the last forward
+    kinematics changed (last: see `_fold`); the other rows still hold their faces."""
+    for f in range(tris.shape[0]):
+        if last[f, 1] == 0.0:
+            continue
+        _store_face(geo, f, _face_geometry(_corners(tris, f), tol))
+        for i in range(3):
+            geo[f, _G_LO + i] = min(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
+            geo[f, _G_LO + 3 + i] = max(tris[f, 0, i], tris[f, 1, i], tris[f, 2, i])
+
+
+@njit(cache=True, inline="always")
+def _sort_by_lo_x(geo, sb, si):
+    """Sort the face ids si[0] in place by (lo x, face id); sb[0] = their lo x.
+
+    Consecutive configurations of a planner are close, so si[0] (the previous order) is nearly
+    sorted: an insertion sort costs O(F + moves). When the moves pass 8 F (a big jump), a stable
+    merge sort of the face ids instead (the same order: ties by face id). The order never depends
+    on the guess. (Rows are indexed in place: a row view costs atomic reference counting.)
+    """
+    n = si.shape[1]
+    for p in range(n):
+        sb[0, p] = geo[si[0, p], _G_LO]
+    budget = 8 * n
+    for p in range(1, n):
+        v = sb[0, p]
+        f = si[0, p]
+        q = p - 1
+        while q >= 0 and (sb[0, q] > v or (sb[0, q] == v and si[0, q] > f)):
+            sb[0, q + 1] = sb[0, q]
+            si[0, q + 1] = si[0, q]
+            q -= 1
+        sb[0, q + 1] = v
+        si[0, q + 1] = f
+        budget -= p - 1 - q
+        if budget < 0:
+            _merge_sort_by_lo_x(geo, sb, si)
+            return
+
+
+@njit(cache=True)
+def _merge_sort_by_lo_x(geo, sb, si):
+    """si[0] = face ids sorted by (lo x, face id) by a stable merge sort, sb[0] = their lo x (the
+    rare fallback of `_sort_by_lo_x`: a call, not inlined, keeps compiling fast)."""
+    si[0, :] = np.argsort(geo[:, _G_LO], kind="mergesort")
+    for r in range(si.shape[1]):
+        sb[0, r] = geo[si[0, r], _G_LO]
+
+
+@njit(cache=True, inline="always")
+def _gather(geo, parent, piece, rigid, sb, si):
+    """Fill sb and si[1:5] for the sweep order si[0] (see `collision_work`): contiguous rows for
+    the sweep's inner loop, and sb[6] = running maximum of hi x. rigid (F,) groups (-1: none)."""
+    top = -np.inf
+    for p in range(si.shape[1]):
+        f = si[0, p]
+        for r in range(6):
+            sb[r, p] = geo[f, _G_LO + (r >> 1) + 3 * (r & 1)]
+        top = max(top, sb[1, p])
+        sb[6, p] = top
+        si[1, p] = parent[f]
+        si[2, p] = piece[f]
+        si[3, p] = rigid[f]
+        si[4, p] = 0 if geo[f, 22] > 0.0 else 1  # _Face.sliver
+
+
+@njit(cache=True, inline="always")
+def _largest_group(rigid, counts):
+    """The rigid group holding more than half of the faces, or -1 (also when a label is not a
+    face id); counts (F,) int scratch."""
+    n = rigid.shape[0]
+    counts[:] = 0
+    for f in range(n):
+        g = rigid[f]
+        if g >= n:
+            return -1
+        if g >= 0:
+            counts[g] += 1
+            if 2 * counts[g] > n:
+                return g
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _sweep(tris, geo, sb, si, tol, big):
+    """Sort-and-sweep on x over the faces' AABBs in the order si[0] (filled by `_gather`).
+
+    A pair is tested (`_faces_cross`, the face earlier in the order as a) unless its boxes are
+    apart by more than tol on x, y or z, or it is not in one piece, or it is a crease pair, or
+    both faces are in the same rigid group (rigid >= 0: their relative pose is fixed, see
+    `config_collides_moving`), or a face is degenerate. True at the first pair that crosses.
+    big >= 0: a rigid group of most faces, whose own pairs are not tested: only the other faces
+    are swept, forward and backward (big = -1: forward from every face).
+    sb rows: lo x, hi x, lo y, hi y, lo z, hi z, running max of hi x; si rows: face, parent,
+    piece, rigid, non-degenerate, scratch.
+    """
+    n = tris.shape[0]
+    for ii in range(n):
+        if si[4, ii] == 0 or (big >= 0 and si[3, ii] == big):
+            continue  # a degenerate face crosses nothing; big's faces are met from the others
+        i = si[0, ii]
+        loy = sb[2, ii]
+        hiy = sb[3, ii]
+        loz = sb[4, ii]
+        hiz = sb[5, ii]
+        # Branch-free box filters into si[5]: whether boxes overlap in y and z is hard to
+        # predict, and a mispredicted branch costs more than all four comparisons.
+        end = ii + 1
+        while end < n and not (sb[0, end] - sb[1, ii] > tol):  # later faces overlapping in x
+            end += 1
+        k = 0
+        for jj in range(ii + 1, end):
+            apart = ((sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
+                     | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol))
+            si[5, k] = jj
+            k += 1 - np.int64(apart)
+        later = k
+        if big >= 0:
+            # earlier faces of big overlapping in x (the others were swept from themselves); no
+            # face before jj reaches past the running maximum of hi x
+            jj = ii - 1
+            while jj >= 0 and not (sb[0, ii] - sb[6, jj] > tol):
+                apart = ((sb[0, ii] - sb[1, jj] > tol) | (sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
+                         | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol) | (si[3, jj] != big))
+                si[5, k] = jj
+                k += 1 - np.int64(apart)
+                jj -= 1
+        if k == 0:
+            continue
+        t = _corners(tris, i)
+        gt = _load_face(geo, i)
+        for c in range(k):
+            jj = si[5, c]
+            j = si[0, jj]
+            if (si[4, jj] == 0 or si[2, jj] != si[2, ii] or si[1, jj] == i or si[1, ii] == j
+                    or (si[3, ii] >= 0 and si[3, jj] == si[3, ii])):
+                continue
+            u = _corners(tris, j)
+            gu = _load_face(geo, j)
+            # a: the face earlier in the order (i for the forward sweep, j for the backward one)
+            a, b, ga, gb = (t, u, gt, gu) if c < later else (u, t, gu, gt)
+            if _faces_cross(a, b, ga, gb, tol):
+                return True
+    return False
+
+
+@njit(cache=True)
+def _collisions(tris, parent, piece, tol, max_pairs, pairs):
+    """Colliding pairs for reports (first_collision, all_collisions): sort-and-sweep on x in the
+    order of np.argsort of the boxes' lo x, `triangles_collide` on each candidate (the face
+    earlier in the order as a), as this module always did, so the pairs reported and their order
+    are the ones it always reported (the planners' test is `segment_collides`). Stops after
+    max_pairs hits, the first ones (i < j) written to pairs; returns the number of hits."""
     n = tris.shape[0]
     lo, hi = _boxes(tris)
     xs = np.argsort(lo[:, 0])
@@ -239,8 +521,6 @@ def _sweep(tris, parent, piece, tol, max_pairs, pairs, rigid):
                 continue
             if piece[i] != piece[j] or parent[i] == j or parent[j] == i:
                 continue
-            if rigid[i] >= 0 and rigid[i] == rigid[j]:
-                continue
             if triangles_collide(tris[i], tris[j], tol):
                 if count < pairs.shape[0]:
                     pairs[count, 0] = min(i, j)
@@ -255,7 +535,7 @@ def _sweep(tris, parent, piece, tol, max_pairs, pairs, rigid):
 def first_collision(tris, parent, piece, tol):
     """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1)."""
     pairs = np.empty((1, 2), dtype=np.int64)
-    if _sweep(tris, parent, piece, tol, 1, pairs, np.full(tris.shape[0], -1, dtype=np.int64)) > 0:
+    if _collisions(tris, parent, piece, tol, np.int64(1), pairs) > 0:
         return pairs[0, 0], pairs[0, 1]
     return -1, -1
 
@@ -264,17 +544,51 @@ def first_collision(tris, parent, piece, tol):
 def all_collisions(tris, parent, piece, tol, max_pairs):
     """(count, pairs): all colliding pairs (count), the first min(count, max_pairs) of them."""
     pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
-    count = _sweep(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs],
-                   np.full(tris.shape[0], -1, dtype=np.int64))
+    count = _collisions(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs])
     return count, pairs[: min(count, max_pairs)]
 
 
 @njit(cache=True)
-def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
-    """forward_kinematics into (R, T, out), then first_collision: True if q self-intersects."""
-    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
-    i, _ = first_collision(out, parent, piece, tol)
-    return i >= 0
+def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, rigid, tol, work, q):
+    """The planners' collision test, at the configurations q = qa + (k / m) (qb - qa) for k in ks,
+    in that order (m = 0: q = qa), up to the first that self-intersects: (collides, checked).
+
+    Pairs with rigid[i] == rigid[j] >= 0 are not tested (see `config_collides_moving`; -1 for
+    none). work: `collision_work(F)` of this tree, reused across calls: the faces and sweep order
+    of the previous configuration are the starting point (work's out holds the last configuration
+    folded). q (E,) scratch. All the samples of a segment in one call: a call between compiled
+    functions updates the reference count of every array argument, which per configuration
+    would cost a tenth of a small net's test.
+    """
+    geo, sb, si, last, R, T, out, meta = work
+    if not (meta[0] == tol):
+        last[:, 0] = np.nan  # geo rows of another tol: recompute every face
+        meta[0] = tol
+    big = _largest_group(rigid, si[5])
+    checked = 0
+    for k in ks:
+        if m == 0:
+            q[:] = qa
+        else:
+            t = k / m
+            for i in range(qa.shape[0]):
+                q[i] = qa[i] + t * (qb[i] - qa[i])
+        checked += 1
+        _fold(q, order, parent, crease, axis, flat, R, T, out, last)
+        _fill_faces(out, tol, geo, last)
+        _sort_by_lo_x(geo, sb, si)
+        _gather(geo, parent, piece, rigid, sb, si)
+        if _sweep(out, geo, sb, si, tol, big):
+            return True, checked
+    return False, checked
+
+
+@njit(cache=True)
+def config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work):
+    """`config_collides_moving` with the work arrays of `segment_collides` (rigid -1: no group)."""
+    # np.int64(0), not 0: a literal would compile another specialization of segment_collides
+    return segment_collides(q, q, np.zeros(1, dtype=np.int64), np.int64(0), order, parent, crease, axis, flat,
+                            piece, rigid, tol, work, np.empty(q.shape[0]))[0]
 
 
 @njit(cache=True)
@@ -285,9 +599,20 @@ def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, t
     their relative pose; if both endpoints are collision-free such pairs never collide, so a
     planner can label those rigid groups once per segment and skip them.
     """
-    forward_kinematics(q, order, parent, crease, axis, flat, R, T, out)
-    pairs = np.empty((1, 2), dtype=np.int64)
-    return _sweep(out, parent, piece, tol, 1, pairs, rigid) > 0
+    work = collision_work(order.shape[0])
+    hit = config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work)
+    R[:] = work[4]
+    T[:] = work[5]
+    out[:] = work[6]
+    return hit
+
+
+@njit(cache=True)
+def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+    """forward_kinematics into (R, T, out), then the collision test: True if q self-intersects."""
+    no_groups = np.empty(order.shape[0], dtype=np.int64)
+    no_groups[:] = -1
+    return config_collides_moving(q, order, parent, crease, axis, flat, piece, no_groups, tol, R, T, out)
 
 
 # --------------------------------------------------------------------------------------------------
