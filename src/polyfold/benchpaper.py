@@ -127,7 +127,11 @@ def _mean_sd(xs: list[float]) -> tuple[float, float]:
     return float(a.mean()), float(a.std(ddof=1)) if len(a) > 1 else 0.0
 
 
-def _fmt(m: float, s: float, digits: int = 3) -> str:
+def _fmt(m: float, s: float, digits: int | None = None) -> str:
+    """mean ± sd; by default 3 decimals, more for small means (at least two significant digits:
+    the periscope rows are fractions of a millisecond)."""
+    if digits is None:
+        digits = 3 if m >= 0.01 or m <= 0 else min(6, 1 - math.floor(math.log10(m)))
     return f"{m:.{digits}f} ± {s:.{digits}f}"
 
 
@@ -484,6 +488,36 @@ def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, s
     return "\n".join(L) + "\n"
 
 
+def _warm_up(models: Path) -> None:
+    """Call every timed stage once on small models, so numba compiles (fresh checkout) or loads
+    its caches before the clock runs: without it the first timed run of a stage carries seconds
+    of compilation (a cold checkout put 35 s into one horse segmentation)."""
+    from .fold import plan_fold, sample_ratio
+    from .foldfile import net_to_fold
+    from .inflate import inflate
+    from .io import load_mesh
+    from .kinematics import collides, fold_tree
+    from .segment import segment
+    from .unfold import unfold
+
+    small = load_mesh(models / "periscope-28.obj").mesh
+    inflate(small, mode="constrained", max_steps=20)
+    inflate(small, mode="uniform", max_steps=20)
+    # the bunny reaches the segmentation's concavity kernels and the unfolder's local search;
+    # a horse patch the planners' kernels for a net that does not fold along a straight line
+    bunny = load_mesh(models / "bunny-128.obj").mesh
+    segment(bunny, parts=3)
+    patch = load_mesh(models / "paper-parts" / "horse" / "part-3.obj").mesh
+    for mesh in (small, bunny, patch):
+        net, _ = unfold(mesh, seed=0, time_limit=10)
+        tree = fold_tree(net_to_fold([net]), 1e-7)
+        collides(tree, tree.goal)
+        for planner in ("linear", "sequential", "lazy-prm"):
+            plan_fold(tree, planner=planner, time_limit=1, seed=0)
+    for strategy in STRATEGIES:
+        sample_ratio(tree, samples=10, strategy=strategy, seed=0)
+
+
 def run(models: Path, out_dir: Path, st: BenchSettings, progress: Callable[[str], None] | None = None) -> dict:
     """Run everything, write out_dir/report.md, report.json, fig3.png, fig5.png; return the data."""
     from .io import atomic_write, load_mesh
@@ -495,7 +529,7 @@ def run(models: Path, out_dir: Path, st: BenchSettings, progress: Callable[[str]
         raise PolyfoldError(f"benchmark models not found in {models} (set POLYFOLD_MODELS)")
     out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    net_and_path(load_mesh(models / "tetrahedron-4.obj").components[0], 0, 10, 1e-7)  # compile / load caches
+    _warm_up(models)
     t1 = table1(models, st, say)
     t2, trees = table2(models, st, say)
     f5 = fig5(trees, st, say)
