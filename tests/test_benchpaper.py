@@ -16,6 +16,8 @@ def test_bench_paper_quick(models_dir, tmp_path):
     assert "Traceback" not in proc.stderr
     data = json.loads((out / "report.json").read_text())
     assert data["settings"]["quick"] and data["settings"]["runs"] == 3
+    # the warm-up reached every kernel the timed runs use: none compiled (or loaded) on the clock
+    assert data["compiled_while_timed"] == []
     # Table 1: the paper's patches have the paper's DOF, and every run found a verified path
     patches = data["table1"]["paper_patches"]
     assert [p["dof"] for p in patches] == PAPER_HORSE_DOF
