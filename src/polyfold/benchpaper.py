@@ -110,16 +110,21 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner
     return row
 
 
+def _planner_counts(rows: list[dict], counts: dict[str, int] | None = None) -> dict[str, int]:
+    """How many of the `net_and_path` rows each planner found the path of (added to counts)."""
+    counts = {} if counts is None else counts
+    for r in rows:
+        if r["planner"]:
+            counts[r["planner"]] = counts.get(r["planner"], 0) + 1
+    return counts
+
+
 def _whole_row(mesh, seeds, time_limit: float, tol: float, planner: str) -> dict:
     """Runs of one whole mesh: seconds per run, paths found, LC count, planners that found them."""
     rows = [net_and_path(mesh, seed, time_limit, tol, planner) for seed in seeds]
-    planners: dict[str, int] = {}
-    for r in rows:
-        if r["planner"]:
-            planners[r["planner"]] = planners.get(r["planner"], 0) + 1
     return {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
             "runs": len(rows), "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
-            "planners": planners, "notes": sorted({r["note"] for r in rows if r["note"]}), "rows": rows}
+            "planners": _planner_counts(rows), "notes": sorted({r["note"] for r in rows if r["note"]}), "rows": rows}
 
 
 def _mean_sd(xs: list[float]) -> tuple[float, float]:
@@ -156,9 +161,7 @@ def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: lis
         per_run.append({"net_s": net_s, "path_s": path_s, "paths": [r["path"] for r in rows],
                         "lc": [r["lc"] for r in rows], "notes": [r["note"] for r in rows],
                         "part_net_s": [r["net_s"] for r in rows], "part_path_s": [r["path_s"] for r in rows]})
-        for r in rows:
-            if r["planner"]:
-                planners[r["planner"]] = planners.get(r["planner"], 0) + 1
+        _planner_counts(rows, planners)
         if seed == 1:
             dofs = [r["dof"] for r in rows]
             trees = [r["tree"] for r in rows]
@@ -514,13 +517,10 @@ def _warm_up(models: Path) -> None:
     """Call every timed stage once on small models, so numba compiles (fresh checkout) or loads
     its caches before the clock runs: without it the first timed run of a stage carries seconds
     of compilation (a cold checkout put 35 s into one horse segmentation)."""
-    from .fold import plan_fold, sample_ratio
-    from .foldfile import net_to_fold
+    from .fold import sample_ratio
     from .inflate import inflate
     from .io import load_mesh
-    from .kinematics import collides, fold_tree
     from .segment import segment
-    from .unfold import unfold
 
     small = load_mesh(models / "periscope-28.obj").mesh
     inflate(small, mode="constrained", max_steps=20)
@@ -531,18 +531,15 @@ def _warm_up(models: Path) -> None:
     segment(bunny, parts=3)
     patch = load_mesh(models / "paper-parts" / "horse" / "part-3.obj").mesh
     for mesh in (small, bunny, patch):
-        net, _ = unfold(mesh, seed=0, time_limit=10)
-        tree = fold_tree(net_to_fold([net]), 1e-7)
-        collides(tree, tree.goal)
         for planner in ("linear", "sequential", "lazy-prm"):
-            plan_fold(tree, planner=planner, time_limit=1, seed=0)
+            tree = net_and_path(mesh, 0, 1.0, 1e-7, planner)["tree"]
     for strategy in STRATEGIES:
         sample_ratio(tree, samples=10, strategy=strategy, seed=0)
 
 
 def run(models: Path, out_dir: Path, st: BenchSettings, progress: Callable[[str], None] | None = None) -> dict:
     """Run everything, write out_dir/report.md, report.json, fig3.png, fig5.png; return the data."""
-    from .io import atomic_write, load_mesh
+    from .io import atomic_write
 
     say = progress or (lambda s: None)
     if not (models / "horse-302.obj").exists():

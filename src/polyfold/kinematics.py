@@ -701,9 +701,7 @@ def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
     frames = fold.get("file_frames")
     if not frames:
         return None
-    frame = frames[0]  # the first foldedForm frame, else the first frame
-    if not (isinstance(frame, dict) and "foldedForm" in (frame.get("frame_classes") or [])):
-        frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frame)
+    frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frames[0])
     if not isinstance(frame, dict) or "vertices_coords" not in frame:
         return None
     coords = _float_array(frame["vertices_coords"], "file_frames[0].vertices_coords", (3,))
@@ -904,7 +902,6 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
         piece=piece, goal=goal, creases=creases[:n_creases], scale=scale,
         tol=contact_tol * scale, folded=folded,
     )
-
 
 
 # --------------------------------------------------------------------------------------------------
