@@ -19,8 +19,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from polyfold.batch import run_batch
-from polyfold.make import MakeOptions
+from polyfold.apps.batch import run_batch
+from polyfold.pipeline.make import MakeOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from polyfold.inflate import inflate
-from polyfold.io import load_mesh
-from polyfold.mesh import Mesh
+from polyfold.inflate.inflate import inflate
+from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.mesh import Mesh
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -32,11 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from polyfold.errors import PolyfoldError
-from polyfold.fold import is_linearly_foldable, plan_fold
-from polyfold.foldfile import net_to_fold
-from polyfold.io import load_mesh
-from polyfold.kinematics import collides, fold_tree
-from polyfold.unfold import unfold
+from polyfold.fold.plan import is_linearly_foldable, plan_fold
+from polyfold.formats.fold import net_to_fold
+from polyfold.formats.meshes import load_mesh
+from polyfold.fold.tree import collides, fold_tree
+from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
@@ -95,9 +95,9 @@ def collision_table() -> None:
 
     from numba import njit
 
-    from polyfold.fold import segment_free
-    from polyfold.kinematics import collision_work, segment_collides
-    from polyfold.segment import segment
+    from polyfold.fold.checker import segment_free
+    from polyfold.fold.checker import collision_work, segment_collides
+    from polyfold.segment.segment import segment
 
     def best_of(fn) -> float:
         fn()

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from polyfold.inflate import inflate
-from polyfold.io import load_mesh
-from polyfold.overlap import find_overlaps
-from polyfold.unfold import unfold
+from polyfold.inflate.inflate import inflate
+from polyfold.formats.meshes import load_mesh
+from polyfold.collide.flat import find_overlaps
+from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from polyfold.errors import PolyfoldError
-from polyfold.make import MakeOptions, make
+from polyfold.pipeline.make import make, MakeOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

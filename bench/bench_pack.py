@@ -23,7 +23,7 @@ import shapely
 import shapely.affinity
 from shapely import Polygon
 
-from polyfold.pack import Packing, Placement, check_packing, fits_page, pack_outlines, placed_outline
+from polyfold.fabricate.pack import check_packing, fits_page, pack_outlines, Packing, placed_outline, Placement
 
 A4 = (210.0, 297.0)
 MARGIN, GAP = 10.0, 2.0

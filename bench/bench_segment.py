@@ -25,15 +25,15 @@ import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
 
-from polyfold import segment as S
+from polyfold.segment import segment as S
 from polyfold.errors import PolyfoldError
-from polyfold.fold import plan_fold
-from polyfold.foldfile import net_to_fold
-from polyfold.io import load_mesh
-from polyfold.kinematics import collides, fold_tree
-from polyfold.mesh import Mesh
-from polyfold.raster import part_colors, write_mesh_png
-from polyfold.unfold import unfold
+from polyfold.fold.plan import plan_fold
+from polyfold.formats.fold import net_to_fold
+from polyfold.formats.meshes import load_mesh
+from polyfold.fold.tree import collides, fold_tree
+from polyfold.mesh.mesh import Mesh
+from polyfold.formats.raster import part_colors, write_mesh_png
+from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from polyfold.io import load_mesh
-from polyfold.overlap import find_overlaps
-from polyfold.unfold import unfold
+from polyfold.formats.meshes import load_mesh
+from polyfold.collide.flat import find_overlaps
+from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -20,9 +20,9 @@ import pytest
 
 from test_cli import one_line, run_cli
 
-from polyfold.batch import FAULT_ENV, BatchRow, expand, out_names, run_batch, run_study
+from polyfold.apps.batch import BatchRow, expand, FAULT_ENV, out_names, run_batch, run_study
 from polyfold.errors import PolyfoldError
-from polyfold.make import MakeOptions, make
+from polyfold.pipeline.make import make, MakeOptions
 
 GOOD = ("cube-12", "icosahedron-20", "octahedron-8")
 FAULTS = "crash:crash-me.obj,segv:segv-me.obj,hang:hang-me.obj"

@@ -5,18 +5,12 @@ verdict is the one of a fresh test, and the folded faces are forward_kinematics'
 import numpy as np
 import pytest
 
-from polyfold.foldfile import net_to_fold
-from polyfold.io import load_mesh
-from polyfold.kinematics import (
-    collision_work,
-    config_collides,
-    config_collides_cached,
-    config_collides_moving,
-    fold_positions,
-    fold_tree,
-    triangles_collide,
-)
-from polyfold.unfold import unfold
+from polyfold.formats.fold import net_to_fold
+from polyfold.formats.meshes import load_mesh
+from polyfold.collide.triangles import triangles_collide
+from polyfold.fold.checker import collision_work, config_collides, config_collides_cached, config_collides_moving
+from polyfold.fold.tree import fold_positions, fold_tree
+from polyfold.unfold.search import unfold
 
 
 @pytest.fixture(scope="module", params=["periscope-28", "bunny-128", "torus-8x4-64"])

@@ -18,13 +18,14 @@ from hypothesis.extra import numpy as hnp
 
 from fold_checker import check_fold
 from path_checker import FoldNet, check_path, triangles_cross
-from polyfold.fold import is_linearly_foldable, plan_fold, with_path
-from polyfold.foldfile import dumps, net_to_fold
-from polyfold.io import load_mesh
-from polyfold.kinematics import fold_positions, fold_tree
-from polyfold.unfold import unfold
+from polyfold.fold.plan import is_linearly_foldable, plan_fold
+from polyfold.formats.fold import with_path
+from polyfold.formats.fold import dumps, net_to_fold
+from polyfold.formats.meshes import load_mesh
+from polyfold.fold.tree import fold_positions, fold_tree
+from polyfold.unfold.search import unfold
 
-CLI = [sys.executable, "-m", "polyfold.cli"]
+CLI = [sys.executable, "-m", "polyfold"]
 TESTS = Path(__file__).resolve().parent
 PARTS = [f"paper-parts/horse/part-{i}" for i in range(7)] + ["periscope-28"]
 

@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from polyfold.errors import PolyfoldError
-from polyfold.inflate import inflate, self_intersections
-from polyfold.io import describe, load_mesh
-from polyfold.mesh import Mesh
+from polyfold.inflate.inflate import inflate, self_intersections
+from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.repair import describe
+from polyfold.mesh.mesh import Mesh
 
-CLI = [sys.executable, "-m", "polyfold.cli"]
+CLI = [sys.executable, "-m", "polyfold"]
 TWO_PI = 2 * math.pi
 
 
@@ -268,7 +269,7 @@ def test_inflated_mesh_is_valid(runs: dict, deformed: Mesh) -> None:
         # no face flipped against the input, none collapsed, HV recounted independently
         assert ((out.face_normals * deformed.face_normals).sum(1) > 0).all()
         assert out.angle_sums.max() <= TWO_PI + 1e-9
-        from polyfold.mesh import face_areas
+        from polyfold.mesh.geometry import face_areas
 
         assert face_areas(out.vertices, out.faces).min() > 1e-8 * face_areas(deformed.vertices, deformed.faces).mean()
         assert crossing_pairs(out) == []

@@ -17,8 +17,10 @@ from hypothesis import strategies as st
 
 from conftest import closed_meshes, models_path
 from polyfold.errors import MeshError
-from polyfold.io import LoadedMesh, atomic_write, describe, load_mesh
-from polyfold.mesh import Mesh, face_components
+from polyfold.formats.files import atomic_write
+from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.repair import describe, LoadedMesh
+from polyfold.mesh.mesh import face_components, Mesh
 
 
 # ----------------------------------------------------------------------------------------------

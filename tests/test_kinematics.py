@@ -9,19 +9,16 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from polyfold.errors import PolyfoldError
-from polyfold.foldfile import net_to_fold
-from polyfold.io import load_mesh
-from polyfold.kinematics import (
-    colliding_pairs,
-    collides,
-    config_collides,
-    first_collision,
-    fold_positions,
-    fold_tree,
-    forward_kinematics,
-    triangles_collide,
-)
-from polyfold.unfold import Net, UnfoldProblem, unfold
+from polyfold.formats.fold import net_to_fold
+from polyfold.formats.meshes import load_mesh
+from polyfold.collide.sweep import first_collision
+from polyfold.collide.triangles import triangles_collide
+from polyfold.fold.checker import config_collides
+from polyfold.fold.kinematics import forward_kinematics
+from polyfold.fold.tree import collides, colliding_pairs, fold_positions, fold_tree
+from polyfold.unfold.net import Net
+from polyfold.unfold.problem import UnfoldProblem
+from polyfold.unfold.search import unfold
 
 # (model, unfolding method): single- and multi-piece nets, closed meshes and an open paper part
 NETS = [

@@ -23,7 +23,7 @@ from fold_checker import check_fold, read_mesh
 from path_checker import check_path
 from test_cli import one_line, run_cli
 
-from polyfold.make import MakeOptions, make, paper_size
+from polyfold.pipeline.make import make, MakeOptions, paper_size
 
 NS = {"svg": "http://www.w3.org/2000/svg"}
 AREA_EPS = 1e-3  # mm^2; the SVG stores coordinates to 1e-4 mm, so touching shapes may show slivers

@@ -15,7 +15,7 @@ import pytest
 from conftest import closed_meshes, models_path
 from fold_checker import check_fold
 
-CLI = [sys.executable, "-m", "polyfold.cli"]
+CLI = [sys.executable, "-m", "polyfold"]
 METHODS = ["steepest-edge", "flat-tree", "unflat-tree", "min-perimeter", "max-perimeter", "random", "ga"]
 
 

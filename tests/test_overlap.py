@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from polyfold.overlap import find_overlaps, triangles_overlap
+from polyfold.collide.flat import find_overlaps, triangles_overlap
 
 
 def _clip(poly, a, b):

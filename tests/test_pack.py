@@ -12,7 +12,7 @@ from shapely import affinity
 from shapely.geometry import LineString, Polygon, box
 
 from polyfold.errors import PolyfoldError
-from polyfold.pack import Packing, Placement, check_packing, fits_page, pack_outlines, placed_outline
+from polyfold.fabricate.pack import check_packing, fits_page, pack_outlines, Packing, placed_outline, Placement
 
 A4 = (210.0, 297.0)
 
@@ -258,7 +258,7 @@ def test_check_packing_reports_problems():
 def test_final_check_repairs_a_broken_placement(snakes, monkeypatch):
     # a grid that forgets every piece stacks them all in one spot: the exact check must catch it
     # and move the offenders to pages of their own
-    from polyfold import pack
+    from polyfold.fabricate import pack
 
     monkeypatch.setattr(pack._Page, "stamp", lambda self, mask, y, x: None)
     packing = pack_outlines(snakes[:6], A4, gap=2.0)

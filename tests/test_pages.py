@@ -13,8 +13,13 @@ import ezdxf
 import numpy as np
 import pytest
 
-from polyfold import pages as pg
-from polyfold.pages import MM_TO_PT, Page, TextItem, write_dxf_page, write_pdf, write_svg_page
+from polyfold.formats import pdf as pdf_writer
+from polyfold.formats import sheet_style
+from polyfold.fabricate.page import Page, TextItem
+from polyfold.formats.dxf import write_dxf_page
+from polyfold.formats.pdf import write_pdf
+from polyfold.formats.sheet_style import MM_TO_PT
+from polyfold.formats.svg import write_svg_page
 
 SVG = "{http://www.w3.org/2000/svg}"
 INK = "{http://www.inkscape.org/namespaces/inkscape}"
@@ -74,12 +79,12 @@ def test_page_coerces_and_validates() -> None:
 def test_baseline_centres_text_for_any_angle() -> None:
     for angle in (0.0, 30.0, 90.0, -135.0):
         t = TextItem("A", 10.0, 20.0, angle, 4.0, "edge-label")
-        bx, by = pg._baseline(t)
+        bx, by = sheet_style.text_baseline(t)
         a = math.radians(angle)
         reading = np.array([math.cos(a), -math.sin(a)])  # CCW on a y-down page
         off = np.array([bx - 10.0, by - 20.0])
         assert abs(off @ reading) < 1e-12  # shifted across the reading direction only
-        assert math.isclose(np.hypot(*off), 0.5 * pg.CAP_HEIGHT * 4.0)
+        assert math.isclose(np.hypot(*off), 0.5 * sheet_style.CAP_HEIGHT * 4.0)
         # Towards the glyphs' bottom: clockwise of the reading direction as seen on screen.
         assert reading[0] * off[1] - reading[1] * off[0] > 0
 
@@ -193,7 +198,7 @@ def test_pdf_pages_mediabox_and_geometry(page: Page, tmp_path) -> None:
     assert "/F1 " in big and "(P1) Tj" in big
     m = re.search(r"(?m)^0 1 -1 0 (-?[\d.]+) (-?[\d.]+) cm$", big)
     assert m, "no text rotated by 90 degrees"
-    bx, by = pg._baseline(page.texts[1])
+    bx, by = sheet_style.text_baseline(page.texts[1])
     np.testing.assert_allclose([float(m.group(1)), float(m.group(2))],
                                [bx * MM_TO_PT, (page.height - by) * MM_TO_PT], atol=TOL * MM_TO_PT)
 
@@ -246,7 +251,7 @@ def test_dxf_layers_units_entities_and_flip(page: Page, tmp_path) -> None:
     assert [t.dxf.text for t in texts] == [t.text for t in page.texts]
     assert [t.dxf.rotation for t in texts] == [t.angle for t in page.texts]  # flip keeps CCW sense
     anchor = np.array([texts[0].dxf.align_point.x, texts[0].dxf.align_point.y])
-    bx, by = pg._baseline(page.texts[0])
+    bx, by = sheet_style.text_baseline(page.texts[0])
     np.testing.assert_allclose(anchor, [bx, page.height - by], atol=TOL)
 
 
@@ -292,7 +297,7 @@ def test_failure_while_drawing_writes_nothing(page: Page, tmp_path, monkeypatch)
     def boom(*_args, **_kwargs):
         raise RuntimeError("renderer crashed")
 
-    monkeypatch.setattr(pg, "_draw_pdf_page", boom)
+    monkeypatch.setattr(pdf_writer, "_draw_pdf_page", boom)
     with pytest.raises(RuntimeError):
         write_pdf([page], tmp_path / "x.pdf")
     assert list(tmp_path.iterdir()) == []

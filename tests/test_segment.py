@@ -20,10 +20,11 @@ from fold_checker import check_fold
 from path_checker import check_path
 from test_cli import one_line, run_cli
 
-from polyfold.io import load_mesh
-from polyfold.mesh import Mesh
-from polyfold._segment_kernels import FLAT_EPS, convex_hull
-from polyfold.segment import DEFAULT_TAU, rand_index, segment, surface_samples
+from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.mesh import Mesh
+from polyfold.mesh.geometry import FLAT_EPS
+from polyfold.segment.kernels import convex_hull
+from polyfold.segment.segment import DEFAULT_TAU, rand_index, segment, surface_samples
 
 # ----------------------------------------------------------------------------------------------
 # Independent measures
@@ -218,8 +219,8 @@ def test_merging_arrays_match_their_numpy_definitions(models_dir):
     so costs and concavities do not move."""
     import math
 
-    import polyfold.segment as S
-    from polyfold.mesh import face_areas
+    import polyfold.segment.segment as S
+    from polyfold.mesh.geometry import face_areas
 
     for name in ("periscope-28", "bunny-128", "paper-parts/horse/part-6", "open/tube-132"):
         mesh = load_mesh(models_dir / f"{name}.obj").mesh
@@ -244,7 +245,7 @@ def test_merging_arrays_match_their_numpy_definitions(models_dir):
 def test_a_full_memo_is_regrown_and_the_run_redone(models_dir, monkeypatch):
     """merge_run stops when the memo of union concavities fills up and redoes the run on a larger
     one: starting from a memo with room for 2 unions gives the same segmentations."""
-    import polyfold.segment as S
+    import polyfold.segment.segment as S
 
     meshes = [load_mesh(models_dir / f"{n}.obj").mesh for n in ("periscope2-44", "bunny-128")]
     cases = [(m, k) for m in meshes for k in (None, 2, 5)]

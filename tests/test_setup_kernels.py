@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from polyfold import _unfold_setup as S
-from polyfold.mesh import edge_topology
+from polyfold.unfold import setup_kernels as S
+from polyfold.mesh.mesh import edge_topology
 
 
 def _reference_topology(faces):

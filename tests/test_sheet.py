@@ -15,7 +15,7 @@ import pytest
 from shapely.geometry import Point, Polygon
 from shapely.ops import unary_union
 
-from polyfold import sheet
+from polyfold.formats import sheet
 
 SVG = "{http://www.w3.org/2000/svg}"
 H3 = math.sqrt(3) / 2

@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 from polyfold.errors import NoNetFound
-from polyfold.io import load_mesh
-from polyfold.mesh import edge_topology
-from polyfold.overlap import find_overlaps
-from polyfold.unfold import HEURISTICS, UnfoldProblem, local_frames, split_into_pieces, unfold
+from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.mesh import edge_topology
+from polyfold.collide.flat import find_overlaps
+from polyfold.unfold.problem import HEURISTICS, local_frames, UnfoldProblem
+from polyfold.unfold.search import split_into_pieces, unfold
 
 PLATONIC = ["tetrahedron-4", "cube-12", "octahedron-8", "dodecahedron-36", "icosahedron-20"]
 GENUS_ONE = ["torus-50", "torus-8x4-64", "torus-12x6-144", "torus-twisted-10x3-60"]

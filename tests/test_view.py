@@ -23,8 +23,8 @@ import pytest
 from test_cli import CLI, one_line, run_cli
 
 from polyfold.errors import PolyfoldError
-from polyfold.make import MakeOptions, make
-from polyfold.view import check_host, load_folder, make_folder, path_degrees, pose_piece, serve
+from polyfold.pipeline.make import make, MakeOptions
+from polyfold.apps.view import check_host, load_folder, make_folder, path_degrees, pose_piece, serve
 
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
@@ -51,7 +51,7 @@ def _edge_lengths(corners: np.ndarray) -> np.ndarray:
 
 
 def test_load_folder(make_dir: Path, models_dir: Path) -> None:
-    from polyfold.io import load_mesh
+    from polyfold.formats.meshes import load_mesh
 
     folder = load_folder(make_dir)
     assembly = json.loads((make_dir / "assembly.json").read_text())

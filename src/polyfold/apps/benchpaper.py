@@ -1,0 +1,565 @@
+"""`polyfold bench paper`: the paper's Tables 1-2 and Figs. 3 and 5, regenerated next to the
+paper's own numbers (ALGORITHMS.md 8).
+
+In: the benchmark models folder (../shared/models), a number of runs, time limits. Out (into a
+folder): report.md (tables: ours as mean ± standard deviation over the runs, the paper's value,
+paper / ours), report.json (every run), fig3.png and fig5.png. Needs matplotlib for the figures
+(the `bench` extra); the tables do not.
+
+Every time is wall-clock seconds in this process with the numba kernels already compiled. A
+"path" is a collision-free folding path found by `fold.plan_fold` ("auto": straight line first =
+LC, then the sequential planner, then Lazy PRM); whole meshes are also run with the paper's own
+planner (straight line, then Lazy PRM) on a few seeds. A run without a path within the time limit
+counts the time limit as its path time and is marked.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+# ALGORITHMS.md 8.1: (DOF, LC, finding net s, path planning s) per horse patch
+PAPER_TABLE1 = [(17, True, 0.00, 0.01), (17, True, 0.00, 0.02), (21, False, 0.00, 2.69), (42, False, 0.56, 1.39),
+                (37, False, 0.02, 0.73), (86, True, 4.84, 0.31), (75, False, 0.58, 1.60)]
+# ALGORITHMS.md 8.2 (+ the horse of 8.1): model -> whole (net, path, total), parts (k, seg, net, path, total)
+PAPER_TABLE2 = {
+    "periscope-28": {"whole": (0.08, 7.05, 7.13), "parts": (2, 0.00, 0.00, 0.12, 0.12)},
+    "periscope2-44": {"whole": (0.21, 12.40, 12.61), "parts": (3, 0.00, 0.09, 0.17, 0.26)},
+    "bunny-128": {"whole": (8.09, 482.57, 490.66), "parts": (3, 0.02, 2.90, 23.15, 26.07)},
+    "fish-472": {"whole": (69.66, 1848.86, 1918.52), "parts": (5, 0.92, 13.19, 105.82, 119.01)},
+    "fish-472 inflated": {"whole": None, "parts": (5, 0.92, 0.88, 9.93, 11.73)},
+    "horse-302": {"whole": (219.87, math.inf, math.inf), "parts": (7, None, 6.00, 6.75, 12.75)},
+}
+# fish-472 folds into a shape that intersects itself by ~2.4e-4 of its size (MODELS.md): at the
+# default contact tolerance no path can exist, so the fish rows use the paper's thickness scale.
+CONTACT = {"fish-472": 1e-3, "fish-472 inflated": 1e-3}
+STRATEGIES = ("discrete", "continuous", "continuous-full")
+STRATEGY_STYLE = {"discrete": ("o", "tab:red"), "continuous": ("^", "tab:blue"), "continuous-full": ("s", "tab:green")}
+FIG3_PAPER = {
+    "uniform": [(0.0, 44), (0.0918, 48), (0.1726, 36), (0.2371, 20), (0.2681, 14), (0.3182, 0)],
+    "constrained": [(0.0, 44), (0.0539, 38), (0.0705, 28), (0.0807, 20), (0.0830, 6), (0.0839, 0)],
+}
+
+
+@dataclass(frozen=True)
+class BenchSettings:
+    runs: int = 20
+    time_limit: float = 60.0  # per search (one unfold, one path), whole meshes and parts alike
+    samples: int = 1000  # Fig. 5 samples per net and strategy (ALGORITHMS.md 6.6)
+    quick: bool = False
+
+
+def quick_settings() -> BenchSettings:
+    return BenchSettings(runs=3, time_limit=5.0, samples=200, quick=True)
+
+
+# ----------------------------------------------------------------------------------------------
+# Measurements
+
+
+PAPER_PLANNER_RUNS = 5  # whole meshes with the paper's planner: it mostly runs into the time limit
+
+
+def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner: str = "auto") -> dict:
+    """Unfold `mesh` (one component) and plan a folding path for the net; seconds and facts.
+
+    planner: a `plan_fold` planner, or "paper": the straight line, then Lazy PRM for the time left.
+    """
+    from ..errors import PolyfoldError
+    from ..fold.plan import plan_fold
+    from ..formats.fold import net_to_fold
+    from ..fold.tree import collides, fold_tree
+    from ..unfold.search import unfold
+
+    t0 = time.perf_counter()
+    net, st = unfold(mesh, seed=seed, time_limit=time_limit)
+    t1 = time.perf_counter()
+    fold = net_to_fold([net])
+    tree = fold_tree(fold, contact_tol)
+    row = {"dof": int(len(tree.creases)), "pieces": int(net.n_pieces), "net_s": t1 - t0, "path": False,
+           "lc": None, "path_s": float(time_limit), "note": "", "tree": tree, "planner": None}
+    if net.n_pieces > 1:
+        row["note"] = "no single net in time"
+        return row
+    if collides(tree, tree.goal):
+        row["note"] = "goal self-intersects"
+        return row
+    try:
+        if planner == "paper":
+            path = plan_fold(tree, planner="linear", time_limit=time_limit, seed=seed)
+            if path is None:
+                left = max(0.0, time_limit - (time.perf_counter() - t1))
+                path = plan_fold(tree, planner="lazy-prm", time_limit=left, seed=seed)
+        else:
+            path = plan_fold(tree, planner=planner, time_limit=time_limit, seed=seed)
+    except PolyfoldError as exc:
+        row["note"] = str(exc)
+        return row
+    t2 = time.perf_counter()
+    if path is None:
+        row["note"] = "no path in time"
+        row["path_s"] = max(t2 - t1, float(time_limit))
+    else:
+        row.update(path=True, lc=bool(path.linear), path_s=t2 - t1, planner=path.planner)
+    return row
+
+
+def _planner_counts(rows: list[dict], counts: dict[str, int] | None = None) -> dict[str, int]:
+    """How many of the `net_and_path` rows each planner found the path of (added to counts)."""
+    counts = {} if counts is None else counts
+    for r in rows:
+        if r["planner"]:
+            counts[r["planner"]] = counts.get(r["planner"], 0) + 1
+    return counts
+
+
+def _whole_row(mesh, seeds, time_limit: float, tol: float, planner: str) -> dict:
+    """Runs of one whole mesh: seconds per run, paths found, LC count, planners that found them."""
+    rows = [net_and_path(mesh, seed, time_limit, tol, planner) for seed in seeds]
+    return {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
+            "runs": len(rows), "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
+            "planners": _planner_counts(rows), "notes": sorted({r["note"] for r in rows if r["note"]}), "rows": rows}
+
+
+def _mean_sd(xs: list[float]) -> tuple[float, float]:
+    a = np.asarray(xs, dtype=float)
+    return float(a.mean()), float(a.std(ddof=1)) if len(a) > 1 else 0.0
+
+
+def _fmt(m: float, s: float, digits: int | None = None) -> str:
+    """mean ± sd; by default 3 decimals, more for small means (at least two significant digits:
+    the periscope rows are fractions of a millisecond)."""
+    if digits is None:
+        digits = 3 if m >= 0.01 or m <= 0 else min(6, 1 - math.floor(math.log10(m)))
+    return f"{m:.{digits}f} ± {s:.{digits}f}"
+
+
+def _ratio(paper: float | None, ours: float) -> str:
+    if paper is None or not math.isfinite(paper):
+        return "–" if paper is None else "∞"
+    if ours <= 0:
+        return "–"
+    return f"{paper / ours:.0f}×" if paper / ours >= 10 else f"{paper / ours:.1f}×"
+
+
+def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: list[float] | None = None) -> dict:
+    """Runs over a list of part meshes: per run the sums of net and path seconds."""
+    per_run, dofs, ok = [], [], True
+    trees = []
+    planners: dict[str, int] = {}
+    for seed in range(1, runs + 1):
+        rows = [net_and_path(p, seed, time_limit, tol) for p in parts]
+        net_s = sum(r["net_s"] for r in rows)
+        path_s = sum(r["path_s"] for r in rows)
+        ok &= all(r["path"] for r in rows)
+        per_run.append({"net_s": net_s, "path_s": path_s, "paths": [r["path"] for r in rows],
+                        "lc": [r["lc"] for r in rows], "notes": [r["note"] for r in rows],
+                        "part_net_s": [r["net_s"] for r in rows], "part_path_s": [r["path_s"] for r in rows]})
+        _planner_counts(rows, planners)
+        if seed == 1:
+            dofs = [r["dof"] for r in rows]
+            trees = [r["tree"] for r in rows]
+    seg = seg_s or [0.0] * runs
+    totals = [s + r["net_s"] + r["path_s"] for s, r in zip(seg, per_run)]
+    return {"dofs": dofs, "runs": per_run, "seg_s": seg, "totals": totals, "all_paths": ok, "trees": trees,
+            "planners": planners}
+
+
+# ----------------------------------------------------------------------------------------------
+# Tables
+
+
+def table1(models: Path, st: BenchSettings, say) -> dict:
+    """Horse: the paper's 7 patches and our own 7-part segmentation of horse-302."""
+    from ..formats.meshes import load_mesh
+    from ..segment.segment import segment
+
+    say("table 1: the paper's horse patches")
+    paper_parts = [load_mesh(p).components[0] for p in sorted((models / "paper-parts" / "horse").glob("part-*.obj"))]
+    per_part = []
+    for k, part in enumerate(paper_parts):
+        rows = [net_and_path(part, seed, st.time_limit, 1e-7) for seed in range(1, st.runs + 1)]
+        per_part.append({"dof": rows[0]["dof"], "lc": sum(bool(r["lc"]) for r in rows), "paths": sum(r["path"] for r in rows),
+                         "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows]})
+    say("table 1: our segmentation of horse-302")
+    whole = load_mesh(models / "horse-302.obj").mesh
+    seg_s, seg = [], None
+    for _ in range(st.runs):
+        t0 = time.perf_counter()
+        seg = segment(whole, parts=7)
+        seg_s.append(time.perf_counter() - t0)
+    ours = []
+    for k, part in enumerate(seg.parts):
+        rows = [net_and_path(part, seed, st.time_limit, 1e-7) for seed in range(1, st.runs + 1)]
+        ours.append({"dof": rows[0]["dof"], "lc": sum(bool(r["lc"]) for r in rows), "paths": sum(r["path"] for r in rows),
+                     "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows]})
+    return {"paper_patches": per_part, "our_parts": ours, "our_seg_s": seg_s}
+
+
+def table2(models: Path, st: BenchSettings, say) -> tuple[dict, list]:
+    """Whole mesh vs segmented, per model; also the nets for Fig. 5 (DOF, tree, whole/part)."""
+    from ..inflate.inflate import inflate
+    from ..formats.meshes import load_mesh
+    from ..segment.segment import segment
+
+    out, fig5_trees = {}, []
+    fish_labels = None
+    for name, paper in PAPER_TABLE2.items():
+        tol = CONTACT.get(name, 1e-7)
+        k = paper["parts"][0]
+        if name == "fish-472 inflated":
+            say(f"table 2: {name} (constrained inflation, the fish's own parts)")
+            fish = load_mesh(models / "fish-472.obj").mesh
+            t0 = time.perf_counter()
+            res = inflate(fish, mode="constrained")
+            inflate_s = time.perf_counter() - t0
+            mesh = res.mesh
+            parts = [mesh.submesh(np.flatnonzero(fish_labels == p)) for p in range(k)]
+            seg_s = None
+            extra = {"inflate_s": inflate_s, "inflate_stop": res.stop_reason,
+                     "hv": [int(res.hyperbolic_start), int(res.hyperbolic)]}
+        else:
+            say(f"table 2: {name}")
+            mesh = load_mesh(models / f"{name}.obj").mesh
+            seg_s = []
+            for _ in range(st.runs):
+                t0 = time.perf_counter()
+                seg = segment(mesh, parts=k)
+                seg_s.append(time.perf_counter() - t0)
+            parts = list(seg.parts)
+            if name == "fish-472":
+                fish_labels = seg.labels
+            extra = {"tau": seg.tau}
+        whole = None
+        if paper["whole"] is not None:
+            whole = _whole_row(mesh, range(1, st.runs + 1), st.time_limit, tol, "auto")
+            say(f"table 2: {name} whole, the paper's planner")
+            whole["paper_planner"] = _whole_row(mesh, range(1, min(st.runs, PAPER_PLANNER_RUNS) + 1),
+                                                st.time_limit, tol, "paper")
+            rows = whole.pop("rows")
+            whole["paper_planner"].pop("rows")
+            fig5_trees.append((name, "whole", rows[0]["tree"]))
+        pr = _parts_row(parts, st.runs, st.time_limit, tol, seg_s)
+        fig5_trees += [(name, "parts", t) for t in pr.pop("trees")]
+        out[name] = {"whole": whole, "parts": pr, "contact_tol": tol, **extra}
+    return out, fig5_trees
+
+
+# ----------------------------------------------------------------------------------------------
+# Figures
+
+
+def fig5(trees: list, st: BenchSettings, say) -> list[dict]:
+    from ..fold.cspace import sample_ratio
+
+    say(f"fig. 5: valid configuration ratios ({st.samples} samples per net and strategy)")
+    rows = []
+    for name, kind, tree in trees:
+        dof = int(len(tree.creases))
+        m = st.samples * (10 if dof < 20 and not st.quick else 1)
+        r = {"model": name, "kind": kind, "dof": dof, "samples": m}
+        for strategy in STRATEGIES:
+            valid, n = sample_ratio(tree, samples=m, strategy=strategy, seed=0)
+            r[strategy] = valid / n
+        rows.append(r)
+    return rows
+
+
+def fig3(models: Path, say) -> dict:
+    from ..inflate.inflate import inflate
+    from ..formats.meshes import load_mesh
+
+    say("fig. 3: inflation of sphere-deformed-320, both modes")
+    mesh = load_mesh(models / "sphere-deformed-320.obj").mesh
+    out = {}
+    for mode in ("uniform", "constrained"):
+        t0 = time.perf_counter()
+        res = inflate(mesh, mode=mode, log_every=10)
+        hist = res.history
+        hit = np.flatnonzero(hist[:, 2] <= 0)
+        out[mode] = {"seconds": time.perf_counter() - t0, "steps": res.steps, "stop": res.stop_reason,
+                     "if_at_hv0": float(hist[hit[0], 1]) if len(hit) else None,
+                     "history": hist[:, :3].tolist()}
+    return out
+
+
+def _plots(out_dir: Path, f3: dict, f5: list[dict]) -> list[str]:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return []
+    written = []
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for mode, color in (("uniform", "tab:blue"), ("constrained", "tab:orange")):
+        h = np.asarray(f3[mode]["history"])
+        ax.plot(h[:, 1], h[:, 2], color=color, label=f"{mode} (polyfold)")
+        p = np.asarray(FIG3_PAPER[mode])
+        ax.plot(p[:, 0], p[:, 1], "o", color=color, mfc="none", label=f"{mode} (paper)")
+    ax.set_xlabel("inflation rate IF")
+    ax.set_ylabel("hyperbolic vertices HV")
+    ax.set_title("Fig. 3: sphere-deformed-320")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "fig3.png", dpi=120)
+    plt.close(fig)
+    written.append("fig3.png")
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    floor = 0.5 / max(r["samples"] for r in f5)  # zero ratios drawn at half a sample
+    for strategy, (marker, color) in STRATEGY_STYLE.items():
+        for kind, fill in (("whole", "full"), ("parts", "none")):
+            sel = [r for r in f5 if r["kind"] == kind]
+            if not sel:
+                continue
+            x, y = [r["dof"] for r in sel], [max(r[strategy], floor) for r in sel]
+            label = f"{strategy} – {'original' if kind == 'whole' else 'NCD parts'}"
+            if fill == "full":
+                ax.scatter(x, y, marker=marker, color=color, label=label)
+            else:
+                ax.scatter(x, y, marker=marker, facecolors="none", edgecolors=color, label=label)
+    ax.set_yscale("log")
+    ax.set_xlabel("DOF (creases)")
+    ax.set_ylabel("|C_valid| / |C_sampled|")
+    ax.set_title("Fig. 5: valid configuration ratio")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out_dir / "fig5.png", dpi=120)
+    plt.close(fig)
+    written.append("fig5.png")
+    return written
+
+
+# ----------------------------------------------------------------------------------------------
+# Report
+
+
+TARGET_SPEEDUP = 50  # issue 8: every Table 2 total at least 50x faster than the paper's
+
+
+def _targets(t2: dict, st: BenchSettings) -> list[str]:
+    """Markdown lines: each Table 2 total (our default planner) against paper / TARGET_SPEEDUP; a
+    whole mesh the paper could not fold must fold on every run within the time limit."""
+    L = ["", f"Targets: every total at least {TARGET_SPEEDUP}× faster than the paper's (mean ≤ paper / {TARGET_SPEEDUP}); "
+         "a whole mesh the paper could not fold gets a path on every run within the time limit.", "",
+         "| model | route | ours s | target | verdict |", "|---|---|---|---|---|"]
+    for name, r in t2.items():
+        paper = PAPER_TABLE2[name]
+        rows = []
+        if r["whole"] is not None:
+            w = r["whole"]
+            rows.append(("whole", np.asarray(w["net_s"]) + np.asarray(w["path_s"]), paper["whole"][2], w["paths"] == w["runs"]))
+        p = r["parts"]
+        rows.append(("parts", np.asarray(p["totals"]), paper["parts"][4], bool(p["all_paths"])))
+        for route, tot, ref, all_paths in rows:
+            m, sd = _mean_sd(list(tot))
+            if not math.isfinite(ref):
+                target, met = "a path on every run", "met" if all_paths else "not met"
+            else:
+                limit = ref / TARGET_SPEEDUP
+                target = f"≤ {limit:.4g}"
+                met = "met" if all_paths and m <= limit else (
+                    "not met (within one sd)" if all_paths and m - sd <= limit else "not met")
+            L.append(f"| {name} | {route} | {_fmt(m, sd, 4)} | {target} | {met} |")
+    return L
+
+
+def _markdown(t1: dict, t2: dict, f3: dict, f5: list[dict], st: BenchSettings, seconds: float, figs: list[str],
+              compiled: list[str]) -> str:
+    late = (f"kernels compiled while the clock ran: {len(compiled)} ({', '.join(compiled)})" if compiled
+            else "no kernel compiled while the clock ran")
+    L = [f"# polyfold vs the paper (Xi & Lien 2017)", "",
+         f"{st.runs} runs (seeds 1–{st.runs}) per row{' (--quick)' if st.quick else ''}; time limit "
+         f"{st.time_limit:g} s per search (one unfold, one path); mean ± standard deviation of wall-clock "
+         f"seconds; a run without a path counts the time limit as its path time. Every stage runs once "
+         f"before the clock starts (numba compiles or loads its kernels); {late}. The paper: C++ on a "
+         f"2012 MacBook Pro, mean of 20 runs. Bench time {seconds:.0f} s.", ""]
+    L += ["## Table 1 — horse, 7 patches", "", "The paper's own patches (../shared/models/paper-parts/horse):", "",
+          "| patch | DOF | LC (runs) | paths | net s | path s | paper DOF | paper LC | paper net s | paper path s |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
+    tot_net = np.sum([p["net_s"] for p in t1["paper_patches"]], axis=0)
+    tot_path = np.sum([p["path_s"] for p in t1["paper_patches"]], axis=0)
+    for k, (p, ref) in enumerate(zip(t1["paper_patches"], PAPER_TABLE1)):
+        L.append(f"| {k} | {p['dof']} | {p['lc']}/{st.runs} | {p['paths']}/{st.runs} | {_fmt(*_mean_sd(p['net_s']))} | "
+                 f"{_fmt(*_mean_sd(p['path_s']))} | {ref[0]} | {'yes' if ref[1] else 'no'} | {ref[2]:.2f} | {ref[3]:.2f} |")
+    L.append(f"| subtotal | | | | {_fmt(*_mean_sd(tot_net))} | {_fmt(*_mean_sd(tot_path))} | | | 6.00 | 6.75 |")
+    total = tot_net + tot_path
+    L += ["", f"Total {_fmt(*_mean_sd(total))} s (paper 12.75 s, ratio {_ratio(12.75, float(np.mean(total)))}).", "",
+          "Our own 7-part segmentation of horse-302 (`segment(parts=7)`):", "",
+          "| part | DOF | LC (runs) | paths | net s | path s |", "|---|---|---|---|---|---|"]
+    for k, p in enumerate(t1["our_parts"]):
+        L.append(f"| {k} | {p['dof']} | {p['lc']}/{st.runs} | {p['paths']}/{st.runs} | {_fmt(*_mean_sd(p['net_s']))} | "
+                 f"{_fmt(*_mean_sd(p['path_s']))} |")
+    o_total = np.sum([p["net_s"] for p in t1["our_parts"]], axis=0) + np.sum([p["path_s"] for p in t1["our_parts"]], axis=0) \
+        + np.asarray(t1["our_seg_s"])
+    L += ["", f"Total with segmentation {_fmt(*_mean_sd(o_total))} s.", ""]
+
+    L += ["## Table 2 — whole mesh vs nearly convex parts", "",
+          "| model | route | parts | DOF per part | seg s | net s | path s | total s | paths | paper total | paper / ours |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, r in t2.items():
+        paper = PAPER_TABLE2[name]
+        w = r["whole"]
+        if w is not None:
+            pw = paper["whole"][2]
+            for route, row in (("whole", w), ("whole, paper's planner", w.get("paper_planner"))):
+                if row is None:
+                    continue
+                tot = np.asarray(row["net_s"]) + np.asarray(row["path_s"])
+                found = ", ".join(f"{k} {v}" for k, v in sorted(row["planners"].items()))
+                facts = [found] if found else []
+                facts += row["notes"]
+                note = f" ({'; '.join(facts)})" if facts else ""
+                L.append(f"| {name} | {route} | 1 | {row['dof']} | – | {_fmt(*_mean_sd(row['net_s']))} | "
+                         f"{_fmt(*_mean_sd(row['path_s']))} | {_fmt(*_mean_sd(tot))} | {row['paths']}/{row['runs']}{note} | "
+                         f"{'> 3600 (no path)' if not math.isfinite(pw) else f'{pw:.2f}'} | "
+                         f"{_ratio(pw, float(tot.mean())) if row['paths'] == row['runs'] else '–'} |")
+        p = r["parts"]
+        n_paths = sum(all(run["paths"]) for run in p["runs"])
+        pp = paper["parts"]
+        # which planner folded the parts, over all parts of all runs (linear = the part was LC)
+        found = ", ".join(f"{k} {v}" for k, v in sorted(p.get("planners", {}).items()))
+        L.append(f"| {name} | parts | {len(p['dofs'])} | {' / '.join(map(str, p['dofs']))} | {_fmt(*_mean_sd(p['seg_s']))} | "
+                 f"{_fmt(*_mean_sd([x['net_s'] for x in p['runs']]))} | {_fmt(*_mean_sd([x['path_s'] for x in p['runs']]))} | "
+                 f"{_fmt(*_mean_sd(p['totals']))} | {n_paths}/{st.runs}{f' (part paths: {found})' if found else ''} | {pp[4]:.2f} | "
+                 f"{_ratio(pp[4], float(np.mean(p['totals']))) if n_paths == st.runs else '–'} |")
+    # The paper's speedup column: whole-mesh total / segmented total (both fish rows against the
+    # original fish's whole mesh, as in the paper).
+    L += ["", "Speedup of the segmented route over the whole mesh (whole total / parts total; the paper's in brackets):"]
+    for name, r in t2.items():
+        base = name.replace(" inflated", "")  # the model whose whole mesh this row is compared with
+        w = t2.get(base, {}).get("whole")
+        if w is None:
+            continue
+        paper_whole = PAPER_TABLE2[base]["whole"][2]
+        paper_parts = PAPER_TABLE2[name]["parts"][4]
+        ours_whole = float(np.mean(np.asarray(w["net_s"]) + np.asarray(w["path_s"])))
+        ours_parts = float(np.mean(r["parts"]["totals"]))
+        bound = "≥ " if w["paths"] < w["runs"] else ""  # runs without a path count the time limit
+        paper_sp = "no path for the whole mesh" if not math.isfinite(paper_whole) else f"{paper_whole / paper_parts:.1f}×"
+        L.append(f"- {name}: {bound}{ours_whole / ours_parts:.1f}× ({paper_sp})")
+    L += _targets(t2, st)
+    L += ["", "Planners: 'whole' and 'parts' rows use `plan_fold`'s default: the straight line (the paper's LC "
+          "test), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
+          "the first free crease in a priority order, restarts with the stuck creases first, two base orders in turn; "
+          "'sequential-rrt': when at most 32 creases lock, an RRT-Connect search over their continuous angles), then Lazy PRM. "
+          f"'whole, paper's planner' rows: the straight line, then Lazy PRM only (ALGORITHMS.md 6.5), on the first "
+          f"{PAPER_PLANNER_RUNS} seeds. The planner that found each path is named beside the path count.", "",
+          "Contact tolerance 1e-3 of the model size for the fish rows (its folded shape self-intersects "
+          "by 2.4e-4 of its size; see MODELS.md), 1e-7 elsewhere. 'fish-472 inflated': constrained inflation, "
+          "then the same parts as 'fish-472'.", ""]
+    if "fish-472 inflated" in t2:
+        fi = t2["fish-472 inflated"]
+        L += [f"Inflation of the fish: {fi['inflate_s']:.2f} s, HV {fi['hv'][0]} → {fi['hv'][1]}, stop: {fi['inflate_stop']}.", ""]
+
+    L += ["## Fig. 3 — inflation rate vs hyperbolic vertices (sphere-deformed-320)", "",
+          "| mode | steps | seconds | IF at HV = 0 | paper |", "|---|---|---|---|---|"]
+    for mode in ("uniform", "constrained"):
+        f = f3[mode]
+        v = "not reached" if f["if_at_hv0"] is None else f"{f['if_at_hv0']:.4f}"
+        L.append(f"| {mode} | {f['steps']} | {f['seconds']:.2f} | {v} | {FIG3_PAPER[mode][-1][0]:.4f} |")
+    u, c = f3["uniform"]["if_at_hv0"], f3["constrained"]["if_at_hv0"]
+    if u and c:
+        L += ["", f"Constrained / uniform IF: {c / u:.2f} (paper 0.26): "
+              f"{'reproduced' if c / u < 1 / 3 else 'not reproduced'} (constrained needs far less deformation)."]
+    L += [""]
+    if "fig3.png" in figs:
+        L += ["![Fig. 3](fig3.png)", ""]
+
+    L += ["## Fig. 5 — valid configuration ratio", "",
+          "Continuous: each crease uniform between 0 and its goal angle; continuous-full: uniform in (−π, π), "
+          "the whole configuration space (ALGORITHMS.md 6.4 names both; the paper does not say which it used).", "",
+          "| model | net | DOF | samples | discrete | continuous | continuous-full |", "|---|---|---|---|---|---|---|"]
+    for r in sorted(f5, key=lambda r: r["dof"]):
+        L.append(f"| {r['model']} | {r['kind']} | {r['dof']} | {r['samples']} | {r['discrete']:.4f} | "
+                 f"{r['continuous']:.4f} | {r['continuous-full']:.4f} |")
+    for other in ("continuous", "continuous-full"):
+        ge = sum(r["discrete"] >= r[other] for r in f5)
+        L.append(f"Discrete ≥ {other} on {ge} of {len(f5)} nets.")
+    L += ["", "Paper: discrete ≫ continuous, the gap growing roughly exponentially with DOF."]
+    parts = [r for r in f5 if r["kind"] == "parts"]
+    whole = [r for r in f5 if r["kind"] == "whole"]
+    if parts and whole:
+        L.append(f"Mean discrete ratio: parts {np.mean([r['discrete'] for r in parts]):.3f}, whole meshes "
+                 f"{np.mean([r['discrete'] for r in whole]):.3f} (paper: parts higher).")
+    if "fig5.png" in figs:
+        L += ["", "![Fig. 5](fig5.png)", "", "(A ratio of 0 is drawn at half a sample, 0.5 / samples, so it shows on the log axis.)"]
+    return "\n".join(L) + "\n"
+
+
+def kernel_signatures() -> dict[str, set[str]]:
+    """The type signatures each numba kernel of the polyfold modules imported so far holds in
+    this process (compiled or loaded from the cache): a signature that appears while the clock
+    runs means timed compilation."""
+    import sys
+
+    from numba.core.registry import CPUDispatcher
+
+    out: dict[str, set[str]] = {}
+    for module_name, module in list(sys.modules.items()):
+        if module is None or not module_name.startswith(f"{__package__}."):
+            continue
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module_name:
+                out[f"{module_name.removeprefix(__package__ + '.')}.{name}"] = {str(s) for s in obj.signatures}
+    return out
+
+
+def _warm_up(models: Path) -> None:
+    """Call every timed stage once on small models, so numba compiles (fresh checkout) or loads
+    its caches before the clock runs: without it the first timed run of a stage carries seconds
+    of compilation (a cold checkout put 35 s into one horse segmentation)."""
+    from ..fold.cspace import sample_ratio
+    from ..inflate.inflate import inflate
+    from ..formats.meshes import load_mesh
+    from ..segment.segment import segment
+
+    small = load_mesh(models / "periscope-28.obj").mesh
+    inflate(small, mode="constrained", max_steps=20)
+    inflate(small, mode="uniform", max_steps=20)
+    # the bunny reaches the segmentation's concavity kernels and the unfolder's local search;
+    # a horse patch the planners' kernels for a net that does not fold along a straight line
+    bunny = load_mesh(models / "bunny-128.obj").mesh
+    segment(bunny, parts=3)
+    patch = load_mesh(models / "paper-parts" / "horse" / "part-3.obj").mesh
+    for mesh in (small, bunny, patch):
+        for planner in ("linear", "sequential", "lazy-prm"):
+            tree = net_and_path(mesh, 0, 1.0, 1e-7, planner)["tree"]
+    for strategy in STRATEGIES:
+        sample_ratio(tree, samples=10, strategy=strategy, seed=0)
+
+
+def run(models: Path, out_dir: Path, st: BenchSettings, progress: Callable[[str], None] | None = None) -> dict:
+    """Run everything, write out_dir/report.md, report.json, fig3.png, fig5.png; return the data."""
+    from ..formats.files import atomic_write
+
+    say = progress or (lambda s: None)
+    if not (models / "horse-302.obj").exists():
+        from ..errors import PolyfoldError
+
+        raise PolyfoldError(f"benchmark models not found in {models} (set POLYFOLD_MODELS)")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    _warm_up(models)
+    before = kernel_signatures()
+    t1 = table1(models, st, say)
+    t2, trees = table2(models, st, say)
+    f5 = fig5(trees, st, say)
+    f3 = fig3(models, say)
+    after = kernel_signatures()
+    compiled = sorted(f"{name} {sig}" for name, sigs in after.items() for sig in sigs - before.get(name, set()))
+    figs = _plots(out_dir, f3, f5)
+    seconds = time.perf_counter() - t0
+    data = {"settings": st.__dict__, "seconds": seconds, "table1": t1, "table2": t2, "fig3": f3, "fig5": f5,
+            "figures": figs, "compiled_while_timed": compiled}
+    atomic_write(out_dir / "report.json", json.dumps(data, indent=1, default=float) + "\n")
+    atomic_write(out_dir / "report.md", _markdown(t1, t2, f3, f5, st, seconds, figs, compiled))
+    return data

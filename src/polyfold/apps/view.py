@@ -1,0 +1,786 @@
+"""The browser viewer behind `polyfold view` (issue 7), built on viser.
+
+In: an output folder of `polyfold make` (assembly.json, report.json, part-K.obj, piece-X.fold).
+Out: a local web page (viser serves its bundled client; nothing else is served, nothing is
+fetched) showing the model with its parts in colour, the flat nets of the chosen part, its
+folding animation along the verified path of every piece, an inflation panel (mode, pressure,
+stiffness ratio, steps; hyperbolic vertices in red, their count as "HV: N") and buttons that run
+`make` / export the inflated mesh into the folder.
+
+Plain functions do the work so tests can use them without a browser: `load_folder` (the folder as
+a frozen `MakeFolder`), `pose_piece` / `ViewPiece.pose` (face corners in the model frame at a
+fraction t of the folding path), `check_host`, `serve` (starts the server and returns at once) and
+`wait` (blocks until Ctrl+C, for the CLI).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import ipaddress
+import json
+import math
+import re
+import shutil
+import tempfile
+import threading
+import time
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..errors import PolyfoldError
+from ..formats.meshes import obj_text
+from ..fold.tree import fold_positions, fold_tree, FoldTree
+from ..mesh.mesh import Mesh
+
+DEFAULT_HOST = "127.0.0.1"
+DEBOUNCE_S = 0.3  # inflation re-runs wait until the sliders rest this long
+PLAY_SECONDS = 4.0  # one play of the folding animation, flat to folded
+PLAY_FPS = 25.0
+GHOST = (190, 190, 190)  # colour of the parts that are not being animated
+GHOST_OPACITY = 0.18
+LINE_COLORS = {"M": (214, 39, 40), "V": (31, 119, 180)}  # mountain red, valley blue (as the sheets)
+CUT_COLOR = (40, 40, 40)
+HV_COLOR = (230, 20, 20)
+INFLATED_COLOR = (150, 175, 215)
+ALL_PARTS = "all parts"
+NET_GAP = 0.8  # view units (the model is 2 long): model to nets, on the right
+INFLATED_GAP = 1.4  # model to the inflated copy, on the left
+
+
+# ----------------------------------------------------------------------------------------------
+# The folder
+
+
+@dataclass(frozen=True, eq=False)
+class ViewPiece:
+    """One piece of a make folder, ready to animate.
+
+    fold: its FOLD dict; tree: `fold_tree(fold)`; frames (K, E): `polyfold:path` (FOLD degrees,
+    valley positive), None when the piece has no verified path (it is then shown folded only);
+    rotation (P, 3, 3) / translation (P, 3): per FOLD piece, the rigid motion (Kabsch fit of the
+    goal pose onto the foldedForm) that puts the folded net onto the model; fit_error: largest
+    corner distance between the aligned goal pose and the foldedForm, in model units (nan
+    without a foldedForm frame).
+    """
+
+    name: str
+    part: int
+    fold: dict
+    tree: FoldTree
+    frames: np.ndarray | None
+    rotation: np.ndarray
+    translation: np.ndarray
+    fit_error: float
+
+    @property
+    def verified(self) -> bool:
+        return self.frames is not None
+
+    def pose(self, t: float) -> np.ndarray:
+        """Face corners (F, 3, 3) in the model frame at fraction t in [0, 1] of the folding path
+        (0 flat, 1 folded onto the model). Without a path the piece stays folded."""
+        deg = _goal_degrees(self.fold, self.tree) if self.frames is None else path_degrees(self.frames, t)
+        corners = fold_positions(self.tree, -np.radians(deg))
+        piece = self.tree.piece
+        return np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
+
+
+@dataclass(frozen=True, eq=False)
+class MakeFolder:
+    """A `polyfold make` output folder: parts (in part order), pieces (in assembly order), the
+    whole model (the parts welded back together), the model's file name and the make options of
+    report.json (empty when it is missing)."""
+
+    path: Path
+    model: str
+    parts: tuple[Mesh, ...]
+    pieces: tuple[ViewPiece, ...]
+    whole: Mesh
+    options: dict
+
+
+def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
+    """FOLD angles (E,) in degrees at fraction t of a path (K, E): linear between consecutive
+    frames, every segment the same share of t."""
+    frames = np.asarray(frames, dtype=np.float64)
+    t = min(1.0, max(0.0, float(t)))
+    if len(frames) == 1:
+        return frames[0].copy()
+    s = t * (len(frames) - 1)
+    i = min(int(math.floor(s)), len(frames) - 2)
+    u = s - i
+    return (1.0 - u) * frames[i] + u * frames[i + 1]
+
+
+def _goal_degrees(fold: dict, tree: FoldTree) -> np.ndarray:
+    path = fold.get("polyfold:path")
+    if path:
+        return np.asarray(path[-1], dtype=np.float64)
+    angles = fold.get("edges_foldAngle")
+    if angles is None:  # no angles in the file: the tree's own goal (rho radians)
+        return -np.degrees(tree.goal)
+    return np.asarray(angles, dtype=np.float64)
+
+
+def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation R and translation t minimising |R p + t - q| over the rows (a proper rotation)."""
+    cp, cq = p.mean(axis=0), q.mean(axis=0)
+    u, _, vt = np.linalg.svd((p - cp).T @ (q - cq))
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return r, cq - r @ cp
+
+
+def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
+    """A ViewPiece of a FOLD dict: builds the fold tree, checks the path and fits the rigid motion
+    that lands the goal pose on the foldedForm (fold_positions keeps each root face flat)."""
+    tree = fold_tree(fold)
+    frames = None
+    if fold.get("polyfold:path"):
+        frames = np.asarray(fold["polyfold:path"], dtype=np.float64)
+        if frames.ndim != 2 or frames.shape[1] != tree.n_edges:
+            raise PolyfoldError(f"piece {name}: polyfold:path frames must have one angle per edge ({tree.n_edges})")
+    elif tree.n_faces == 1:
+        frames = np.zeros((2, tree.n_edges))  # a single face is trivially foldable
+    goal = fold_positions(tree, -np.radians(_goal_degrees(fold, tree)))
+    n_p = int(tree.piece.max()) + 1
+    rotation = np.repeat(np.eye(3)[None], n_p, axis=0)
+    translation = np.zeros((n_p, 3))
+    fit_error = float("nan")
+    if tree.folded is not None:
+        target = tree.folded[tree.faces]
+        fit_error = 0.0
+        for k in range(n_p):
+            on = tree.piece == k
+            if not on.any():
+                continue
+            r, t = _kabsch(goal[on].reshape(-1, 3), target[on].reshape(-1, 3))
+            rotation[k], translation[k] = r, t
+            moved = goal[on] @ r.T + t
+            fit_error = max(fit_error, float(np.abs(moved - target[on]).max()))
+    return ViewPiece(name=name, part=part, fold=fold, tree=tree, frames=frames, rotation=rotation,
+                     translation=translation, fit_error=fit_error)
+
+
+def pose_piece(fold: dict, t: float) -> np.ndarray:
+    """Face corners (F, 3, 3) of a FOLD piece in the model frame at fraction t of its folding
+    path (see `ViewPiece.pose`; prepare the piece once with `prepare_piece` to pose it often)."""
+    return prepare_piece(fold).pose(t)
+
+
+def weld_parts(parts: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
+    """The whole model from its parts: vertices at the same position become one (make writes
+    them bit-exact). When that would join more than two faces at an edge (the input had split a
+    non-manifold vertex) the parts are kept side by side instead."""
+    verts = np.concatenate([p.vertices for p in parts])
+    offsets = np.cumsum([0] + [p.n_vertices for p in parts])[:-1]
+    faces = np.concatenate([p.faces + o for p, o in zip(parts, offsets)])
+    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
+    welded = Mesh(uniq, inverse.reshape(-1)[faces])
+    if (welded.topology.face_count > 2).any():
+        return Mesh(verts, faces)
+    return welded
+
+
+def _read_obj(path: Path) -> Mesh:
+    """The OBJ files make writes (v / f lines, triangles): read them exactly, without repairs."""
+    verts, faces = [], []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        tok = line.split()
+        if not tok:
+            continue
+        if tok[0] == "v":
+            verts.append([float(x) for x in tok[1:4]])
+        elif tok[0] == "f":
+            faces.append([int(x.split("/")[0]) - 1 for x in tok[1:4]])
+    v, f = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if len(f) == 0 or f.min() < 0 or f.max() >= len(v):
+        raise PolyfoldError(f"{path.name}: not a usable part mesh (no faces or bad vertex indices)")
+    return Mesh(v, f)
+
+
+def _inside(root: Path, name: str) -> Path:
+    """root / name for a plain file name from assembly.json, refusing anything that leaves root."""
+    if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
+        raise PolyfoldError(f"{root.name}/assembly.json: bad file name {name!r}")
+    return root / name
+
+
+def load_folder(path: str | Path) -> MakeFolder:
+    """Read a `polyfold make` output folder. Raises PolyfoldError (one line) when it is not one."""
+    from ..formats.fold import read_fold
+
+    root = Path(path)
+    if not root.is_dir():
+        raise PolyfoldError(f"{root}: no such folder")
+    asm_path = root / "assembly.json"
+    if not asm_path.is_file():
+        raise PolyfoldError(f"{root}: not a `polyfold make` output folder (no assembly.json)")
+    try:
+        assembly = json.loads(asm_path.read_text(encoding="utf-8"))
+        part_rows, piece_rows = assembly["parts"], assembly["pieces"]
+        obj_names = [str(p["obj"]) for p in part_rows]
+        piece_specs = [(str(r["piece"]), int(r["part"]), str(r["fold"])) for r in piece_rows]
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError) as exc:
+        raise PolyfoldError(f"{asm_path}: not a readable assembly file ({type(exc).__name__}: {exc})") from None
+    if not obj_names:
+        raise PolyfoldError(f"{asm_path}: no parts")
+    parts = []
+    for name in obj_names:
+        f = _inside(root, name)
+        if not f.is_file():
+            raise PolyfoldError(f"{root}: {name} is missing")
+        parts.append(_read_obj(f))
+    pieces = []
+    for name, part, fold_name in piece_specs:
+        if not 0 <= part < len(parts):
+            raise PolyfoldError(f"{asm_path}: piece {name} belongs to part {part}, which does not exist")
+        fold = read_fold(_inside(root, fold_name))
+        try:
+            pieces.append(prepare_piece(fold, name, part))
+        except PolyfoldError as exc:
+            raise PolyfoldError(f"{fold_name}: {exc}") from None
+        except (ValueError, TypeError, KeyError, IndexError) as exc:  # malformed values in the JSON
+            raise PolyfoldError(f"{fold_name}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
+    options: dict = {}
+    report_path = root / "report.json"
+    if report_path.is_file():
+        try:
+            options = dict(json.loads(report_path.read_text(encoding="utf-8")).get("options") or {})
+        except (OSError, UnicodeDecodeError, ValueError, AttributeError, TypeError):
+            options = {}
+    return MakeFolder(path=root, model=str(assembly.get("model") or root.name), parts=tuple(parts),
+                      pieces=tuple(pieces), whole=weld_parts(parts), options=options)
+
+
+def make_folder(mesh_path: str | Path, out_dir: str | Path, opts=None,
+                progress: Callable[[str, str], None] | None = None) -> MakeFolder:
+    """Run `polyfold make` on a mesh file into out_dir and load the result (the MESH form of
+    `polyfold view`)."""
+    from ..pipeline.make import make, MakeOptions
+
+    make(mesh_path, out_dir, opts or MakeOptions(), progress=progress)
+    return load_folder(out_dir)
+
+
+def make_options(saved: dict, **changes):
+    """MakeOptions from report.json's options (unknown keys dropped) with `changes` applied."""
+    from ..pipeline.make import MakeOptions
+
+    known = {f.name for f in fields(MakeOptions)}
+    kw = {k: v for k, v in saved.items() if k in known}
+    kw.update(changes)
+    return MakeOptions(**kw)
+
+
+# ----------------------------------------------------------------------------------------------
+# Serving
+
+
+def check_host(host: str, explicit: bool) -> str:
+    """The address to listen on. Only an IP address or 'localhost'; anything that is not a
+    loopback address must have been asked for explicitly (--host), since the page can run make
+    and write into the folder."""
+    h = (host or "").strip()
+    if h.lower() == "localhost":
+        return "127.0.0.1"
+    try:
+        addr = ipaddress.ip_address(h)
+    except ValueError:
+        raise PolyfoldError(f"--host must be an IP address such as 127.0.0.1 or 0.0.0.0 (or localhost), "
+                            f"not {host!r}") from None
+    if not addr.is_loopback and not explicit:
+        raise PolyfoldError(f"refusing to listen on {h}, which other machines can reach: "
+                            f"pass --host {h} explicitly to allow it")
+    return str(addr)
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """viser prints a banner and 'Server stopped' on stdout; the CLI prints its own one line."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        yield
+
+
+class _Debounced:
+    """Runs `func()` in a background thread once requests have stopped for `delay` seconds;
+    requests made while it runs cause one more run afterwards."""
+
+    def __init__(self, func: Callable[[], None], delay: float) -> None:
+        self._func = func
+        self._delay = delay
+        self._cv = threading.Condition()
+        self._last = 0.0
+        self._pending = False
+        self._closed = False
+        self._thread = threading.Thread(target=self._loop, daemon=True, name="polyfold-view-debounce")
+        self._thread.start()
+
+    def request(self) -> None:
+        with self._cv:
+            self._pending = True
+            self._last = time.monotonic()
+            self._cv.notify()
+
+    def close(self) -> None:
+        with self._cv:
+            self._closed = True
+            self._cv.notify()
+
+    def _loop(self) -> None:
+        while True:
+            with self._cv:
+                while not self._pending and not self._closed:
+                    self._cv.wait()
+                if self._closed:
+                    return
+                # wait until the requests have been quiet for `delay`
+                while not self._closed and time.monotonic() - self._last < self._delay:
+                    self._cv.wait(self._delay - (time.monotonic() - self._last))
+                if self._closed:
+                    return
+                self._pending = False
+            try:
+                self._func()
+            except Exception:  # a failed run must not kill the worker; func reports its own errors
+                pass
+
+
+class Viewer:
+    """A running viewer: the viser server, its scene and GUI. Create with `serve`."""
+
+    def __init__(self, server, folder: MakeFolder, source: Mesh, source_path: Path | None, root: Path) -> None:
+        self.server = server
+        self.folder = folder
+        self.root = root.resolve()  # make / export write only inside this folder
+        self.source = source  # the mesh the inflation panel inflates
+        self.source_path = source_path
+        host = server.get_host()
+        if host in ("0.0.0.0", "::"):  # all interfaces: this machine reaches it on loopback
+            host = "127.0.0.1"
+        self.url = f"http://[{host}]:{server.get_port()}" if ":" in host else f"http://{host}:{server.get_port()}"
+        self.port = int(server.get_port())
+        self.inflation = None  # last InflateResult
+        self.inflation_runs = 0
+        self.make_runs = 0
+        self._lock = threading.RLock()
+        self._playing = threading.Event()
+        self._play_thread: threading.Thread | None = None
+        self._stopped = False
+        self._part_nodes: list = []
+        self._net_nodes: list = []
+        self._fold_nodes: list = []  # (piece, mesh handle)
+        self._make_running = False
+
+        # A fixed view frame (camera and offsets stay put when a new make result is loaded): the
+        # model centred at the origin, longest side 2, z up. As the project's PNG previews
+        # (raster.render_mesh) do, the axis of middle extent is up and the longest one runs
+        # left to right.
+        v = source.vertices[np.unique(source.faces)]
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        ext = hi - lo
+        order = np.argsort(ext, kind="stable")  # shortest, middle, longest
+        rot = np.zeros((3, 3))
+        rot[0, order[2]] = rot[1, order[0]] = rot[2, order[1]] = 1.0  # view x, y, z <- model axes
+        if np.linalg.det(rot) < 0:
+            rot[1] *= -1.0  # a rotation, not a mirror image
+        self._rot = rot
+        self._center = (lo + hi) / 2
+        self._k = 2.0 / max(float(ext.max()), 1e-12)
+        self._half = np.abs(rot @ ext) * self._k / 2  # half extents along view x, y, z
+
+        scene, gui = server.scene, server.gui
+        gui.configure_theme(show_share_button=False, show_logo=False, control_width="medium")
+        scene.set_up_direction("+z")
+        hx, hz = float(self._half[0]), float(self._half[2])
+        left, right = self._inflated_offset()[0] - hx, hx + NET_GAP + self._net_row_width()
+        # look a little right of the middle: the control panel covers the right of the page
+        mid = (left + right) / 2 + 0.12 * (right - left)
+        dist = 0.5 * (right - left) + 0.8
+        server.initial_camera.look_at = (mid, 0.0, -0.3 * hz)
+        server.initial_camera.position = (mid, -dist, 0.55 * dist)
+
+        self._title = gui.add_markdown("")
+        with gui.add_folder("Folding"):
+            self.part_dropdown = gui.add_dropdown("Part", [ALL_PARTS], initial_value=ALL_PARTS,
+                                                  hint="The part whose pieces fold; the others are ghosted.")
+            self.fold_slider = gui.add_slider("Fold", 0.0, 1.0, 0.01, 1.0, hint="0 = flat net, 1 = folded onto the model.")
+            self.play_button = gui.add_button("Play", hint="Play the folding path from flat to folded.")
+            self.fold_info = gui.add_markdown("")
+        with gui.add_folder("Inflation"):
+            self.mode_dropdown = gui.add_dropdown("Mode", ["constrained", "uniform"], initial_value="constrained")
+            self.pressure_slider = gui.add_slider("Pressure", 0.1, 1.0, 0.05, 0.5)
+            self.stiffness_slider = gui.add_slider("Stiffness ratio", 1.0, 20.0, 0.5, 10.0,
+                                                   hint="Stiff-edge multiplier (constrained mode).")
+            self.steps_slider = gui.add_slider("Steps", 0, 20000, 100, 2000, hint="max_steps of the inflation run.")
+            self.show_inflated = gui.add_checkbox("Show inflated", True)
+            self.hv_text = gui.add_markdown(f"input HV {int(source.hyperbolic.sum())}")
+        with gui.add_folder("Make"):
+            self.output_text = gui.add_text("Output folder", ".", hint="Inside the viewed folder ('.' = the folder itself).")
+            self.use_inflated = gui.add_checkbox("Use inflated mesh", True,
+                                                 hint="Make (and export) the mesh inflated with the settings above.")
+            self.make_button = gui.add_button("Run make")
+            self.export_button = gui.add_button("Export inflated OBJ")
+            self.make_status = gui.add_markdown("")
+
+        self._inflated_mesh = scene.add_mesh_simple(
+            "/inflated", np.zeros((3, 3), np.float32), np.array([[0, 1, 2]], np.uint32), color=INFLATED_COLOR,
+            flat_shading=True, side="double", position=self._inflated_offset(), visible=False)
+        self._hv_points = scene.add_point_cloud(
+            "/inflated/hv", np.zeros((0, 3), np.float32), HV_COLOR, point_size=0.04, point_shape="circle",
+            visible=False)
+
+        self.part_dropdown.on_update(lambda _: self._show_part())
+        self.fold_slider.on_update(lambda _: self._pose())
+        self.play_button.on_click(lambda _: self.toggle_play())
+        for h in (self.mode_dropdown, self.pressure_slider, self.stiffness_slider, self.steps_slider):
+            h.on_update(lambda _: self._inflater.request())
+        self.show_inflated.on_update(lambda _: self._show_inflated_visibility())
+        self.make_button.on_click(lambda _: self._start(self._run_make))
+        self.export_button.on_click(lambda _: self._start(self._export))
+
+        self._inflater = _Debounced(self._inflate, DEBOUNCE_S)
+        self.load(folder)
+        self._inflater.request()
+
+    # ---- geometry helpers
+
+    def _to_view(self, x: np.ndarray) -> np.ndarray:
+        return (((np.asarray(x, dtype=np.float64) - self._center) @ self._rot.T) * self._k).astype(np.float32)
+
+    def _inflated_offset(self) -> tuple[float, float, float]:
+        return (-2.0 * float(self._half[0]) - INFLATED_GAP, 0.0, 0.0)  # left of the model
+
+    def _net_row_width(self) -> float:
+        return max(2.5, 2.5 * float(self._half[0]))
+
+    # ---- scene
+
+    def load(self, folder: MakeFolder) -> None:
+        """Show a make folder: part meshes, the part picker, nets and animation."""
+        from ..formats.raster import part_colors
+
+        with self._lock:
+            self.folder = folder
+            for h in self._part_nodes:
+                h.remove()
+            self._part_nodes = []
+            self._colors = [tuple(int(c) for c in rgb) for rgb in part_colors(len(folder.parts))]
+            for k, part in enumerate(folder.parts):
+                self._part_nodes.append(self.server.scene.add_mesh_simple(
+                    f"/model/part-{k}", self._to_view(part.vertices), part.faces.astype(np.uint32),
+                    color=self._colors[k], flat_shading=True, side="double"))
+            options = [ALL_PARTS] + [self._part_label(k) for k in range(len(folder.parts))]
+            self.part_dropdown.options = options
+            verified = sum(p.verified for p in folder.pieces)
+            self._title.content = (f"**{folder.model}**: {len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
+                                   f"{verified}/{len(folder.pieces)} folding paths verified")
+            self._show_part()
+
+    def _part_label(self, k: int) -> str:
+        names = [p.name for p in self.folder.pieces if p.part == k]
+        return f"part {k} ({', '.join(names)})" if names else f"part {k}"
+
+    def _chosen_part(self) -> int | None:
+        value = self.part_dropdown.value
+        m = re.match(r"part (\d+)", value)
+        return int(m.group(1)) if m else None
+
+    def _show_part(self) -> None:
+        """Rebuild the nets and the animated pieces for the part picked in the dropdown."""
+        with self._lock:
+            for h in self._net_nodes:
+                h.remove()
+            for _, h in self._fold_nodes:
+                h.remove()
+            self._net_nodes, self._fold_nodes = [], []
+            chosen = self._chosen_part()
+            parts = range(len(self.folder.parts)) if chosen is None else [chosen]
+            pieces = [p for p in self.folder.pieces if p.part in parts]
+            for k, node in enumerate(self._part_nodes):
+                animated = k in parts
+                # The animated part is drawn by its pieces; the rest is ghosted while one part folds.
+                node.visible = not animated
+                node.color = self._colors[k] if chosen is None else GHOST
+                node.opacity = None if chosen is None else GHOST_OPACITY
+            for i, piece in enumerate(pieces):  # node names by index: piece names come from a file
+                n_f = piece.tree.n_faces
+                h = self.server.scene.add_mesh_simple(
+                    f"/fold/piece-{i}", np.zeros((3 * n_f, 3), np.float32),
+                    np.arange(3 * n_f, dtype=np.uint32).reshape(-1, 3), color=self._colors[piece.part],
+                    flat_shading=True, side="double")
+                self._fold_nodes.append((piece, h))
+            self._add_nets(pieces)
+            bad = [p.name for p in pieces if not p.verified]
+            errs = [p.fit_error for p in pieces if not math.isnan(p.fit_error)]
+            lines = [f"{len(pieces)} piece(s): {', '.join(p.name for p in pieces)}"]
+            if errs:
+                lines.append(f"folded vs model: max corner error {max(errs) * self._k / 2:.1e} of the model size")
+            if bad:
+                lines.append(f"no verified path (shown folded): {', '.join(bad)}")
+            self.fold_info.content = "  \n".join(lines)
+            self._pose()
+
+    def _add_nets(self, pieces: list[ViewPiece]) -> None:
+        """Flat nets of `pieces` on the ground to the right of the model, printed side up, creases
+        drawn as on the sheets (mountain red, valley blue, cuts dark)."""
+        x0 = float(self._half[0]) + NET_GAP
+        y0 = -float(self._half[1])
+        ground = -float(self._half[2])
+        row_width = self._net_row_width()
+        x = y = shelf = 0.0
+        gap = 0.15
+        for i, piece in enumerate(pieces):
+            xy = np.asarray(piece.fold["vertices_coords"], dtype=np.float64)[:, :2] * self._k
+            faces = np.asarray(piece.fold["faces_vertices"], dtype=np.int64)
+            lo, hi = xy.min(axis=0), xy.max(axis=0)
+            w, d = hi - lo
+            if x > 0 and x + w > row_width:
+                x, y, shelf = 0.0, y + shelf + gap, 0.0
+            # the crease pattern's +z (outer, printed side) faces up; rows go away from the viewer
+            u = xy[:, 0] - lo[0] + x0 + x
+            v = xy[:, 1] - lo[1] + y0 + y
+            pts = np.stack([u, v, np.full_like(u, ground)], axis=1).astype(np.float32)
+            self._net_nodes.append(self.server.scene.add_mesh_simple(
+                f"/net/piece-{i}", pts, faces.astype(np.uint32), color=self._colors[piece.part],
+                flat_shading=True, side="double", opacity=0.9))
+            edges = np.asarray(piece.fold["edges_vertices"], dtype=np.int64)
+            assign = [str(a).upper() for a in piece.fold["edges_assignment"]]
+            lifted = pts + np.array([0.0, 0.0, 0.002], np.float32)
+            colors = np.array([LINE_COLORS.get(a, CUT_COLOR if a in ("B", "C") else (120, 120, 120)) for a in assign],
+                              dtype=np.uint8)
+            self._net_nodes.append(self.server.scene.add_line_segments(
+                f"/net/lines-{i}", lifted[edges], colors[:, None, :].repeat(2, axis=1),
+                thickness=0.006))
+            x += w + gap
+            shelf = max(shelf, d)
+
+    def _pose(self) -> None:
+        """Move the animated pieces to the slider's fraction of their folding paths."""
+        with self._lock:
+            t = float(self.fold_slider.value)
+            for piece, h in self._fold_nodes:
+                h.vertices = self._to_view(piece.pose(t).reshape(-1, 3))
+
+    # ---- controls
+
+    def set_part(self, part: int | None) -> None:
+        """Pick a part (None: all parts), as the dropdown does."""
+        self.part_dropdown.value = ALL_PARTS if part is None else self._part_label(part)
+
+    def set_fold(self, t: float) -> None:
+        """Move the fold slider (0 flat .. 1 folded), as the GUI does."""
+        self.fold_slider.value = float(min(1.0, max(0.0, t)))
+
+    def toggle_play(self) -> None:
+        """Play / pause the folding animation."""
+        if self._playing.is_set():
+            self._playing.clear()
+            return
+        if self.fold_slider.value >= 1.0:
+            self.set_fold(0.0)
+        self._playing.set()
+        self.play_button.label = "Pause"
+        self._play_thread = threading.Thread(target=self._play, daemon=True, name="polyfold-view-play")
+        self._play_thread.start()
+
+    def _play(self) -> None:
+        step = 1.0 / (PLAY_SECONDS * PLAY_FPS)
+        try:
+            while self._playing.is_set() and not self._stopped:
+                t = min(1.0, float(self.fold_slider.value) + step)
+                self.set_fold(t)
+                if t >= 1.0:
+                    break
+                time.sleep(1.0 / PLAY_FPS)
+        finally:
+            self._playing.clear()
+            if not self._stopped:
+                self.play_button.label = "Play"
+
+    # ---- inflation
+
+    def _inflate(self) -> None:
+        from ..inflate.inflate import inflate
+
+        mode = str(self.mode_dropdown.value)
+        p, r, n = float(self.pressure_slider.value), float(self.stiffness_slider.value), int(self.steps_slider.value)
+        hv0 = int(self.source.hyperbolic.sum())
+        # keep the last count on screen while the new run goes (readers never see it vanish)
+        last = self.hv_text.content.split("  \n")[0]
+        self.hv_text.content = f"{last}  \ninflating ({mode}, pressure {p:.2f}, stiffness {r:g}, {n} steps) ..."
+        try:
+            res = inflate(self.source, mode=mode, pressure=p, stiffness_ratio=r, max_steps=n)
+        except Exception as exc:  # shown in the page; the next slider change tries again
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            self.hv_text.content = f"input HV {hv0}  \ninflation failed: {why}"
+            return
+        mesh = res.mesh
+        hv = mesh.hyperbolic
+        with self._lock:
+            self.inflation = res
+            self._inflated_mesh.vertices = self._to_view(mesh.vertices)
+            self._inflated_mesh.faces = mesh.faces.astype(np.uint32)
+            self._hv_points.points = self._to_view(mesh.vertices[hv]).reshape(-1, 3)
+            self._show_inflated_visibility()
+            self.inflation_runs += 1
+        self.hv_text.content = (f"HV: {int(hv.sum())} (input {hv0})  \n{mode}, pressure {p:.2f}, stiffness {r:g}, "
+                                f"{res.steps} steps: {res.stop_reason}")
+
+    def _show_inflated_visibility(self) -> None:
+        on = bool(self.show_inflated.value) and self.inflation is not None
+        self._inflated_mesh.visible = on
+        self._hv_points.visible = on
+
+    def wait_inflation(self, runs: int = 1, timeout: float = 30.0) -> bool:
+        """Wait until at least `runs` inflation runs finished (for tests and scripts)."""
+        end = time.monotonic() + timeout
+        while self.inflation_runs < runs and time.monotonic() < end:
+            time.sleep(0.05)
+        return self.inflation_runs >= runs
+
+    # ---- make / export
+
+    def _start(self, job: Callable[[], None]) -> None:
+        with self._lock:
+            if self._make_running:
+                self.make_status.content = "busy: wait for the running job to finish"
+                return
+            self._make_running = True
+        self.make_button.disabled = self.export_button.disabled = True
+
+        def run() -> None:
+            try:
+                job()
+            except PolyfoldError as exc:
+                self.make_status.content = f"failed: {str(exc).splitlines()[0]}"
+            except Exception as exc:  # report in the page; the server keeps running
+                self.make_status.content = f"failed ({type(exc).__name__}): {str(exc).splitlines()[0] if str(exc) else ''}"
+            finally:
+                with self._lock:
+                    self._make_running = False
+                if not self._stopped:
+                    self.make_button.disabled = self.export_button.disabled = False
+
+        threading.Thread(target=run, daemon=True, name="polyfold-view-make").start()
+
+    def output_dir(self) -> Path:
+        """The folder the Make panel names, which must lie inside the viewed folder."""
+        text = str(self.output_text.value).strip() or "."
+        out = (self.root / text).resolve()
+        if out != self.root and self.root not in out.parents:
+            raise PolyfoldError(f"the output folder must be inside {self.root} (got {text!r})")
+        return out
+
+    def _mesh_for_make(self) -> tuple[Mesh, str]:
+        res = self.inflation
+        if self.use_inflated.value and res is not None:
+            return res.mesh, "inflated"
+        return self.source, "original"
+
+    def _stem(self) -> str:
+        return re.sub(r"[^A-Za-z0-9_.-]+", "_", Path(self.folder.model).stem) or "model"
+
+    def _export(self) -> None:
+        from ..formats.files import atomic_write
+
+        out = self.output_dir()
+        mesh, kind = self._mesh_for_make()
+        out.mkdir(parents=True, exist_ok=True)
+        name = f"{self._stem()}-{kind}.obj" if kind == "original" else f"{self._stem()}-inflated-{self.mode_dropdown.value}.obj"
+        atomic_write(out / name, obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind}) exported by polyfold view"))
+        self.make_status.content = f"exported {name} to {out}"
+
+    def _run_make(self) -> None:
+        """Run make on the original or inflated mesh into the output folder, then show the result."""
+        out = self.output_dir()
+        mesh, kind = self._mesh_for_make()
+        t0 = time.perf_counter()
+        tmp = Path(tempfile.mkdtemp(prefix="polyfold-view-"))
+        try:
+            if kind == "original" and self.source_path is not None:
+                src = self.source_path
+            else:
+                # make reads a file: the mesh as an OBJ named after the model (the report names it)
+                suffix = "" if kind == "original" else "-inflated"
+                src = tmp / f"{self._stem()}{suffix}.obj"
+                src.write_text(obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind})"))
+            opts = make_options(self.folder.options, inflate="none")
+
+            def progress(stage: str, msg: str) -> None:
+                self.make_status.content = f"make: {stage}: {msg}"
+
+            folder = make_folder(src, out, opts, progress)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        self.make_runs += 1
+        verified = sum(p.verified for p in folder.pieces)
+        self.make_status.content = (f"make ({kind} mesh) done in {time.perf_counter() - t0:.1f} s: "
+                                    f"{len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
+                                    f"{verified}/{len(folder.pieces)} paths verified, in {out}")
+        self.load(folder)
+
+    def wait_make(self, runs: int = 1, timeout: float = 120.0) -> bool:
+        """Wait until at least `runs` make runs finished (for tests and scripts)."""
+        end = time.monotonic() + timeout
+        while self.make_runs < runs and time.monotonic() < end:
+            time.sleep(0.05)
+        return self.make_runs >= runs
+
+    # ---- life cycle
+
+    def stop(self) -> None:
+        """Stop the animation, the inflation worker and the server."""
+        if self._stopped:
+            return
+        self._stopped = True
+        self._playing.clear()
+        self._inflater.close()
+        with _quiet_stdout():
+            self.server.stop()
+
+
+def serve(folder: MakeFolder | str | Path, host: str = DEFAULT_HOST, port: int = 8080, *,
+          allow_remote: bool = False, source: Mesh | None = None, source_path: str | Path | None = None) -> Viewer:
+    """Start the viewer on host:port (port 0: any free port; a taken port moves to the next free
+    one) and return at once. Only loopback addresses unless allow_remote (the CLI's explicit
+    --host). source: the mesh the inflation panel and make use (default: the folder's parts
+    welded); source_path: its file, if any. Serves only viser's bundled client."""
+    import viser
+
+    host = check_host(host, allow_remote)
+    if not 0 <= int(port) <= 65535:
+        raise PolyfoldError(f"--port must be 0..65535, not {port}")
+    if not isinstance(folder, MakeFolder):
+        folder = load_folder(folder)
+    with _quiet_stdout():
+        server = viser.ViserServer(host=host, port=int(port), label="polyfold", verbose=False)
+    try:
+        return Viewer(server, folder, source if source is not None else folder.whole,
+                      Path(source_path) if source_path is not None else None, folder.path)
+    except BaseException:
+        with _quiet_stdout():
+            server.stop()
+        raise
+
+
+def wait(viewer: Viewer) -> None:
+    """Block until Ctrl+C (or SIGTERM), then stop the viewer."""
+    import signal
+
+    def on_term(signum, frame):  # noqa: ARG001 - a polite kill ends like Ctrl+C (temp folders removed)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, on_term)
+    try:
+        while True:
+            time.sleep(0.5)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        viewer.stop()

@@ -1,0 +1,7 @@
+"""Collision tests, shared by unfold (2D), inflate and fold (3D).
+
+    tolerance.py  CONTACT_TOL: faces closer than this (times the model size) touch, not cross
+    flat.py       exact 2D triangle overlap of a net's faces, sort-and-sweep broad phase
+    triangles.py  the 3D triangle pair test (touching allowed, crossing not)
+    sweep.py      the 3D broad phase: sort-and-sweep over face boxes, collision reports
+"""

@@ -1,0 +1,530 @@
+"""Packing of paper-net pieces onto pages by their real outlines (not their bounding boxes).
+
+Every piece is tried in a few rotations (``angles`` evenly over 360 degrees plus the rotation that
+aligns its minimum-area bounding rectangle with the page axes) and dropped where its centroid is
+lowest, then leftmost, among the free positions of a page (bottom-left fill with "gravity" towards
+y = 0), so a piece slides into the concavities and holes of pieces already placed. Larger pieces
+go first; each piece goes onto the first open page that takes it, and a new page is opened only
+when none does (first-fit decreasing). Pieces are never mirrored: the printed side must stay up.
+
+Free positions are found on an occupancy grid (about 600 cells along the page's long side): every
+piece is grown by half the gap plus half a cell diagonal and rasterised by cell centres, which
+over-approximates the cells the half-gap-grown piece touches. Two pieces whose grids do not share a
+cell are therefore at least ``gap`` apart, exactly; the result is nevertheless re-checked with
+shapely (`check_packing`) before it is returned. The scan over positions is a numba kernel that
+checks a piece row by row as runs of cells against a "last occupied column" table and jumps past
+the obstacle it hits, so no loop visits every cell.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from numba import njit
+from shapely import MultiPolygon, Polygon
+
+from ..errors import PolyfoldError
+
+_CELLS = 600  # grid cells along the long printable side: ~0.46 mm on A4
+_QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
+_TOL = 1e-9  # mm: float noise allowed by check_packing
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where one piece goes: rotate by `angle` degrees CCW about the origin of its own
+    coordinates, then translate by `offset` (mm), onto page `page` (0-based)."""
+
+    page: int
+    angle: float
+    offset: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        # plain Python numbers whatever the caller computed them with (numpy scalars print badly)
+        object.__setattr__(self, "page", int(self.page))
+        object.__setattr__(self, "angle", float(self.angle))
+        object.__setattr__(self, "offset", (float(self.offset[0]), float(self.offset[1])))
+
+    def apply(self, xy: np.ndarray) -> np.ndarray:
+        """(n, 2) piece coordinates -> (n, 2) page coordinates."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        return xy @ _rot(self.angle).T + np.asarray(self.offset, dtype=float)
+
+
+@dataclass(frozen=True)
+class Packing:
+    """The result of `pack_outlines`: one placement per input outline, in input order."""
+
+    placements: tuple[Placement, ...]
+    n_pages: int
+    page_size: tuple[float, float]  # (width, height) mm
+    margin: float
+    utilisation: float  # total outline area / (n_pages * printable area)
+
+
+def placed_outline(outline: Polygon | MultiPolygon, placement: Placement) -> Polygon | MultiPolygon:
+    """The outline moved onto its page (page coordinates, mm)."""
+    return shapely.transform(outline, placement.apply)
+
+
+# ----------------------------------------------------------------------------------------------
+# geometry helpers
+
+
+def _rot(deg: float) -> np.ndarray:
+    """(2, 2) CCW rotation matrix."""
+    return _rots(np.array([deg]))[0]
+
+
+def _rots(degs: np.ndarray) -> np.ndarray:
+    """(k, 2, 2) CCW rotation matrices; quarter turns are exact (cos 90 is 6e-17 in floats,
+    which would make a piece that exactly fits the page miss by a hair)."""
+    t = np.radians(np.asarray(degs, dtype=float))
+    c, s = np.cos(t), np.sin(t)
+    c, s = np.where(np.abs(c) < 1e-15, 0.0, c), np.where(np.abs(s) < 1e-15, 0.0, s)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def _polygonal(outline, i: int) -> Polygon | MultiPolygon:
+    """The outline as a valid, non-empty (Multi)Polygon, or a PolyfoldError naming piece `i`."""
+    if not isinstance(outline, (Polygon, MultiPolygon)):
+        raise PolyfoldError(f"piece {i}: outline is a {type(outline).__name__}, not a polygon")
+    if not outline.is_valid:
+        # unions of triangles can come out self-touching; repair rather than refuse
+        outline = shapely.make_valid(outline)
+        outline = shapely.unary_union([g for g in shapely.get_parts(outline) if isinstance(g, (Polygon, MultiPolygon))])
+    if outline.is_empty or outline.area <= 0.0 or not np.isfinite(shapely.get_coordinates(outline)).all():
+        raise PolyfoldError(f"piece {i}: outline is empty or not finite")
+    return outline
+
+
+def _angles(outline: Polygon | MultiPolygon, angles: int, phase: float) -> np.ndarray:
+    """Rotations to try (degrees in [0, 360)): `angles` evenly spaced ones starting at `phase`, and
+    the two that put the sides of the minimum-area bounding rectangle along the page axes."""
+    out = [phase + k * 360.0 / max(angles, 1) for k in range(max(angles, 1))]
+    rect = shapely.get_coordinates(shapely.minimum_rotated_rectangle(outline))
+    if len(rect) >= 2:
+        d = rect[1] - rect[0]
+        if np.hypot(*d) > 0:
+            a = -math.degrees(math.atan2(d[1], d[0]))
+            out += [a, a + 90.0]
+    out = np.mod(np.asarray(out), 360.0)
+    keep = []
+    for a in out:  # a handful of values: drop near-duplicates, keep the order
+        if all(min(abs(a - b), 360.0 - abs(a - b)) > 1e-6 for b in keep):
+            keep.append(float(a))
+    return np.asarray(keep)
+
+
+def _extents(xy: np.ndarray, degs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bounding boxes of the points `xy` rotated by each angle: mins (k, 2), maxs (k, 2)."""
+    r = np.einsum("kij,nj->kni", _rots(degs), xy)
+    return r.min(axis=1), r.max(axis=1)
+
+
+def _best_fit(xy: np.ndarray, degs: np.ndarray, pw: float, ph: float) -> tuple[float, float]:
+    """(largest scale, its angle) at which the points fit a pw x ph rectangle."""
+    lo, hi = _extents(xy, degs)
+    ext = hi - lo
+    with np.errstate(divide="ignore"):
+        s = np.minimum(np.where(ext[:, 0] > 0, pw / ext[:, 0], np.inf), np.where(ext[:, 1] > 0, ph / ext[:, 1], np.inf))
+    k = int(np.argmax(s))
+    return float(s[k]), float(degs[k])
+
+
+def fits_page(outline: Polygon | MultiPolygon, page_size: tuple[float, float], margin: float, angles: int = 8) -> float:
+    """The largest uniform scale s (may be > 1) such that `outline` * s fits the printable area
+    (page minus margins) in one of the rotations `pack_outlines` tries with the same `angles`."""
+    pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
+    if pw <= 0 or ph <= 0:
+        return 0.0
+    xy = shapely.get_coordinates(outline)
+    if len(xy) == 0:
+        return math.inf
+    return _best_fit(xy, _angles(outline, angles, 0.0), pw, ph)[0]
+
+
+# ----------------------------------------------------------------------------------------------
+# rasters
+
+
+def _ring_edges(geom) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end points (e, 2) of every edge of every ring of a (Multi)Polygon."""
+    rings = shapely.get_rings(shapely.get_parts(geom))
+    xy, idx = shapely.get_coordinates(rings, return_index=True)
+    same = idx[1:] == idx[:-1]  # consecutive points of one ring (rings are closed)
+    return xy[:-1][same], xy[1:][same]
+
+
+def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
+    """(h, w) bool: cells whose centre (c + 0.5, r + 0.5) is inside the rings p0 -> p1 given in
+    cell units (even-odd rule, so holes work). Vectorised scanline: each edge toggles the cells
+    to the right of where it crosses a row's centre line; a cumulative sum gives the parity."""
+    v0, v1 = p0[:, 1], p1[:, 1]
+    lo, hi = np.minimum(v0, v1), np.maximum(v0, v1)
+    r0 = np.clip(np.ceil(lo - 0.5), 0, h).astype(np.int64)  # rows with lo <= r + 0.5 < hi
+    r1 = np.clip(np.ceil(hi - 0.5), 0, h).astype(np.int64)
+    cnt = np.maximum(r1 - r0, 0)
+    e = np.repeat(np.arange(len(cnt)), cnt)
+    r = np.repeat(r0, cnt) + (np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    a, b = p0[e], p1[e]
+    u = a[:, 0] + (r + 0.5 - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    c = np.clip(np.ceil(u - 0.5), 0, w).astype(np.int64)  # first column whose centre is right of u
+    toggles = np.bincount(r * (w + 1) + c, minlength=h * (w + 1)).reshape(h, w + 1)[:, :w]
+    return (np.cumsum(toggles, axis=1) & 1).astype(bool)
+
+
+@dataclass
+class _Shape:
+    """One piece in one rotation, rasterised on a grid aligned with its rotated bounding box."""
+
+    angle: float
+    lo: np.ndarray  # (2,) min corner of the rotated outline (mm)
+    mask: np.ndarray  # (h, w) bool, grown piece; cell (0, 0) starts at lo - pad cells
+    runs: np.ndarray  # (k, 3) int64: row, first column, last column of each run of the mask
+    xmax: int  # largest column offset at which the piece stays inside the printable area
+    ymax: int
+    cy: float  # centroid of the mask (cells): pieces go where their centroid is lowest ("gravity")
+    cx: float
+
+
+@njit(cache=True)
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Runs of set cells of a mask, (k, 3) int64 rows of (row, first column, last column), and the
+    mask's centroid (row, column), in one pass."""
+    h, w = mask.shape
+    runs = np.empty((h * (w // 2 + 1), 3), dtype=np.int64)
+    n = 0
+    sr = 0.0
+    sc = 0.0
+    cnt = 0
+    for r in range(h):
+        c = 0
+        while c < w:
+            if mask[r, c]:
+                a = c
+                while c < w and mask[r, c]:
+                    c += 1
+                runs[n, 0] = r
+                runs[n, 1] = a
+                runs[n, 2] = c - 1
+                n += 1
+                k = c - a
+                cnt += k
+                sr += k * r
+                sc += k * (a + c - 1) / 2.0
+            else:
+                c += 1
+    runs = runs[:n].copy()
+    # widest runs first: they are the likeliest to hit an obstacle, so a blocked position fails fast
+    order = np.argsort(runs[:, 1] - runs[:, 2], kind="mergesort")
+    return runs[order], sr / max(cnt, 1), sc / max(cnt, 1)
+
+
+class _Piece:
+    def __init__(self, geom, degs: np.ndarray, grow: float, res: float, pad: int, pw: float, ph: float):
+        self.xy = shapely.get_coordinates(geom)
+        self.area = float(geom.area)
+        self.degs = degs
+        self.p0, self.p1 = _ring_edges(geom.buffer(grow, quad_segs=_QUAD_SEGS))
+        self.res, self.pad, self.pw, self.ph = res, pad, pw, ph
+        self.lo, self.hi = _extents(self.xy, degs)
+        self._shapes: dict[int, _Shape | None] = {}
+
+    def shape(self, k: int) -> _Shape | None:
+        """Rotation k rasterised (cached: a piece is tried on several pages), None if it cannot
+        fit the printable area in that rotation."""
+        if k not in self._shapes:
+            self._shapes[k] = self._make_shape(k)
+        return self._shapes[k]
+
+    def _make_shape(self, k: int) -> _Shape | None:
+        res, pad = self.res, self.pad
+        lo, ext = self.lo[k], self.hi[k] - self.lo[k]
+        xmax, ymax = math.floor((self.pw - ext[0]) / res), math.floor((self.ph - ext[1]) / res)
+        if xmax < 0 or ymax < 0:
+            return None
+        w, h = (np.ceil(ext / res).astype(int) + 2 * pad + 1).tolist()
+        rot = _rot(self.degs[k]).T
+        origin = lo - pad * res
+        mask = _raster((self.p0 @ rot - origin) / res, (self.p1 @ rot - origin) / res, h, w)
+        runs, cy, cx = _runs(mask)
+        return _Shape(float(self.degs[k]), lo, mask, runs, xmax, ymax, cy, cx)
+
+
+# ----------------------------------------------------------------------------------------------
+# the position scan
+
+
+@njit(cache=True)
+def _scan(last: np.ndarray, rowmax: np.ndarray, runs: np.ndarray, ymax: int, xmax: int) -> tuple[int, int]:
+    """Lowest row y <= ymax, then lowest column x <= xmax, at which no run of the piece covers an
+    occupied cell; (-1, -1) if none. last[r, c] is the last occupied column <= c of row r (-1 if
+    none), so a run [a, b] placed at x is free iff last[y + row, x + b] < x + a; when it is not,
+    no x' <= last - a can work either, and the scan jumps there. rowmax[r] is the longest free
+    run of row r: rows where one of the widest runs (listed first) cannot fit are skipped whole."""
+    n = runs.shape[0]
+    k0 = 0  # the run that blocked last is tried first: neighbouring positions share obstacles
+    for y in range(ymax + 1):
+        skip = False
+        for k in range(min(n, 4)):
+            if rowmax[y + runs[k, 0]] < runs[k, 2] - runs[k, 1] + 1:
+                skip = True
+                break
+        if skip:
+            continue
+        x = 0
+        while x <= xmax:
+            ok = True
+            for t in range(n):
+                k = k0 + t
+                if k >= n:
+                    k -= n
+                c = last[y + runs[k, 0], x + runs[k, 2]]
+                if c >= x + runs[k, 1]:
+                    x = c - runs[k, 1] + 1
+                    k0 = k
+                    ok = False
+                    break
+            if ok:
+                return y, x
+    return -1, -1
+
+
+class _Page:
+    def __init__(self, h: int, w: int):
+        self.occ = np.zeros((h, w), dtype=bool)
+        self.last = np.full((h, w), -1, dtype=np.int32)
+        self.free = h * w
+        self.rowmax = np.full(h, w, dtype=np.int32)  # longest run of free cells in each row
+        self._cols = np.arange(w, dtype=np.int32)
+
+    def stamp(self, mask: np.ndarray, y: int, x: int) -> None:
+        h, w = mask.shape
+        block = self.occ[y : y + h, x : x + w]
+        self.free -= int(np.count_nonzero(mask & ~block))
+        block |= mask
+        rows = self.occ[y : y + h]
+        self.last[y : y + h] = np.maximum.accumulate(np.where(rows, self._cols, -1), axis=1)
+        # a free cell c ends a free run of c - last[c] cells; occupied cells give 0
+        self.rowmax[y : y + h] = (self._cols - self.last[y : y + h]).max(axis=1)
+
+
+def _best_on_page(page: _Page, piece: _Piece, res: float) -> tuple[_Shape, int, int] | None:
+    """The position and rotation of the piece on the page with the lowest centroid (then the
+    leftmost): like gravity, this drops pieces into the gaps left by others rather than merely
+    keeping their bounding boxes low, which would always prefer the flattest rotation."""
+    if piece.area / res**2 > page.free:
+        return None
+    widest_free = int(page.rowmax.max())
+    best, best_key = None, None
+    for k in range(len(piece.degs)):
+        s = piece.shape(k)
+        if s is None or s.runs[0, 2] - s.runs[0, 1] + 1 > widest_free:
+            continue
+        ylim = s.ymax if best_key is None else min(s.ymax, math.floor(best_key[0] - s.cy))
+        if ylim < 0:
+            continue  # branch and bound: cannot beat the best rotation so far
+        y, x = _scan(page.last, page.rowmax, s.runs, ylim, s.xmax)
+        if y < 0:
+            continue
+        key = (y + s.cy, x + s.cx)
+        if best_key is None or key < best_key:
+            best, best_key = (s, y, x), key
+    return best
+
+
+# ----------------------------------------------------------------------------------------------
+# fallbacks
+
+
+def _shelf(items: list[tuple[int, _Piece]], pw: float, ph: float, margin: float, gap: float, first_page: int) -> dict[int, Placement]:
+    """Bounding-box shelf packing onto new pages from `first_page` on: quick and always valid,
+    used for what is left when the time budget runs out. Each piece takes its flattest rotation."""
+    boxes = []
+    for i, p in items:
+        ext = p.hi - p.lo
+        with np.errstate(divide="ignore"):
+            scale = np.minimum(pw / ext[:, 0], ph / ext[:, 1])
+        ok = np.flatnonzero(scale >= 1.0 - 1e-12)  # as in pack_outlines: some rotation fits
+        k = int(ok[np.argmin(ext[ok, 1])])
+        boxes.append((float(ext[k, 1]), float(ext[k, 0]), i, k, p))
+    boxes.sort(key=lambda b: (-b[0], b[2]))
+    out: dict[int, Placement] = {}
+    page, x, y, shelf_h = first_page, 0.0, 0.0, 0.0
+    for bh, bw, i, k, p in boxes:
+        if x > 0 and x + bw > pw:
+            x, y, shelf_h = 0.0, y + shelf_h + gap, 0.0
+        if y > 0 and y + bh > ph:
+            page, x, y, shelf_h = page + 1, 0.0, 0.0, 0.0
+        lo = p.lo[k]
+        out[i] = Placement(page, float(p.degs[k]), (margin + x - lo[0], margin + y - lo[1]))
+        x, shelf_h = x + bw + gap, max(shelf_h, bh)
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# public
+
+
+def pack_outlines(
+    outlines: list[Polygon | MultiPolygon],
+    page_size: tuple[float, float],
+    margin: float = 10.0,
+    gap: float = 2.0,
+    angles: int = 8,
+    seed: int = 0,
+    time_limit: float = 5.0,
+) -> Packing:
+    """Place the outlines (mm, each in its own coordinates) on as few pages of `page_size` (width,
+    height mm) as the bottom-left fill finds, inside `margin` and at least `gap` apart. Raises
+    PolyfoldError naming a piece (and the largest scale that fits) if one cannot fit an empty page.
+    The same seed gives the same packing; a seed other than 0 turns the tried rotations by a random
+    phase. After `time_limit` seconds the remaining pieces are shelf-packed onto new pages."""
+    t0 = time.perf_counter()
+    W, H = float(page_size[0]), float(page_size[1])
+    pw, ph = W - 2 * margin, H - 2 * margin
+    geoms = [_polygonal(g, i) for i, g in enumerate(outlines)]
+    if not geoms:
+        return Packing((), 0, (W, H), float(margin), 0.0)
+    if gap < 0 or not math.isfinite(gap):
+        raise PolyfoldError(f"gap between pieces must be >= 0 mm, got {gap:g}")
+    if pw <= 0 or ph <= 0:
+        raise PolyfoldError(f"page {W:g} x {H:g} mm has no printable area inside {margin:g} mm margins")
+    rng = np.random.default_rng(seed)
+    phase = 0.0 if seed == 0 else float(rng.uniform(0.0, 360.0 / max(angles, 1)))
+
+    res = max(pw, ph) / _CELLS
+    # grow each piece by half the gap plus half a cell diagonal, and by 1/cos(half an arc segment)
+    # because shapely's arcs are chords inside the true circle: the grown polygon then contains
+    # every cell that the half-gap-grown piece touches (see the module docstring)
+    grow = (gap / 2 + res * math.sqrt(0.5)) / math.cos(math.pi / (4 * _QUAD_SEGS)) + 1e-6
+    pad = math.ceil(grow / res)
+    gh, gw = math.ceil(ph / res) + 2 * pad + 2, math.ceil(pw / res) + 2 * pad + 2
+
+    pieces = []
+    for i, g in enumerate(geoms):
+        xy = shapely.get_coordinates(g)
+        degs = _angles(g, angles, phase)
+        if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too
+            degs = np.append(degs, _best_fit(xy, _angles(g, angles, 0.0), pw, ph)[1])
+        scale, _ = _best_fit(xy, degs, pw, ph)
+        if scale < 1.0 - 1e-12:  # float noise of the rotation; check_packing allows 1e-9 mm
+            raise PolyfoldError(
+                f"piece {i} does not fit a {W:g} x {H:g} mm page with {margin:g} mm margins; "
+                f"the largest scale that fits is {math.floor(scale * 1000) / 1000:.3f}"
+            )
+        pieces.append(_Piece(g, degs, grow, res, pad, pw, ph))
+
+    areas = np.array([p.area for p in pieces])
+    order = np.lexsort((rng.random(len(pieces)), -areas))  # larger first, seeded ties
+    pages: list[_Page] = []
+    place: dict[int, Placement] = {}
+    deadline = t0 + time_limit
+    for n_done, i in enumerate(order.tolist()):
+        p, hit, pg = pieces[i], None, len(pages)
+        for pg, page in enumerate(pages):  # first fit: the first open page that takes the piece
+            if time.perf_counter() > deadline:
+                break
+            hit = _best_on_page(page, p, res)
+            if hit is not None:
+                break
+        if hit is None and time.perf_counter() > deadline:
+            # out of time: shelves on new pages for this piece and the rest (valid, quick)
+            rest = [(int(j), pieces[j]) for j in order[n_done:]]
+            place.update(_shelf(rest, pw, ph, margin, gap, len(pages)))
+            break
+        if hit is None:
+            pg, page = len(pages), _Page(gh, gw)
+            pages.append(page)
+            hit = _best_on_page(page, p, res)
+        if hit is not None:
+            s, y, x = hit
+            page.stamp(s.mask, y, x)
+            place[i] = Placement(pg, s.angle, (margin + x * res - s.lo[0], margin + y * res - s.lo[1]))
+            continue
+        # fits exactly but not on the conservative grid: alone in the middle of its new page,
+        # with its grown raster stamped so later pieces can still use the rest of the page
+        _, a = _best_fit(p.xy, p.degs, pw, ph)
+        lo, hi = _extents(p.xy, np.array([a]))
+        off = np.array([margin, margin]) + (np.array([pw, ph]) - (hi[0] - lo[0])) / 2 - lo[0]
+        place[i] = Placement(pg, a, (off[0], off[1]))
+        origin = margin - pad * res
+        rot = _rot(a).T
+        mask = _raster((p.p0 @ rot + off - origin) / res, (p.p1 @ rot + off - origin) / res, gh, gw)
+        page.stamp(mask, 0, 0)
+
+    placements = [place[i] for i in range(len(geoms))]
+    # the grid argument is exact, but never hand out a packing that fails the independent check
+    bad = sorted({j for pair in _conflicts(geoms, placements, W, H, margin, gap) for j in pair[1:]})
+    if bad:
+        n_pages = max(pl.page for pl in placements) + 1
+        for i, pl in _shelf([(i, pieces[i]) for i in bad], pw, ph, margin, gap, n_pages).items():
+            placements[i] = pl
+    used = sorted({pl.page for pl in placements})  # renumber in case a page was emptied above
+    remap = {old: new for new, old in enumerate(used)}
+    placements = [Placement(remap[pl.page], pl.angle, pl.offset) for pl in placements]
+    util = float(areas.sum()) / (len(used) * pw * ph)
+    return Packing(tuple(placements), len(used), (W, H), float(margin), util)
+
+
+def _conflicts(outlines, placements, W, H, margin, gap) -> list[tuple[str, int, ...]]:
+    """("page" | "bounds" | "gap" | "overlap", piece indices...) for every problem found."""
+    out: list[tuple] = []
+    if not outlines:
+        return out
+    placed = []
+    for i, (g, pl) in enumerate(zip(outlines, placements)):
+        q = placed_outline(g, pl)
+        placed.append(q)
+        x0, y0, x1, y1 = q.bounds
+        if x0 < margin - _TOL or y0 < margin - _TOL or x1 > W - margin + _TOL or y1 > H - margin + _TOL:
+            out.append(("bounds", i))
+    pages = np.array([pl.page for pl in placements])
+    for page in np.unique(pages):  # one tree per page: pieces on other pages never conflict
+        idx = np.flatnonzero(pages == page)
+        geoms = [placed[j] for j in idx]
+        tree = shapely.STRtree(geoms)
+        if gap > 0:
+            left, right = tree.query(geoms, predicate="dwithin", distance=gap)
+        else:
+            left, right = tree.query(geoms, predicate="intersects")
+        for a, b in zip(idx[left].tolist(), idx[right].tolist()):
+            if a >= b:
+                continue
+            if gap > 0:
+                if placed[a].distance(placed[b]) < gap - _TOL:
+                    out.append(("gap", a, b))
+            elif placed[a].relate_pattern(placed[b], "T********"):
+                out.append(("overlap", a, b))
+    return sorted(out, key=lambda p: p[1:])
+
+
+def check_packing(outlines: list[Polygon | MultiPolygon], packing: Packing, gap: float = 0.0) -> list[str]:
+    """Independent exact check of a packing: one human-readable line per problem (empty = OK):
+    a wrong number of placements or a page index out of range, an outline leaving the printable
+    rectangle, or two outlines on one page whose interiors intersect (gap = 0) or that are closer
+    than `gap`."""
+    if len(outlines) != len(packing.placements):
+        return [f"{len(packing.placements)} placements for {len(outlines)} outlines"]
+    problems = [
+        f"piece {i}: page {pl.page} is not in 0..{packing.n_pages - 1}"
+        for i, pl in enumerate(packing.placements)
+        if not 0 <= pl.page < packing.n_pages
+    ]
+    W, H = packing.page_size
+    m = packing.margin
+    # GEOS predicates can fail on invalid input; measure what pack_outlines measured (its repair)
+    geoms = [g if g.is_valid else _polygonal(g, i) for i, g in enumerate(outlines)]
+    for kind, *idx in _conflicts(geoms, list(packing.placements), W, H, m, gap):
+        if kind == "bounds":
+            problems.append(f"piece {idx[0]} leaves the printable area [{m:g}, {W - m:g}] x [{m:g}, {H - m:g}]")
+        elif kind == "gap":
+            problems.append(f"pieces {idx[0]} and {idx[1]} on page {packing.placements[idx[0]].page} are closer than {gap:g} mm")
+        else:
+            problems.append(f"pieces {idx[0]} and {idx[1]} on page {packing.placements[idx[0]].page} overlap")
+    return problems

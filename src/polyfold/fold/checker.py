@@ -1,0 +1,220 @@
+"""The one validity checker of the folding planners: is a configuration, or a straight segment
+between two configurations, free of self-intersection?
+
+Every planner asks `ValidityChecker` only (the pattern of OMPL's StateValidityChecker and
+MotionValidator): `valid(q)` for a configuration, `segment(qa, qb, step)` for the straight motion
+between two, sampled every `step` radians (largest angle change) in bisection order, midpoints
+first, so a blocked segment fails early. It counts what it checks.
+
+Underneath are numba kernels that planners may call inside their own loops: `segment_collides`
+(all the samples of a segment in one call, reusing per-face work from one configuration to the
+next, see `collision_work`), `config_collides` and its variants. A segment skips the pairs of
+faces whose relative pose cannot change on it (rigid groups: faces joined through creases that do
+not move), since both endpoints are valid.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numba import njit
+
+from ..collide.sweep import fill_face_geometry, gather_boxes, largest_group, sort_by_lo_x, sweep_collides
+from ..collide.triangles import GEO_SIZE
+from .kinematics import fold_faces
+
+if TYPE_CHECKING:
+    from .tree import FoldTree
+
+
+@njit(cache=True)
+def collision_work(n_faces):
+    """Work arrays of `segment_collides` for one tree of n_faces faces, reused across calls:
+    (geo, sb, si, last, R, T, out, meta).
+
+    geo (F, GEO_SIZE): per-face geometry and AABB; sb (7, F): the AABBs (lo x, hi x, lo y, hi y,
+    lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep
+    order (face ids by lo x; kept from call to call, it is the next call's starting guess), then
+    per position parent, piece, rigid group, non-degenerate flag, and scratch for the candidates
+    of one face; last (F, 2), R, T,
+    out: the folded state of the previous call (see `kinematics.fold_faces`); meta (1,): the tol geo was filled
+    with (NaN: geo not of out). The state changes only the cost, never a verdict.
+    """
+    si = np.empty((6, n_faces), dtype=np.int64)
+    last = np.empty((n_faces, 2))
+    meta = np.empty(1)
+    for f in range(n_faces):  # (loops, not np.full: that takes seconds to compile)
+        si[0, f] = f
+        last[f, 0] = np.nan
+    meta[0] = np.nan
+    return (np.empty((n_faces, GEO_SIZE)), np.empty((7, n_faces)), si, last,
+            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), meta)
+
+
+@njit(cache=True)
+def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, rigid, tol, work, q):
+    """The planners' collision test, at the configurations q = qa + (k / m) (qb - qa) for k in ks,
+    in that order (m = 0: q = qa), up to the first that self-intersects: (collides, checked).
+
+    Pairs with rigid[i] == rigid[j] >= 0 are not tested (see `config_collides_moving`; -1 for
+    none). work: `collision_work(F)` of this tree, reused across calls: the faces and sweep order
+    of the previous configuration are the starting point (work's out holds the last configuration
+    folded). q (E,) scratch. All the samples of a segment in one call: a call between compiled
+    functions updates the reference count of every array argument, which per configuration
+    would cost a tenth of a small net's test.
+    """
+    geo, sb, si, last, R, T, out, meta = work
+    if not (meta[0] == tol):
+        last[:, 0] = np.nan  # geo rows of another tol: recompute every face
+        meta[0] = tol
+    big = largest_group(rigid, si[5])
+    checked = 0
+    for k in ks:
+        if m == 0:
+            q[:] = qa
+        else:
+            t = k / m
+            for i in range(qa.shape[0]):
+                q[i] = qa[i] + t * (qb[i] - qa[i])
+        checked += 1
+        fold_faces(q, order, parent, crease, axis, flat, R, T, out, last)
+        fill_face_geometry(out, tol, geo, last)
+        sort_by_lo_x(geo, sb, si)
+        gather_boxes(geo, parent, piece, rigid, sb, si)
+        if sweep_collides(out, geo, sb, si, tol, big):
+            return True, checked
+    return False, checked
+
+
+@njit(cache=True)
+def config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work):
+    """`config_collides_moving` with the work arrays of `segment_collides` (rigid -1: no group)."""
+    # np.int64(0), not 0: a literal would compile another specialization of segment_collides
+    return segment_collides(q, q, np.zeros(1, dtype=np.int64), np.int64(0), order, parent, crease, axis, flat,
+                            piece, rigid, tol, work, np.empty(q.shape[0]))[0]
+
+
+@njit(cache=True)
+def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out):
+    """Like `config_collides`, but pairs with rigid[i] == rigid[j] >= 0 are not tested.
+
+    Along a segment on which only some creases move, faces joined by non-moving creases keep
+    their relative pose; if both endpoints are collision-free such pairs never collide, so a
+    planner can label those rigid groups once per segment and skip them.
+    """
+    work = collision_work(order.shape[0])
+    hit = config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work)
+    R[:] = work[4]
+    T[:] = work[5]
+    out[:] = work[6]
+    return hit
+
+
+@njit(cache=True)
+def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+    """forward_kinematics into (R, T, out), then the collision test: True if q self-intersects."""
+    no_groups = np.empty(order.shape[0], dtype=np.int64)
+    no_groups[:] = -1
+    return config_collides_moving(q, order, parent, crease, axis, flat, piece, no_groups, tol, R, T, out)
+
+
+@njit(cache=True)
+def bisection_order(m: int) -> np.ndarray:
+    """Interior sample indices 1..m-1, midpoints first (early rejection of bad segments)."""
+    out = np.empty(max(m - 1, 0), dtype=np.int64)
+    if m <= 1:
+        return out
+    lo = np.empty(2 * m, dtype=np.int64)
+    hi = np.empty(2 * m, dtype=np.int64)
+    lo[0], hi[0] = 0, m
+    head, tail, k = 0, 1, 0
+    while head < tail:
+        a, b = lo[head], hi[head]
+        head += 1
+        if b - a < 2:
+            continue
+        mid = (a + b) // 2
+        out[k] = mid
+        k += 1
+        lo[tail], hi[tail] = a, mid
+        tail += 1
+        lo[tail], hi[tail] = mid, b
+        tail += 1
+    return out[:k]
+
+
+@njit(cache=True)
+def segment_free(qa, qb, step, order, parent, crease, axis, flat, piece, tol, q, max_samples, work) -> tuple:
+    """Check the straight segment qa -> qb at interior samples k/m, m = ceil(max|qb - qa| / step).
+
+    Samples go in bisection order; only the first `max_samples` are checked (a cheap coarse test
+    when small; pass a huge number for the full check). Endpoints are assumed valid. q (E,)
+    scratch; work: the tree's `collision_work` arrays. Returns (free, configurations checked).
+    """
+    span = 0.0
+    for i in range(qa.shape[0]):
+        span = max(span, abs(qb[i] - qa[i]))
+    m = int(math.ceil(span / step - 1e-12))
+    # Rigid groups: faces joined through creases that do not move on this segment keep their
+    # relative pose, and both endpoints are valid, so pairs inside one group are skipped.
+    rigid = np.empty(order.shape[0], dtype=np.int64)
+    for f in order:
+        if parent[f] < 0 or qa[crease[f]] != qb[crease[f]]:
+            rigid[f] = f
+        else:
+            rigid[f] = rigid[parent[f]]
+    hit, checked = segment_collides(qa, qb, bisection_order(m)[:max_samples], m, order, parent, crease, axis, flat,
+                                    piece, rigid, tol, work, q)
+    return not hit, checked
+
+
+class ValidityChecker:
+    """Collision queries on one tree with preallocated work arrays; counts what it does."""
+
+    def __init__(self, tree: FoldTree, resolution: float):
+        self.tree = tree
+        self.step = resolution
+        self.q = np.empty(len(tree.goal))
+        self.work = collision_work(len(tree.order))
+        self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
+        self.configs = 0
+        self.edges = 0
+
+    def valid(self, q: np.ndarray) -> bool:
+        t = self.tree
+        self.configs += 1
+        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
+                                          t.tol, self.work)
+
+    def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
+        t = self.tree
+        self.edges += 1
+        free, n = segment_free(qa, qb, self.step if step is None else step, t.order, t.parent, t.crease, t.axis,
+                               t.flat, t.piece, t.tol, self.q, max_samples, self.work)
+        self.configs += n
+        return bool(free)
+
+
+def first_blocked_segment(check: ValidityChecker, frames: np.ndarray, step: float) -> int:
+    """Index of the first segment that collides at `step`, or -1 if the whole path is free."""
+    for i in range(len(frames) - 1):
+        if not check.segment(frames[i], frames[i + 1], step):
+            return i
+    return -1
+
+
+def shortcut(frames: list[np.ndarray], check: ValidityChecker, deadline: float, step: float | None = None) -> np.ndarray:
+    """Greedy shortcut: from each kept frame jump to the farthest later frame reachable directly
+    (checked at `step`, default the checker's resolution); after the deadline, no more jumps."""
+    out = [frames[0]]
+    i = 0
+    while i < len(frames) - 1:
+        j = len(frames) - 1
+        while j > i + 1 and (time.perf_counter() >= deadline or not check.segment(frames[i], frames[j], step)):
+            j -= 1
+        out.append(frames[j])
+        i = j
+    return np.stack(out)

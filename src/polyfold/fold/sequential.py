@@ -1,0 +1,190 @@
+"""The sequential planner (ours, not the paper's): unfold the folded shape one crease at a time.
+
+`plan_sequential` opens creases from the goal towards the flat net, each move checked by the
+`ValidityChecker` at half the resolution as it goes, and reverses the sequence; when only a few
+creases lock in the discrete domain, `rrt_connect` searches their continuous subspace.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .checker import ValidityChecker, shortcut
+from .tree import FoldTree, crease_depth_size
+
+
+# The sequential planner's continuous search over the creases it cannot open (`rrt_connect`):
+RRT_MAX_DOF = 32  # stuck sets of up to this many creases get one
+
+
+RRT_STEP_DEG = 15.0  # longest extension of a tree, per crease
+
+
+RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much on either side
+
+
+def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: float, rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
+    """Reverse sequential unfolding: (frames flat -> goal, continuous?), or None (stuck or out of time).
+
+    Start at the folded goal and open one crease at a time (its angle to 0), always the first
+    crease in priority order whose motion is collision-free; the path is that sequence reversed.
+    Every frame stays in the paper's discrete domain (each crease flat or at its goal), so this is
+    a path the Lazy PRM could also find, but found directly instead of by sampling 2^n states.
+    Priority: creases splitting the net most evenly first (the largest smaller side), so a closed
+    shape first opens into big halves that swing apart, and small flaps open last, when little is
+    left in their way. When no remaining crease can open, start again from the goal with the
+    stuck creases promoted to the front: opened early, while the shape around them is still
+    folded, they usually swing out freely (a curled strip of faces, say, that would sweep through
+    a flattened neighbour). Restarts alternate between two base orders (see `tracks`), each with
+    its own promotions; a track stuck on the same creases again shuffles them (rng, so the seed
+    decides). Restarts go on until the deadline.
+    When a restart is stuck with at most RRT_MAX_DOF creases left closed (a set not searched
+    before), their continuous subspace is searched by `rrt_connect` from the stuck state to
+    flat: some creases can open neither alone, nor first, nor together in the discrete domain
+    (a tightly curled strip carrying a large flap, say) but can by partial, coordinated moves.
+    Such a path leaves the discrete domain in its first frames (`continuous?` is then True).
+    Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
+    """
+    creases, goal = tree.creases, tree.goal
+    n = len(creases)
+    depth, size = crease_depth_size(tree)
+    smaller_side = np.minimum(size, len(tree.order) - size)
+    # Two tracks of restarts, taken in turn, each with its own base order and promotions: creases
+    # splitting the net most evenly first (ties: shallower first), and the shallowest first (ties:
+    # larger smaller side first), which unlocks some nets the first order cannot.
+    tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
+    tried: list[set[frozenset]] = [set(), set()]
+    searched: set[frozenset] = set()  # stuck sets given to the continuous search already
+    fine = check.step / 2
+    restart = 0
+    while time.perf_counter() < deadline:
+        track = restart % 2
+        prio = tracks[track]
+        restart += 1
+        q = goal.copy()
+        frames = [q]  # q is replaced, never changed in place
+        is_open = np.zeros(n, dtype=bool)
+        fails = np.zeros(n, dtype=np.int64)
+        retry_at = np.zeros(n, dtype=np.int64)
+        group, step = 1, 0
+        while not is_open.all() and time.perf_counter() < deadline:
+            step += 1
+            todo = [i for i in prio if not is_open[i]]
+            # Open the next `group` creases in one motion when that is free (one check instead of
+            # `group`: a segment costs its largest angle change, not its crease count); the group
+            # doubles after each success, else one crease at a time: the first free one. A crease
+            # that was blocked waits 2, 4, 8, ... steps before it is tried again (it is usually
+            # still blocked); only when nothing else moves are the waiting ones tried at once.
+            ready = [i for i in todo if retry_at[i] <= step]
+            waiting = [i for i in todo if retry_at[i] > step]
+            moves = [ready[:group]] if group > 1 and len(ready) > 1 else []
+            moves += ([i] for i in ready + waiting)
+            for move in moves:
+                if time.perf_counter() >= deadline:  # a scan of a large net can take a while
+                    return None
+                nxt = q.copy()
+                nxt[creases[move]] = 0.0
+                # the new state itself first (segments assume valid endpoints), then the motion,
+                # at half the resolution straight away: the path needs no re-validation
+                if check.valid(nxt) and check.segment(q, nxt, fine):
+                    is_open[move] = True
+                    q = nxt  # a fresh array: frames may keep it
+                    frames.append(q)
+                    group = min(2 * len(move), len(todo))
+                    break
+                if len(move) == 1:
+                    fails[move[0]] += 1
+                    retry_at[move[0]] = step + (1 << min(int(fails[move[0]]), 6))
+            else:
+                break
+        if is_open.all():
+            frames.reverse()  # (plan_fold answers nets without creases before this runs)
+            return np.stack(frames), False
+        stuck = [i for i in prio if not is_open[i]]
+        if time.perf_counter() >= deadline:
+            return None
+        key = frozenset(stuck)
+        if len(stuck) <= RRT_MAX_DOF and key not in searched:
+            # Locked in the discrete domain, but only a few creases are left: search their
+            # continuous subspace (once per stuck set, with half the time left).
+            searched.add(key)
+            sub_deadline = min(deadline, time.perf_counter() + 0.5 * (deadline - time.perf_counter()))
+            rest = rrt_connect(check, q, creases[stuck], sub_deadline, rng)
+            if rest is not None:
+                frames += rest
+                frames.reverse()
+                return np.stack(frames), True
+        if key in tried[track]:
+            rng.shuffle(stuck)
+        tried[track].add(key)
+        tracks[track] = stuck + [i for i in prio if is_open[i]]
+    return None
+
+
+def rrt_connect(check: ValidityChecker, start: np.ndarray, moving: np.ndarray, deadline: float,
+                 rng: np.random.Generator) -> list[np.ndarray] | None:
+    """Continuous path from the valid state `start` to `start` with the edges `moving` at 0, by
+    RRT-Connect (Kuffner & LaValle 2000) in the subspace of those edges; None when out of time.
+
+    Out: the frames after `start`, ending at the target, every move checked at half the
+    resolution (as the sequential planner's own moves). Each moving edge ranges over [0, goal]
+    widened by RRT_MARGIN_DEG (within [-pi, pi]); trees grow by at most RRT_STEP_DEG per edge
+    (distances are max-norms: a segment's check costs its largest angle change). The joined
+    path is shortened greedily (`shortcut`) at the same resolution.
+    """
+    fine = check.step / 2
+    a = start[moving]
+    lo = np.maximum(np.minimum(a, 0.0) - math.radians(RRT_MARGIN_DEG), -math.pi)
+    hi = np.minimum(np.maximum(a, 0.0) + math.radians(RRT_MARGIN_DEG), math.pi)
+    step = math.radians(RRT_STEP_DEG)
+
+    def state(x: np.ndarray) -> np.ndarray:
+        q = start.copy()
+        q[moving] = x
+        return q
+
+    target = state(np.zeros(len(moving)))
+    if not check.valid(target):
+        return None
+    # two trees (node angles of the moving edges, parent index); tree 0 grows from start
+    nodes = [[a.copy()], [np.zeros(len(moving))]]
+    parents = [[-1], [-1]]
+
+    def extend(t: int, x: np.ndarray) -> tuple[int, bool]:
+        """Grow tree t one step towards x: (new node or -1 when blocked, x reached?)."""
+        pts = np.asarray(nodes[t])
+        i = int(np.argmin(np.abs(pts - x).max(axis=1)))
+        y = pts[i]
+        d = float(np.abs(x - y).max())
+        z = x if d <= step else y + (x - y) * (step / d)
+        if not check.valid(state(z)) or not check.segment(state(y), state(z), fine):
+            return -1, False
+        nodes[t].append(z)
+        parents[t].append(i)
+        return len(nodes[t]) - 1, d <= step
+
+    def branch(t: int, i: int) -> list[np.ndarray]:
+        out = []
+        while i >= 0:
+            out.append(nodes[t][i])
+            i = parents[t][i]
+        return out
+
+    t = 0
+    while time.perf_counter() < deadline:
+        k, _ = extend(t, lo + rng.random(len(moving)) * (hi - lo))
+        if k >= 0:
+            x = nodes[t][k]
+            while time.perf_counter() < deadline:  # connect: the other tree steps towards x
+                j, reached = extend(1 - t, x)
+                if j < 0:
+                    break
+                if reached:
+                    ends = {t: k, 1 - t: j}
+                    path = branch(0, ends[0])[::-1] + branch(1, ends[1])[1:]
+                    return list(shortcut([state(p) for p in path], check, deadline, fine)[1:])
+        t = 1 - t
+    return None

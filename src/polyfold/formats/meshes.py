@@ -1,0 +1,203 @@
+"""Mesh files: readers of OBJ, OFF, STL, PLY, GLB and GLTF, the OBJ writer, and `load_mesh`
+(read, then `mesh.repair.repair`).
+
+Every message names indices in the INPUT file's numbering, 0-based (faces in file order, before
+triangulation), so a user can find the culprit in their file.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..mesh.repair import LoadedMesh, RawMesh, mesh_error, repair
+
+
+TEXT_FORMATS = {".obj", ".off"}
+
+
+TRIMESH_FORMATS = {".stl", ".ply", ".glb", ".gltf"}
+
+
+def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
+    """Fan-triangulate polygons; returns (tris, source polygon per tri, number of polygons > 3)."""
+    tris: list[tuple[int, int, int]] = []
+    source: list[int] = []
+    n_big = 0
+    for i, p in enumerate(polygons):
+        if len(p) < 3:
+            # Keep it as a face with a repeated index so it is dropped (and counted) as degenerate.
+            p = p + [p[-1]] * (3 - len(p))
+        elif len(p) > 3:
+            n_big += 1
+        for j in range(1, len(p) - 1):
+            tris.append((p[0], p[j], p[j + 1]))
+            source.append(i)
+    return (
+        np.array(tris, dtype=np.int64).reshape(-1, 3),
+        np.array(source, dtype=np.int64),
+        n_big,
+    )
+
+
+def _logical_lines(text: str):
+    """(line number, tokens) of the non-empty lines, comments stripped, '\\' continuations joined."""
+    pending: list[str] = []
+    start = 0
+    for lineno, line in enumerate(text.splitlines(), 1):
+        line = line.split("#", 1)[0]
+        if not pending:
+            start = lineno
+        if line.rstrip().endswith("\\"):
+            pending.append(line.rstrip()[:-1])
+            continue
+        tokens = " ".join(pending + [line]).split()
+        pending = []
+        if tokens:
+            yield start, tokens
+    if pending:
+        tokens = " ".join(pending).split()
+        if tokens:
+            yield start, tokens
+
+
+def _parse_obj(text: str, name: str) -> RawMesh:
+    verts: list[list[float]] = []
+    vlines: list[int] = []
+    polys: list[list[int]] = []
+    flines: list[int] = []
+    for lineno, tokens in _logical_lines(text):
+        tag = tokens[0]
+        if tag == "v":
+            if len(tokens) < 4:
+                raise mesh_error(name, f"line {lineno}: vertex {len(verts)} needs 3 coordinates")
+            try:
+                verts.append([float(t) for t in tokens[1:4]])
+            except ValueError:
+                raise mesh_error(name, f"line {lineno}: vertex {len(verts)} has a coordinate that is not a number") from None
+            vlines.append(lineno)
+        elif tag in ("f", "fo"):
+            face = len(polys)
+            if len(tokens) < 2:
+                raise mesh_error(name, f"line {lineno}: face {face} has no vertices")
+            idx = []
+            for tok in tokens[1:]:
+                try:
+                    k = int(tok.split("/", 1)[0])
+                except ValueError:
+                    raise mesh_error(name, f"line {lineno}: face {face} has a bad vertex reference {tok!r}") from None
+                if k == 0:
+                    raise mesh_error(name, f"line {lineno}: face {face} uses vertex index 0 (OBJ indices start at 1)")
+                # Negative indices count back from the last vertex defined so far.
+                j = k - 1 if k > 0 else len(verts) + k
+                if j < 0:
+                    raise mesh_error(name, f"line {lineno}: face {face} uses relative index {k} before that many vertices exist")
+                idx.append(j)
+            polys.append(idx)
+            flines.append(lineno)
+        # Other tags (vt, vn, g, o, s, usemtl, mtllib, l, p, ...) carry nothing a net needs.
+    tris, source, n_big = _fan(polys)
+    vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
+    return RawMesh(vertices, tris, source, n_big, flines, vlines)
+
+
+def _parse_off(text: str, name: str) -> RawMesh:
+    rows = list(_logical_lines(text))
+    if not rows:
+        raise mesh_error(name, "no faces (empty file)")
+    lineno, tokens = rows[0]
+    header = tokens[0]
+    if not header.upper().endswith("OFF"):
+        raise mesh_error(name, f"line {lineno}: expected an OFF header, found {header!r}")
+    if header[:-3].startswith("4") or "n" in header[:-3]:
+        raise mesh_error(name, f"line {lineno}: OFF variant {header!r} (not 3D) is not supported")
+    counts = tokens[1:]
+    pos = 1
+    if not counts:
+        if len(rows) < 2:
+            raise mesh_error(name, "no faces (missing vertex and face counts)")
+        lineno, counts = rows[1]
+        pos = 2
+    try:
+        nv, nf = int(counts[0]), int(counts[1])
+    except (ValueError, IndexError):
+        raise mesh_error(name, f"line {lineno}: expected vertex and face counts") from None
+    if len(rows) < pos + nv + nf:
+        raise mesh_error(name, f"file ends early: header promises {nv} vertices and {nf} faces")
+    verts, vlines = [], []
+    for i in range(nv):
+        lineno, tokens = rows[pos + i]
+        try:
+            verts.append([float(t) for t in tokens[:3]])
+            if len(tokens) < 3:
+                raise ValueError
+        except ValueError:
+            raise mesh_error(name, f"line {lineno}: vertex {i} needs 3 numeric coordinates") from None
+        vlines.append(lineno)
+    polys, flines = [], []
+    for i in range(nf):
+        lineno, tokens = rows[pos + nv + i]
+        try:
+            k = int(tokens[0])
+            idx = [int(t) for t in tokens[1 : 1 + k]]
+            if k < 1 or len(idx) != k:
+                raise ValueError
+        except ValueError:
+            raise mesh_error(name, f"line {lineno}: face {i} should be a vertex count followed by that many indices") from None
+        polys.append(idx)
+        flines.append(lineno)
+    tris, source, n_big = _fan(polys)
+    vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
+    return RawMesh(vertices, tris, source, n_big, flines, vlines)
+
+
+def _load_trimesh(path: str, name: str) -> RawMesh:
+    import trimesh  # imported lazily: slow to import, and only needed for these formats
+
+    try:
+        # process=False keeps vertices and faces exactly in file order; force='mesh' concatenates
+        # the geometries of a scene (GLB/GLTF).
+        tm = trimesh.load(path, process=False, force="mesh")
+    except Exception as exc:  # trimesh raises many kinds of errors on broken files
+        raise mesh_error(name, f"cannot read: {type(exc).__name__}: {exc}") from None
+    if not hasattr(tm, "faces") or tm.faces is None or len(tm.faces) == 0:
+        raise mesh_error(name, "no faces")
+    faces = np.asarray(tm.faces, dtype=np.int64).reshape(-1, 3)
+    return RawMesh(np.asarray(tm.vertices, dtype=np.float64).reshape(-1, 3), faces, np.arange(len(faces)), 0)
+
+
+def _read(path: str, name: str) -> RawMesh:
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in TEXT_FORMATS | TRIMESH_FORMATS:
+        known = ", ".join(sorted(TEXT_FORMATS | TRIMESH_FORMATS))
+        raise mesh_error(name, f"unknown format {ext or '(no extension)'!r} (expected one of {known})")
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read() if ext in TEXT_FORMATS else b""
+    except OSError as exc:
+        raise mesh_error(name, f"cannot read: {exc.strerror or exc}") from None
+    if ext in TRIMESH_FORMATS:
+        return _load_trimesh(path, name)
+    # Comments may hold any encoding; the data we need is ASCII.
+    text = data.decode("utf-8", errors="replace")
+    return _parse_obj(text, name) if ext == ".obj" else _parse_off(text, name)
+
+
+def obj_text(vertices: np.ndarray, faces: np.ndarray, header: list[str] | str = ()) -> str:
+    """Wavefront OBJ text of a triangle mesh: header comment lines, then v and f (1-based) lines.
+    Coordinates are written with repr so reading the file back gives the same floats."""
+    header = [header] if isinstance(header, str) else list(header)
+    lines = [f"# {h}" for h in header]
+    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, dtype=np.float64).tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.asarray(faces).tolist()]
+    return "\n".join(lines) + "\n"
+
+
+def load_mesh(path: str | os.PathLike) -> LoadedMesh:
+    """Read, check and repair a mesh file (OBJ, OFF, STL, PLY, GLB, GLTF).
+
+    Raises MeshError (one line, starting with the file name) when the file cannot be used.
+    """
+    path = os.fspath(path)
+    return repair(_read(path, os.path.basename(path)), path)

@@ -1,0 +1,98 @@
+"""PDF sheets: all pages in one document, each exactly its own size (reportlab)."""
+
+from __future__ import annotations
+
+import io as _io
+import os
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..fabricate.page import Page
+from .files import atomic_write
+from .sheet_style import MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
+
+
+def _pt(page: Page, pts: np.ndarray) -> np.ndarray:
+    """(n, 2) page mm (y down) -> PDF points (y up, origin bottom-left)."""
+    out = np.empty_like(pts, dtype=np.float64)
+    out[..., 0] = pts[..., 0] * MM_TO_PT
+    out[..., 1] = (page.height - pts[..., 1]) * MM_TO_PT
+    return out
+
+
+def _pdf_stroke(c, style: str) -> None:
+    """Set stroke colour, hairline width and dash pattern (converted to points) on canvas `c`."""
+    st = STYLES[style]
+    c.setStrokeColorRGB(*(v / 255 for v in st["rgb"]))
+    c.setLineWidth(STROKE_MM * MM_TO_PT)
+    c.setDash([v * MM_TO_PT for v in st["dash"]] if st["dash"] else [], 0)
+
+
+def _pdf_polygon(c, pts_pt: np.ndarray, stroke: int, fill: int) -> None:
+    """One closed polygon (points already in PDF points) on reportlab canvas `c`."""
+    p = c.beginPath()
+    p.moveTo(*pts_pt[0])
+    for x, y in pts_pt[1:]:
+        p.lineTo(x, y)
+    p.close()
+    c.drawPath(p, stroke=stroke, fill=fill)
+
+
+def _draw_pdf_page(c, page: Page) -> None:
+    """Draw `page` on the current page of reportlab canvas `c` (page size already set)."""
+    c.setFillColorRGB(*(v / 255 for v in TAB_RGB))
+    for t in page.tabs:
+        _pdf_polygon(c, _pt(page, t), stroke=0, fill=1)
+    c.setFillColorRGB(*(v / 255 for v in PREVIEW_RGB))
+    for tris in page.faces:
+        for tri in _pt(page, tris):
+            _pdf_polygon(c, tri, stroke=0, fill=1)
+
+    for style, _cls, segs in crease_layers(page):
+        if not len(segs):
+            continue
+        _pdf_stroke(c, style)
+        for (x0, y0), (x1, y1) in _pt(page, segs):
+            c.line(x0, y0, x1, y1)
+
+    _pdf_stroke(c, "cut")
+    c.setLineJoin(1)  # round, as in the SVG
+    for poly in page.cut:
+        _pdf_polygon(c, _pt(page, poly), stroke=1, fill=0)
+    for (x0, y0), (x1, y1) in _pt(page, page.slits):
+        c.line(x0, y0, x1, y1)
+
+    c.setFillColorRGB(*(v / 255 for v in TEXT_RGB))
+    for t in page.texts:
+        bx, by = text_baseline(t)
+        c.saveState()
+        c.translate(bx * MM_TO_PT, (page.height - by) * MM_TO_PT)
+        c.rotate(t.angle)  # PDF rotation is CCW with y up: the same visual sense as ours
+        c.setFont("Helvetica", t.size * MM_TO_PT)
+        c.drawCentredString(0, 0, t.text)
+        c.restoreState()
+
+
+def pdf_bytes(pages: Sequence[Page], title: str = "polyfold net") -> bytes:
+    """The PDF document (bytes): one PDF page per Page, each exactly its own mm size."""
+    from reportlab.pdfgen.canvas import Canvas  # lazy: reportlab is slow to import
+
+    if not pages:
+        raise ValueError("write_pdf needs at least one page")
+    buf = _io.BytesIO()
+    # invariant: no timestamp / random file ID, so the same pages give byte-identical files.
+    c = Canvas(buf, pagesize=(pages[0].width * MM_TO_PT, pages[0].height * MM_TO_PT), invariant=1)
+    c.setTitle(title)
+    c.setCreator("polyfold")
+    for page in pages:
+        c.setPageSize((page.width * MM_TO_PT, page.height * MM_TO_PT))
+        _draw_pdf_page(c, page)
+        c.showPage()
+    c.save()
+    return buf.getvalue()
+
+
+def write_pdf(pages: Sequence[Page], path: str | os.PathLike, title: str = "polyfold net") -> None:
+    """Write all `pages` into one PDF at `path` (atomically); `title` goes into the metadata."""
+    atomic_write(path, pdf_bytes(pages, title))

@@ -1,0 +1,138 @@
+"""Tiny software rasteriser: PNG encoding, distinct part colours and a flat-shaded 3D mesh view.
+
+Used for previews (segmentation pictures, net PNGs) without Pillow or matplotlib. In: numpy
+arrays; out: (H, W, 3) uint8 images or PNG bytes.
+"""
+
+from __future__ import annotations
+
+import colorsys
+import math
+import struct
+import zlib
+
+import numpy as np
+from numba import njit
+
+from .files import atomic_write
+
+
+def png_bytes(img: np.ndarray) -> bytes:
+    """(H, W, 3) uint8 RGB image -> PNG file bytes (8-bit truecolour, no filtering)."""
+    h, w = img.shape[:2]
+    raw = np.zeros((h, 1 + 3 * w), dtype=np.uint8)  # filter byte 0 per row
+    raw[:, 1:] = np.ascontiguousarray(img, dtype=np.uint8).reshape(h, 3 * w)
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+
+    ihdr = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
+            + chunk(b"IEND", b""))
+
+
+def part_colors(n: int, saturation: float = 0.65, value: float = 0.92) -> np.ndarray:
+    """(n, 3) uint8 colours with well separated hues (golden-ratio steps), for labelling parts."""
+    out = np.empty((n, 3), dtype=np.uint8)
+    for i in range(n):
+        r, g, b = colorsys.hsv_to_rgb((0.08 + 0.618033988749895 * i) % 1.0, saturation, value)
+        out[i] = (round(r * 255), round(g * 255), round(b * 255))
+    return out
+
+
+@njit(cache=True)
+def _zfill(img, zbuf, tri, depth, colors):
+    """Fill 2D pixel-space triangles with flat colours, nearest depth (smaller z) wins."""
+    H, W = zbuf.shape
+    for t in range(tri.shape[0]):
+        ax, ay = tri[t, 0, 0], tri[t, 0, 1]
+        bx, by = tri[t, 1, 0], tri[t, 1, 1]
+        cx, cy = tri[t, 2, 0], tri[t, 2, 1]
+        area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        if abs(area2) < 1e-12:
+            continue
+        x0 = max(0, int(math.floor(min(ax, bx, cx))))
+        x1 = min(W - 1, int(math.ceil(max(ax, bx, cx))))
+        y0 = max(0, int(math.floor(min(ay, by, cy))))
+        y1 = min(H - 1, int(math.ceil(max(ay, by, cy))))
+        inv = 1.0 / area2
+        for py in range(y0, y1 + 1):
+            yy = py + 0.5
+            for px in range(x0, x1 + 1):
+                xx = px + 0.5
+                w0 = ((bx - xx) * (cy - yy) - (by - yy) * (cx - xx)) * inv
+                w1 = ((cx - xx) * (ay - yy) - (cy - yy) * (ax - xx)) * inv
+                w2 = 1.0 - w0 - w1
+                if w0 < -1e-9 or w1 < -1e-9 or w2 < -1e-9:
+                    continue
+                z = w0 * depth[t, 0] + w1 * depth[t, 1] + w2 * depth[t, 2]
+                if z < zbuf[py, px]:
+                    zbuf[py, px] = z
+                    img[py, px, 0] = colors[t, 0]
+                    img[py, px, 1] = colors[t, 1]
+                    img[py, px, 2] = colors[t, 2]
+
+
+def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> None:
+    """Paint 2D pixel-space triangles (n, 3, 2) with flat colours (n, 3) into img (H, W, 3), in
+    place; where triangles overlap, the first one drawn stays (a net has no overlaps to resolve)."""
+    tris = np.ascontiguousarray(tris, dtype=np.float64)
+    zbuf = np.full(img.shape[:2], np.inf)
+    _zfill(img, zbuf, tris, np.zeros(tris.shape[:2]), np.ascontiguousarray(colors, dtype=np.uint8))
+
+
+def view_rotation(elevation_deg: float, azimuth_deg: float, up_axis: int) -> np.ndarray:
+    """3x3 rotation taking model coordinates to view coordinates (x right, y up, z towards the viewer).
+
+    The model's `up_axis` (0, 1, 2) points up on screen; azimuth turns about it, elevation tilts."""
+    # permute so the up axis becomes y
+    perm = {0: [1, 0, 2], 1: [0, 1, 2], 2: [0, 2, 1]}[int(up_axis)]
+    P = np.eye(3)[perm]
+    if up_axis == 2:
+        P[2] *= -1  # keep the frame right-handed: (x, z, -y)
+    a, e = math.radians(azimuth_deg), math.radians(elevation_deg)
+    Ry = np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
+    Rx = np.array([[1, 0, 0], [0, math.cos(e), -math.sin(e)], [0, math.sin(e), math.cos(e)]])
+    return Rx @ Ry @ P
+
+
+def render_mesh(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray, *, width: int = 800,
+                height: int = 600, elevation_deg: float = 20.0, azimuth_deg: float = -35.0,
+                up_axis: int | None = None, background=(255, 255, 255)) -> np.ndarray:
+    """Orthographic, flat-shaded (two-sided Lambert + ambient) picture of a triangle mesh.
+
+    vertices (n, 3), faces (m, 3), face_colors (m, 3) uint8 -> (height, width, 3) uint8 image.
+    up_axis: model axis drawn vertically (default: the bbox axis of middle extent, which keeps the
+    longest axis horizontal — how most models are best seen)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if up_axis is None:
+        ext = np.ptp(v[np.unique(f)], axis=0) if len(f) else np.ones(3)
+        up_axis = int(np.argsort(ext)[1])
+    R = view_rotation(elevation_deg, azimuth_deg, up_axis)
+    p = (v - v.mean(axis=0)) @ R.T
+    used = p[np.unique(f)] if len(f) else p
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    margin = 0.05
+    s = min(width * (1 - 2 * margin) / max(hi[0] - lo[0], 1e-12), height * (1 - 2 * margin) / max(hi[1] - lo[1], 1e-12))
+    px = np.empty((len(p), 2))
+    px[:, 0] = (p[:, 0] - (lo[0] + hi[0]) / 2) * s + width / 2
+    px[:, 1] = ((lo[1] + hi[1]) / 2 - p[:, 1]) * s + height / 2
+    depth = -p[:, 2]  # smaller = nearer to the viewer
+    tri3 = p[f]
+    n = np.cross(tri3[:, 1] - tri3[:, 0], tri3[:, 2] - tri3[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    light = np.array([-0.35, 0.55, 0.76])
+    light /= np.linalg.norm(light)
+    shade = 0.35 + 0.65 * np.abs(n @ light)
+    cols = np.clip(np.asarray(face_colors, dtype=np.float64) * shade[:, None], 0, 255).astype(np.uint8)
+    img = np.empty((height, width, 3), dtype=np.uint8)
+    img[:] = background
+    zbuf = np.full((height, width), np.inf)
+    _zfill(img, zbuf, np.ascontiguousarray(px[f]), np.ascontiguousarray(depth[f]), cols)
+    return img
+
+
+def write_mesh_png(path, vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray, **kw) -> None:
+    """`render_mesh` written atomically as a PNG file."""
+    atomic_write(path, png_bytes(render_mesh(vertices, faces, face_colors, **kw)))

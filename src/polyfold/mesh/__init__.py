@@ -1,0 +1,9 @@
+"""Load & check, the first stage: the `Mesh` record and everything every other stage computes on it.
+
+    mesh.py       `Mesh` (vertices, CCW faces, source face of each triangle) and its edge `Topology`
+    geometry.py   normals, areas, corner and fold angles (the one sign convention), angle sums, concavity
+    repair.py     checks and repairs of a loaded mesh (`LoadedMesh`), the `info` report
+    kernels.py    numba: the edge table and per-corner / per-edge vectors
+
+Files are read by `formats/meshes.py` (`load_mesh`), which calls `repair.repair`.
+"""

@@ -1,0 +1,106 @@
+"""Geometric quantities of triangle meshes, on plain arrays: normals, areas, corner angles,
+angle sums, signed fold angles, concavity.
+
+Sign convention: faces are CCW seen from outside (outward normals). The signed fold angle `rho`
+of an edge is the angle between the normals of its two faces, positive on convex edges (mountains
+seen from outside), negative on reflex edges, 0 on flat ones.
+
+The floating-point results are bitwise those of the numpy formulas (see `kernels.py`): every stage
+must see the same bits.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from . import kernels as MK
+
+if TYPE_CHECKING:
+    from .mesh import Mesh, Topology
+
+
+HYPERBOLIC_EPS = 1e-9  # hyperbolic vertex: angle sum > 2 pi + HYPERBOLIC_EPS
+FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F" in FOLD, not scored on sheets)
+
+
+def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Unit normals (m, 3) of CCW faces; zero rows for degenerate faces."""
+    return MK.face_normals(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
+
+
+def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    tri = vertices[faces]
+    return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+
+
+def vector_norm(v: np.ndarray) -> float:
+    """np.linalg.norm(v) of a 1-D float64 vector, bit for bit (the sqrt of v.dot(v)), without its
+    general-case overhead (small meshes call it per heuristic and per net)."""
+    return math.sqrt(v.dot(v))
+
+
+def row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row dot products (n,) of a, b (n, 3). Kept in numpy: einsum's SIMD loop sums in an order of
+    its own, and every stage must see the same bits."""
+    return np.einsum("ij,ij->i", a, b)
+
+
+def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Interior angle (m, 3) of each face at each corner (atan2 form, well conditioned)."""
+    a, b, y = MK.corner_vectors(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
+    out = np.empty((y.shape[1], 3))
+    for k in range(3):  # one numpy call per corner, on the same (m,) layout as always
+        out[:, k] = np.arctan2(y[k], row_dots(a[k], b[k]))
+    return out
+
+
+def vertex_angle_sums(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Sum of corner angles at every vertex (n,)."""
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    return MK.scatter_sums(len(vertices), faces.reshape(-1), corner_angles(vertices, faces).reshape(-1))
+
+
+def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) -> np.ndarray:
+    """Signed fold angle rho per edge: atan2((n0 x n1).u, n0.n1), u along the edge as run by face 0.
+
+    Positive on convex edges; 0 on boundary edges.
+    """
+    inner, cross, u, n0, n1 = MK.fold_angle_vectors(np.ascontiguousarray(vertices, dtype=np.float64),
+                                                    np.ascontiguousarray(faces, dtype=np.int64), topo.edges, topo.edge_faces)
+    rho = np.zeros(topo.n_edges)
+    if len(inner):
+        rho[inner] = np.arctan2(row_dots(cross, u), row_dots(n0, n1))
+    return rho
+
+
+def concavity(mesh: Mesh, samples_per_face: int = 3, seed: int = 0) -> float:
+    """Max distance from the surface to its convex hull, relative to the bounding-box diagonal.
+
+    Samples the vertices plus `samples_per_face` random points per face; for a point inside the
+    hull the distance to the hull boundary is min_j (-(n_j . x + d_j)) over hull facet planes.
+    """
+    from scipy.spatial import ConvexHull, QhullError
+
+    tri = mesh.vertices[mesh.faces]
+    rng = np.random.default_rng(seed)
+    r = rng.random((len(tri), samples_per_face, 2))
+    flip = r.sum(axis=2) > 1
+    r[flip] = 1 - r[flip]
+    pts = tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
+    pts = np.concatenate([mesh.vertices[np.unique(mesh.faces)], pts.reshape(-1, 3)])
+    diag = mesh.bbox_diagonal
+    try:
+        hull = ConvexHull(mesh.vertices[np.unique(mesh.faces)])
+    except (QhullError, ValueError):
+        return 0.0  # flat or degenerate point set: no volume, the surface is its own hull
+    eq = hull.equations
+    # Chunked so points x facets stays small on large meshes (~8 MB per chunk).
+    rows = max(1, 1_000_000 // len(eq))
+    dist = 0.0
+    for start in range(0, len(pts), rows):
+        depth = -(pts[start:start + rows] @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, per facet
+        dist = max(dist, float(np.clip(depth.min(axis=1), 0.0, None).max()))
+    return dist / diag if diag > 0 else 0.0

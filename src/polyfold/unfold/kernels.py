@@ -1,0 +1,433 @@
+"""numba kernels of the unfolder: edge weights -> spanning tree (Prim) -> 2D layout -> fitness.
+
+All arrays are plain numpy; nothing here allocates Python objects, so a whole GA generation is
+evaluated in one call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..collide.flat import overlapping_pairs
+
+
+@njit(cache=True)
+def _heap_push(hw, hc, hf, hp, he, size, w, c, f, p, e):
+    i = size
+    hw[i] = w
+    hc[i] = c
+    hf[i] = f
+    hp[i] = p
+    he[i] = e
+    while i > 0:
+        par = (i - 1) >> 1
+        if hw[par] < hw[i] or (hw[par] == hw[i] and hc[par] < hc[i]):
+            break
+        hw[par], hw[i] = hw[i], hw[par]
+        hc[par], hc[i] = hc[i], hc[par]
+        hf[par], hf[i] = hf[i], hf[par]
+        hp[par], hp[i] = hp[i], hp[par]
+        he[par], he[i] = he[i], he[par]
+        i = par
+    return size + 1
+
+
+@njit(cache=True)
+def _heap_pop(hw, hc, hf, hp, he, size):
+    f, p, e = hf[0], hp[0], he[0]
+    size -= 1
+    hw[0], hc[0], hf[0], hp[0], he[0] = hw[size], hc[size], hf[size], hp[size], he[size]
+    i = 0
+    while True:
+        left = 2 * i + 1
+        if left >= size:
+            break
+        m = left
+        right = left + 1
+        if right < size and (hw[right] < hw[left] or (hw[right] == hw[left] and hc[right] < hc[left])):
+            m = right
+        if hw[i] < hw[m] or (hw[i] == hw[m] and hc[i] < hc[m]):
+            break
+        hw[m], hw[i] = hw[i], hw[m]
+        hc[m], hc[i] = hc[i], hc[m]
+        hf[m], hf[i] = hf[i], hf[m]
+        hp[m], hp[i] = hp[i], hp[m]
+        he[m], he[i] = he[i], he[m]
+        i = m
+    return f, p, e, size
+
+
+@njit(cache=True)
+def prim_tree(weights, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order):
+    """Minimum spanning tree of the dual graph from face `base` (Prim, binary heap).
+
+    weights (E,) per mesh edge (low = keep as crease). Fills parent (F,), parent_edge (F,) and
+    order (F,) (parents before children). Returns the number of faces reached.
+    """
+    n = parent.shape[0]
+    cap = adj_face.shape[0] + 1
+    hw = np.empty(cap)
+    hc = np.empty(cap, dtype=np.int64)
+    hf = np.empty(cap, dtype=np.int64)
+    hp = np.empty(cap, dtype=np.int64)
+    he = np.empty(cap, dtype=np.int64)
+    done = np.zeros(n, dtype=np.bool_)
+    size = 0
+    counter = 0
+    parent[base] = -1
+    parent_edge[base] = -1
+    done[base] = True
+    order[0] = base
+    reached = 1
+    for k in range(adj_ptr[base], adj_ptr[base + 1]):
+        size = _heap_push(hw, hc, hf, hp, he, size, weights[adj_edge[k]], counter, adj_face[k], base, adj_edge[k])
+        counter += 1
+    while size > 0 and reached < n:
+        f, p, e, size = _heap_pop(hw, hc, hf, hp, he, size)
+        if done[f]:
+            continue
+        done[f] = True
+        parent[f] = p
+        parent_edge[f] = e
+        order[reached] = f
+        reached += 1
+        for k in range(adj_ptr[f], adj_ptr[f + 1]):
+            g = adj_face[k]
+            if not done[g]:
+                size = _heap_push(hw, hc, hf, hp, he, size, weights[adj_edge[k]], counter, g, f, adj_edge[k])
+                counter += 1
+    return reached
+
+
+@njit(cache=True)
+def layout_tree(order, parent, parent_edge, faces, face_edges, local, out):
+    """Lay out every face of the tree in the plane: out (F, 3, 2).
+
+    local (F, 3, 2) is each triangle in its own frame (CCW). The base face keeps its local frame;
+    each child is rotated and translated so that its crease corners land exactly on the parent's.
+    """
+    n = order.shape[0]
+    base = order[0]
+    for c in range(3):
+        out[base, c, 0] = local[base, c, 0]
+        out[base, c, 1] = local[base, c, 1]
+    for idx in range(1, n):
+        f = order[idx]
+        p = parent[f]
+        e = parent_edge[f]
+        k = 0
+        for m in range(3):
+            if face_edges[f, m] == e:
+                k = m
+        i = k
+        j = (k + 1) % 3
+        vi = faces[f, i]
+        vj = faces[f, j]
+        pi_x = 0.0
+        pi_y = 0.0
+        pj_x = 0.0
+        pj_y = 0.0
+        for m in range(3):
+            if faces[p, m] == vi:
+                pi_x = out[p, m, 0]
+                pi_y = out[p, m, 1]
+            elif faces[p, m] == vj:
+                pj_x = out[p, m, 0]
+                pj_y = out[p, m, 1]
+        # rotation r = (P_j - P_i) / (L_j - L_i) as a unit complex number
+        dlx = local[f, j, 0] - local[f, i, 0]
+        dly = local[f, j, 1] - local[f, i, 1]
+        dwx = pj_x - pi_x
+        dwy = pj_y - pi_y
+        rx = dwx * dlx + dwy * dly
+        ry = dwy * dlx - dwx * dly
+        rn = np.sqrt(rx * rx + ry * ry)
+        rx /= rn
+        ry /= rn
+        for c in range(3):
+            if c == i:
+                out[f, c, 0] = pi_x
+                out[f, c, 1] = pi_y
+            elif c == j:
+                out[f, c, 0] = pj_x
+                out[f, c, 1] = pj_y
+            else:
+                lx = local[f, c, 0] - local[f, i, 0]
+                ly = local[f, c, 1] - local[f, i, 1]
+                out[f, c, 0] = pi_x + rx * lx - ry * ly
+                out[f, c, 1] = pi_y + ry * lx + rx * ly
+
+
+@njit(cache=True)
+def local_overlaps(pairs, face_edges, edges, hyperbolic):
+    """Paper's local overlap count L: overlapping pairs that share a (cut) edge, counted once per
+    hyperbolic endpoint of that edge."""
+    total = 0
+    for r in range(pairs.shape[0]):
+        f = pairs[r, 0]
+        g = pairs[r, 1]
+        for a in range(3):
+            ea = face_edges[f, a]
+            for b in range(3):
+                if face_edges[g, b] == ea:
+                    if hyperbolic[edges[ea, 0]]:
+                        total += 1
+                    if hyperbolic[edges[ea, 1]]:
+                        total += 1
+    return total
+
+
+@njit(cache=True)
+def evaluate_batch(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges, edges, hyperbolic, local, tol, max_pairs):
+    """Decode and score a batch of genomes (B, E): returns global overlaps G (B,) and local L (B,)."""
+    nb = weights.shape[0]
+    nf = faces.shape[0]
+    G = np.zeros(nb, dtype=np.int64)
+    L = np.zeros(nb, dtype=np.int64)
+    parent = np.empty(nf, dtype=np.int64)
+    parent_edge = np.empty(nf, dtype=np.int64)
+    order = np.empty(nf, dtype=np.int64)
+    tris = np.empty((nf, 3, 2))
+    for b in range(nb):
+        prim_tree(weights[b], base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+        layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
+        count, pairs = overlapping_pairs(tris, parent, tol, max_pairs)
+        G[b] = count
+        L[b] = local_overlaps(pairs, face_edges, edges, hyperbolic)
+    return G, L
+
+
+@njit(cache=True)
+def tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order):
+    """BFS over crease edges from `base`: fills parent, parent_edge, order; returns faces reached."""
+    n = parent.shape[0]
+    for f in range(n):
+        parent[f] = -2
+    parent[base] = -1
+    parent_edge[base] = -1
+    order[0] = base
+    head = 0
+    tail = 1
+    while head < tail:
+        f = order[head]
+        head += 1
+        for k in range(adj_ptr[f], adj_ptr[f + 1]):
+            e = adj_edge[k]
+            g = adj_face[k]
+            if crease[e] and parent[g] == -2:
+                parent[g] = f
+                parent_edge[g] = e
+                order[tail] = g
+                tail += 1
+    return tail
+
+
+@njit(cache=True)
+def _score(pairs, count, face_edges, edges, hyperbolic):
+    return count + 100 * local_overlaps(pairs, face_edges, edges, hyperbolic)
+
+
+@njit(cache=True)
+def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, face_edges, edges, hyperbolic,
+                 local, tol, max_pairs, iterations, seed, temperature):
+    """Edge-swap local search on the spanning tree (in place on `crease`, a bool mask per edge).
+
+    A move picks an overlapping pair, a crease on the tree path between the two faces, and a cut
+    edge that reconnects the two halves; it is kept when the score (G + 100 L) does not grow, or
+    with probability exp(-delta / temperature). Returns (best score, iterations done); `crease`
+    holds the best tree seen.
+    """
+    np.random.seed(seed)
+    n = faces.shape[0]
+    n_e = edges.shape[0]
+    parent = np.empty(n, dtype=np.int64)
+    parent_edge = np.empty(n, dtype=np.int64)
+    order = np.empty(n, dtype=np.int64)
+    depth = np.empty(n, dtype=np.int64)
+    in_sub = np.empty(n, dtype=np.bool_)
+    tris = np.empty((n, 3, 2))
+    best_crease = crease.copy()
+    tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+    layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
+    count, pairs = overlapping_pairs(tris, parent, tol, max_pairs)
+    score = _score(pairs, count, face_edges, edges, hyperbolic)
+    best = score
+    it = 0
+    path = np.empty(n, dtype=np.int64)
+    while it < iterations and best > 0:
+        it += 1
+        npairs = pairs.shape[0]
+        if npairs == 0:
+            break
+        r = np.random.randint(npairs)
+        f = pairs[r, 0]
+        g = pairs[r, 1]
+        # tree path between f and g (creases named by their child face)
+        depth[base] = 0
+        for idx in range(1, n):
+            x = order[idx]
+            depth[x] = depth[parent[x]] + 1
+        plen = 0
+        a = f
+        b = g
+        while a != b:
+            if depth[a] >= depth[b]:
+                path[plen] = a
+                a = parent[a]
+            else:
+                path[plen] = b
+                b = parent[b]
+            plen += 1
+        x = path[np.random.randint(plen)]
+        c = parent_edge[x]
+        # faces of the subtree under x
+        for idx in range(n):
+            in_sub[order[idx]] = False
+        in_sub[x] = True
+        for idx in range(n):
+            y = order[idx]
+            if parent[y] >= 0 and in_sub[parent[y]]:
+                in_sub[y] = True
+        # reservoir-sample a reconnecting cut edge
+        pick = -1
+        seen = 0
+        for e in range(n_e):
+            if crease[e] or e == c:
+                continue
+            f0 = edge_faces[e, 0]
+            f1 = edge_faces[e, 1]
+            if f0 < 0 or f1 < 0:
+                continue
+            if in_sub[f0] != in_sub[f1]:
+                seen += 1
+                if np.random.randint(seen) == 0:
+                    pick = e
+        if pick < 0:
+            continue
+        crease[c] = False
+        crease[pick] = True
+        tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+        layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
+        new_count, new_pairs = overlapping_pairs(tris, parent, tol, max_pairs)
+        new_score = _score(new_pairs, new_count, face_edges, edges, hyperbolic)
+        delta = new_score - score
+        if delta <= 0 or (temperature > 0 and np.random.random() < np.exp(-delta / temperature)):
+            score = new_score
+            pairs = new_pairs
+            if score < best:
+                best = score
+                best_crease[:] = crease
+        else:
+            crease[c] = True
+            crease[pick] = False
+            tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+    crease[:] = best_crease
+    return best, it
+
+
+@njit(cache=True)
+def tree_paths(parent, order, pairs):
+    """Tree paths between the faces of each pair, as CSR (ptr, members); a crease is named by its
+    child face. Parents must precede children in `order`."""
+    n = parent.shape[0]
+    depth = np.zeros(n, dtype=np.int64)
+    for idx in range(1, n):
+        f = order[idx]
+        if parent[f] >= 0:
+            depth[f] = depth[parent[f]] + 1
+    ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
+    total = 0
+    for r in range(pairs.shape[0]):
+        a = pairs[r, 0]
+        b = pairs[r, 1]
+        while a != b:
+            if depth[a] >= depth[b]:
+                a = parent[a]
+            else:
+                b = parent[b]
+            total += 1
+        ptr[r + 1] = total
+    members = np.empty(total, dtype=np.int64)
+    k = 0
+    for r in range(pairs.shape[0]):
+        a = pairs[r, 0]
+        b = pairs[r, 1]
+        while a != b:
+            if depth[a] >= depth[b]:
+                members[k] = a
+                a = parent[a]
+            else:
+                members[k] = b
+                b = parent[b]
+            k += 1
+    return ptr, members
+
+
+@njit(cache=True)
+def greedy_cover(ptr, members, n):
+    """Greedy set cover: repeatedly cut the crease on the most uncovered paths. Returns (n,) bool."""
+    n_rows = ptr.shape[0] - 1
+    count = np.zeros(n, dtype=np.int64)
+    for k in range(members.shape[0]):
+        count[members[k]] += 1
+    # crease -> rows (CSR)
+    cptr = np.zeros(n + 1, dtype=np.int64)
+    for k in range(members.shape[0]):
+        cptr[members[k] + 1] += 1
+    for c in range(n):
+        cptr[c + 1] += cptr[c]
+    fill = cptr[:-1].copy()
+    rows_of = np.empty(members.shape[0], dtype=np.int64)
+    for r in range(n_rows):
+        for k in range(ptr[r], ptr[r + 1]):
+            c = members[k]
+            rows_of[fill[c]] = r
+            fill[c] += 1
+    covered = np.zeros(n_rows, dtype=np.bool_)
+    chosen = np.zeros(n, dtype=np.bool_)
+    left = n_rows
+    while left > 0:
+        best = np.argmax(count)
+        if count[best] <= 0:
+            break
+        chosen[best] = True
+        for k in range(cptr[best], cptr[best + 1]):
+            r = rows_of[k]
+            if covered[r]:
+                continue
+            covered[r] = True
+            left -= 1
+            for m in range(ptr[r], ptr[r + 1]):
+                count[members[m]] -= 1
+    return chosen
+
+
+@njit(cache=True)
+def decode_tree(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges, local):
+    """Genome (E,) -> (reached, parent, parent_edge, order, coords (F, 3, 2)): Prim's tree and its
+    layout. coords is only laid out when every face is reached (reached == F)."""
+    n = faces.shape[0]
+    parent = np.empty(n, np.int64)
+    parent_edge = np.empty(n, np.int64)
+    order = np.empty(n, np.int64)
+    coords = np.empty((n, 3, 2))
+    reached = prim_tree(weights, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+    if reached == n:
+        layout_tree(order, parent, parent_edge, faces, face_edges, local, coords)
+    return reached, parent, parent_edge, order, coords
+
+
+@njit(cache=True)
+def piece_labels(order, parent):
+    """Piece (F,) of every face: roots numbered 0, 1, ... in `order` (parents first), every other
+    face in its parent's piece."""
+    piece = np.full(parent.shape[0], -1, dtype=np.int64)
+    count = 0
+    for f in order:
+        if parent[f] < 0:
+            piece[f] = count
+            count += 1
+        else:
+            piece[f] = piece[parent[f]]
+    return piece

@@ -1,0 +1,135 @@
+"""Nets: a spanning forest of a mesh's dual graph laid out in the plane (the unfold stage's
+result), and the operations on them that never move a face: cutting creases, taking one piece
+as a net of its own, finding the crease that splits a piece most evenly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mesh.mesh import Mesh
+from . import kernels as K
+
+
+@dataclass(frozen=True, eq=False)
+class Net:
+    """A net of one mesh component: a spanning forest of its dual graph laid out in the plane.
+
+    parent (F,): parent face in the tree, -1 for the root of each piece; parent_edge (F,): the mesh
+    edge (crease) joining a face to its parent, -1 for roots; order (F,): faces with parents first;
+    coords (F, 3, 2): 2D position of each face's corners (same corner order as mesh.faces, CCW seen
+    from +z, outer side up); piece (F,): piece label (0..pieces-1).
+    """
+
+    mesh: Mesh
+    parent: np.ndarray
+    parent_edge: np.ndarray
+    order: np.ndarray
+    coords: np.ndarray
+    piece: np.ndarray
+
+    @property
+    def n_pieces(self) -> int:
+        return int(self.piece.max()) + 1 if len(self.piece) else 0
+
+    @property
+    def crease_mask(self) -> np.ndarray:
+        """(E,) True for mesh edges that are creases of the net."""
+        mask = np.zeros(self.mesh.topology.n_edges, dtype=bool)
+        pe = self.parent_edge[self.parent_edge >= 0]
+        mask[pe] = True
+        return mask
+
+
+def cut_creases(net: Net, faces: np.ndarray) -> Net:
+    """The net with the creases between `faces` and their parents cut: each such face becomes the
+    root of a new piece. The layout is unchanged, so every new piece is as overlap-free as before."""
+    faces = np.asarray(faces, dtype=np.int64)
+    parent = net.parent.copy()
+    parent_edge = net.parent_edge.copy()
+    parent[faces] = -1
+    parent_edge[faces] = -1
+    piece = K.piece_labels(net.order, parent)
+    return Net(mesh=net.mesh, parent=parent, parent_edge=parent_edge, order=net.order.copy(),
+               coords=net.coords.copy(), piece=piece)
+
+
+def piece_net(net: Net, piece: int) -> tuple[Net, np.ndarray]:
+    """One piece of a net as a single-piece Net of its own faces: (net, face ids in net.mesh).
+
+    The piece's mesh is `net.mesh.submesh(face_ids)`; crease ids are renumbered into its edges."""
+    fids = np.flatnonzero(net.piece == piece)
+    sub = net.mesh.submesh(fids)
+    new_id = np.full(len(net.piece), -1, dtype=np.int64)
+    new_id[fids] = np.arange(len(fids))
+    used = np.unique(net.mesh.faces[fids])
+    old_edges = net.mesh.topology.edges
+    sub_edges = sub.topology.edges
+    # crease (old mesh edge) -> the same vertex pair in the sub-mesh's vertex numbering
+    se = np.sort(sub_edges, axis=1)
+    key = se[:, 0] * (len(used) + 1) + se[:, 1]
+    order = np.argsort(key)
+    parent = new_id[np.where(net.parent[fids] >= 0, net.parent[fids], 0)]
+    parent[net.parent[fids] < 0] = -1
+    parent_edge = np.full(len(fids), -1, dtype=np.int64)
+    has = np.flatnonzero(net.parent_edge[fids] >= 0)
+    if len(has):
+        ends = np.searchsorted(used, old_edges[net.parent_edge[fids[has]]])
+        ends.sort(axis=1)
+        k = ends[:, 0] * (len(used) + 1) + ends[:, 1]
+        parent_edge[has] = order[np.searchsorted(key, k, sorter=order)]
+    net_order = new_id[net.order[np.isin(net.order, fids)]]
+    out = Net(mesh=sub, parent=parent, parent_edge=parent_edge, order=net_order, coords=net.coords[fids].copy(),
+              piece=np.zeros(len(fids), dtype=np.int64))
+    return out, fids
+
+
+def _dfs_intervals(parent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Euler-tour (tin, tout) per face of a forest: g is in the subtree of f iff
+    tin[f] <= tin[g] < tout[f]."""
+    n = len(parent)
+    children: list[list[int]] = [[] for _ in range(n)]
+    for f, p in enumerate(parent.tolist()):
+        if p >= 0:
+            children[p].append(f)
+    tin = np.zeros(n, dtype=np.int64)
+    tout = np.zeros(n, dtype=np.int64)
+    t = 0
+    for root in np.flatnonzero(parent < 0).tolist():
+        stack = [(root, 0)]
+        while stack:
+            f, i = stack.pop()
+            if i == 0:
+                tin[f] = t
+                t += 1
+            if i < len(children[f]):
+                stack.append((f, i + 1))
+                stack.append((children[f][i], 0))
+            else:
+                tout[f] = t
+    return tin, tout
+
+
+def subtree_areas(net: Net) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sub_area, tin, tout) per face: the flat area of the face's subtree in the net (net units^2)
+    and its Euler-tour interval (see `_dfs_intervals`)."""
+    xy = net.coords
+    e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+    sub_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    tin, tout = _dfs_intervals(net.parent)
+    for f in np.argsort(tin)[::-1]:  # children come after their parent in tin order
+        if net.parent[f] >= 0:
+            sub_area[net.parent[f]] += sub_area[f]
+    return sub_area, tin, tout
+
+
+def balanced_cut(net: Net, piece: int) -> int:
+    """The face of `piece` (two faces or more) whose crease to its parent splits the piece's area
+    most evenly."""
+    faces = np.flatnonzero(net.piece == piece)
+    cand = faces[net.parent[faces] >= 0]
+    sub_area, _, _ = subtree_areas(net)
+    root = faces[net.parent[faces] < 0][0]
+    return int(cand[np.argmin(np.abs(sub_area[cand] - sub_area[root] / 2))])

@@ -1,0 +1,173 @@
+"""The unfolding problem of one mesh component: the arrays the kernels need (`UnfoldProblem`),
+and the heuristic edge weights that seed the search (ALGORITHMS.md 5.3).
+
+Genome (ALGORITHMS.md 5.1, 5.5): one weight in [0, 1] per mesh edge; Prim's algorithm from the
+base face keeps light edges as creases. Low weight = keep as crease.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..collide.flat import overlapping_pairs
+from ..mesh.geometry import row_dots, vector_norm
+from ..mesh.mesh import Mesh
+from . import kernels as K
+from . import setup_kernels as S
+
+
+@dataclass(frozen=True, eq=False)
+class UnfoldProblem:
+    """Arrays the kernels need, derived once per mesh component.
+
+    adj_ptr / adj_face / adj_edge: the dual graph (CSR); local (F, 3, 2): `local_frames`;
+    hyperbolic (n,): the mesh's hyperbolic vertices; tol: overlap tolerance (1e-9 of the bbox
+    diagonal); interior_edges (I,); edge_vec (E, 3) / edge_len (E,): each edge as a vector
+    edges[e, 0] -> edges[e, 1] and its length (for the heuristic weight rules).
+    """
+
+    mesh: Mesh
+    adj_ptr: np.ndarray
+    adj_face: np.ndarray
+    adj_edge: np.ndarray
+    local: np.ndarray
+    hyperbolic: np.ndarray
+    tol: float
+    base: int = 0
+    interior_edges: np.ndarray = field(default=None)  # type: ignore[assignment]
+    edge_vec: np.ndarray = field(default=None)  # type: ignore[assignment]
+    edge_len: np.ndarray = field(default=None)  # type: ignore[assignment]
+    hyperbolic_candidates: int = 0  # interior half-edges at hyperbolic vertices
+
+    @classmethod
+    def from_mesh(cls, mesh: Mesh, base: int = 0) -> "UnfoldProblem":
+        topo = mesh.topology
+        # one numba pass for everything but the numpy-rounded dot products (see _unfold_setup)
+        hyperbolic = mesh.hyperbolic
+        inner, adj_ptr, adj_face, adj_edge, e1, e2, local, edge_vec, edge_len, box, candidates = S.problem_arrays(
+            mesh.vertices, mesh.faces, topo.edges, topo.edge_faces, hyperbolic)
+        local[:, 2, 0] = row_dots(e2, e1) / local[:, 1, 0]
+        diagonal = vector_norm(box) if mesh.n_vertices else mesh.bbox_diagonal
+        return cls(
+            mesh=mesh,
+            adj_ptr=adj_ptr,
+            adj_face=adj_face,
+            adj_edge=adj_edge,
+            local=local,
+            hyperbolic=hyperbolic,
+            tol=1e-9 * max(diagonal, 1e-300),
+            base=base,
+            interior_edges=inner,
+            edge_vec=edge_vec,
+            edge_len=edge_len,
+            hyperbolic_candidates=candidates,
+        )
+
+    def evaluate(self, weights: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Overlap counts (G, L) of a batch of genomes (B, E)."""
+        mesh = self.mesh
+        cap = 4 * mesh.n_faces if max_pairs is None else max_pairs
+        return K.evaluate_batch(
+            np.ascontiguousarray(weights, dtype=np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            mesh.faces, mesh.topology.face_edges, mesh.topology.edges, self.hyperbolic, self.local, self.tol, cap,
+        )
+
+    def decode(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Genome -> (parent, parent_edge, order, coords) of the spanning tree."""
+        n = self.mesh.n_faces
+        reached, parent, parent_edge, order, coords = K.decode_tree(
+            np.ascontiguousarray(weights, np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            self.mesh.faces, self.mesh.topology.face_edges, self.local)
+        if reached != n:
+            raise ValueError(f"dual graph is not connected ({reached} of {n} faces reached)")
+        return parent, parent_edge, order, coords
+
+    def overlaps(self, coords: np.ndarray, parent: np.ndarray) -> np.ndarray:
+        """All overlapping face pairs (k, 2) of a layout (crease pairs skipped)."""
+        count, pairs = overlapping_pairs(coords, parent, self.tol, 0)
+        if count:  # a second sweep to collect them (the first one counts)
+            _, pairs = overlapping_pairs(coords, parent, self.tol, int(count))
+        return pairs
+
+
+def local_frames(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Each triangle in its own 2D frame (F, 3, 2): corner 0 at the origin, corner 1 on +x, CCW."""
+    e1, e2, out = S.frame_parts(np.ascontiguousarray(vertices, np.float64), np.ascontiguousarray(faces, np.int64))
+    out[:, 2, 0] = row_dots(e2, e1) / out[:, 1, 0]
+    return out
+
+
+def _random_direction(rng: np.random.Generator) -> np.ndarray:
+    c = rng.normal(size=3)
+    return c / vector_norm(c)
+
+
+def flat_tree_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    """Edges orthogonal to a random direction are kept, edges along it are cut."""
+    return np.abs(problem.edge_vec @ _random_direction(rng)) / problem.edge_len
+
+
+def unflat_tree_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    w = flat_tree_weights(problem, rng)
+    return np.where(w > 0, 1.0 - w, w)
+
+
+def min_perimeter_weights(problem: UnfoldProblem, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Long edges kept: short total cut length."""
+    length = problem.edge_len
+    span = max(length.max() - length.min(), 1e-300)
+    return 1.0 - (length - length.min()) / span
+
+
+def max_perimeter_weights(problem: UnfoldProblem, rng: np.random.Generator | None = None) -> np.ndarray:
+    length = problem.edge_len
+    span = max(length.max() - length.min(), 1e-300)
+    return (length - length.min()) / span
+
+
+def _steepest(problem: UnfoldProblem, rng: np.random.Generator, un: bool) -> np.ndarray:
+    """Every vertex but the top one cuts its steepest upward edge (un=True: the least steep)."""
+    c = _random_direction(rng)
+    mesh = problem.mesh
+    slope = (problem.edge_vec @ c) / problem.edge_len  # from e0 toward e1
+    top = int(np.argmax(mesh.vertices @ c))
+    return S.steepest_cuts(slope, mesh.topology.edges, mesh.n_vertices, top, un)
+
+
+def steepest_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(problem, rng, un=False)
+
+
+def unsteepest_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return _steepest(problem, rng, un=True)
+
+
+def random_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    return rng.random(problem.mesh.topology.n_edges) + 0.01
+
+
+def random_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
+    """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none."""
+    edges = problem.mesh.topology.edges
+    inner = problem.interior_edges
+    w = np.full(len(edges), 0.01)
+    # one random draw per candidate half-edge (an interior edge at a wanted vertex)
+    want, n = S.pick_random_incident(inner, edges, problem.hyperbolic, 2, rng.random(problem.hyperbolic_candidates), w,
+                                     problem.hyperbolic)
+    S.pick_random_incident(inner, edges, want, 1, rng.random(n), w, problem.hyperbolic)
+    return w
+
+
+HEURISTICS: dict[str, Callable[[UnfoldProblem, np.random.Generator], np.ndarray]] = {
+    "steepest-edge": steepest_edge_weights,
+    "unsteepest-edge": unsteepest_edge_weights,
+    "flat-tree": flat_tree_weights,
+    "unflat-tree": unflat_tree_weights,
+    "min-perimeter": min_perimeter_weights,
+    "max-perimeter": max_perimeter_weights,
+    "random": random_weights,
+    "random-edge": random_edge_weights,
+}

@@ -1,0 +1,399 @@
+"""Edge unfolding: spanning trees of the dual graph from heuristics and a genetic algorithm.
+
+In: a manifold, consistently oriented `Mesh` (one edge-connected component, closed or open).
+Out: a `Net` — a spanning forest of the dual graph with its planar layout, one tree per piece,
+overlap-free (checked with the exact test of `overlap.py`).
+
+Genome (ALGORITHMS.md 5.1, 5.5): one weight in [0, 1] per mesh edge; Prim's algorithm from the base
+face keeps light edges as creases. Fitness = -(G + 100 L), G = overlapping face pairs, L = overlaps
+at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time or
+generation budget runs out, the best tree is split into the fewest overlap-free pieces found by a
+set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..errors import NoNetFound
+from ..mesh.mesh import Mesh
+from . import kernels as K
+from .net import Net
+from .problem import HEURISTICS, UnfoldProblem
+
+
+METHODS = ("auto", "ga", "steepest-edge", "flat-tree", "unflat-tree", "min-perimeter", "max-perimeter", "random")
+
+
+@dataclass(frozen=True)
+class UnfoldStats:
+    seconds: float
+    generations: int
+    evaluations: int
+    method: str
+    pieces: int
+    timed_out: bool
+    best_overlaps: int = 0
+    accepted: bool | None = None  # passed the caller's `accept` test (None: no test asked)
+
+
+FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
+
+
+# The GA's initial population draws from these creators (ALGORITHMS.md 5.5).
+GA_CREATORS = ("steepest-edge", "flat-tree", "unflat-tree", "random-edge")
+
+
+@dataclass
+class _Budget:
+    deadline: float
+    max_generations: int
+
+    def exhausted(self, generation: int) -> bool:
+        return generation >= self.max_generations or time.perf_counter() >= self.deadline
+
+
+def _fitness(G: np.ndarray, L: np.ndarray) -> np.ndarray:
+    return -(G + 100 * L).astype(np.float64)
+
+
+def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _Budget, population: int,
+                     finished: Callable[[np.ndarray], bool]) -> tuple[np.ndarray, np.ndarray, list[str], int, int]:
+    """The GA's initial population: each individual from a creator drawn from GA_CREATORS.
+
+    Evaluated in small batches so a valid heuristic net (one `finished` accepts) stops the search
+    at once; valid but unaccepted ones get fitness -0.5 (good parents, not answers). Returns
+    (pop, fit, origin, evaluations, index of the accepted individual or -1); pop is cut short
+    when the budget runs out.
+    """
+    mesh = problem.mesh
+    pop = np.empty((population, mesh.topology.n_edges))
+    creators = rng.integers(0, len(GA_CREATORS), size=population)
+    origin = [GA_CREATORS[c] for c in creators]
+    fit = np.full(population, -np.inf)
+    evaluations = filled = 0
+    start, size = 0, 2
+    while start < population:
+        # batches of 2, 4, 8, 16, then 25: small meshes are often done by the first heuristic
+        stop = min(start + size, population)
+        size = min(2 * size, 25)
+        for i in range(start, stop):
+            pop[i] = HEURISTICS[origin[i]](problem, rng)
+        G, L = problem.evaluate(pop[start:stop])
+        fit[start:stop] = _fitness(G, L)
+        evaluations += stop - start
+        filled = stop
+        for i in start + np.flatnonzero(fit[start:stop] == 0):
+            if finished(pop[i]):
+                return pop, fit, origin, evaluations, int(i)
+            fit[i] = -0.5
+        start = stop
+        if time.perf_counter() >= budget.deadline:
+            break
+    return pop[:filled], fit[:filled], origin[:filled], evaluations, -1
+
+
+def run_ga(
+    problem: UnfoldProblem,
+    rng: np.random.Generator,
+    budget: _Budget,
+    population: int = 400,
+    children: int = 50,
+    tournament: int = 7,
+    p_cross: float = 0.4,
+    p_mut: float = 0.01,
+    sigma: float = 0.3,
+    progress: Callable[[int, float], None] | None = None,
+) -> tuple[np.ndarray, float, int, int, str]:
+    """Genetic algorithm of ALGORITHMS.md 5.5, seeded with the heuristics.
+
+    Returns (best genome, best fitness, generations, evaluations, creator of the best). Stops at
+    the first valid net (fitness 0) or when the budget runs out.
+    """
+    mesh = problem.mesh
+    n_e = mesh.topology.n_edges
+    pop, fit, origin_list, evaluations, hit = _seed_population(problem, rng, budget, population, lambda g: True)
+    if hit >= 0:
+        return pop[hit].copy(), 0.0, 0, evaluations, origin_list[hit]
+    population = len(pop)
+    origin = np.array(origin_list, dtype=object)
+    best = float(fit.max())
+    stall = 0
+    generation = 0
+    while not budget.exhausted(generation):
+        generation += 1
+        pm = p_mut if stall <= 100 else min(1.0, p_mut * 1.25 ** (stall / 100))
+        pc = p_cross if stall <= 100 else min(1.0, p_cross * 1.1 ** (stall / 100))
+        # tournament selection, two parents per child
+        draws = rng.integers(0, population, size=(children, 2, tournament))
+        winners = np.take_along_axis(draws, np.argmax(fit[draws], axis=2)[..., None], axis=2)[..., 0]
+        a = pop[winners[:, 0]]
+        b = pop[winners[:, 1]]
+        swap = rng.random((children, n_e)) < pc
+        kids = np.where(swap, b, a)
+        mutate = rng.random((children, n_e)) < pm
+        if mutate.any():
+            idx = np.nonzero(mutate)
+            vals = kids[idx] + rng.normal(0.0, sigma, size=len(idx[0]))
+            bad = (vals < 0) | (vals > 1)
+            while bad.any():  # redraw until inside [0, 1]
+                vals[bad] = kids[idx][bad] + rng.normal(0.0, sigma, size=int(bad.sum()))
+                bad = (vals < 0) | (vals > 1)
+            kids[idx] = vals
+        G, L = problem.evaluate(kids)
+        evaluations += children
+        kid_fit = _fitness(G, L)
+        worst = np.argsort(fit)[:children]
+        pop[worst] = kids
+        fit[worst] = kid_fit
+        origin[worst] = "ga"
+        top = float(kid_fit.max())
+        if top > best:
+            best = top
+            stall = 0
+        else:
+            stall += 1
+        if progress is not None and generation % 20 == 0:
+            progress(generation, best)
+        if best == 0:
+            break
+    i = int(np.argmax(fit))
+    return pop[i].copy(), float(fit[i]), generation, evaluations, str(origin[i])
+
+
+def _genome_of_tree(crease: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Weights that make Prim's algorithm rebuild exactly this tree (creases light, cuts heavy)."""
+    return np.where(crease, 0.0, 0.5) + 0.5 * rng.random(len(crease)) * np.where(crease, 0.0, 1.0)
+
+
+def run_memetic(
+    problem: UnfoldProblem,
+    rng: np.random.Generator,
+    budget: _Budget,
+    population: int = 400,
+    tournament: int = 7,
+    p_cross: float = 0.4,
+    temperature: float = 0.5,
+    progress: Callable[[int, float], None] | None = None,
+    accept: Callable[[np.ndarray], bool] | None = None,
+) -> tuple[np.ndarray, float, int, int, str]:
+    """GA of ALGORITHMS.md 5.5 with a Lamarckian tree local search ("auto").
+
+    Same heuristic-seeded population, tournament selection and uniform crossover as `run_ga`; each
+    generation breeds one child, improves it with edge-swap local search (a crease on the tree path
+    between two overlapping faces is swapped for a cut edge that reconnects the halves), and writes
+    the improved tree back into the population in place of the worst individual. Returns the same
+    tuple as `run_ga`.
+
+    accept: optional extra test of a valid (overlap-free) genome; the search goes on, within the
+    budget, until a valid genome passes it, and falls back to the first valid one otherwise.
+    """
+    fallback: list[np.ndarray] = []
+
+    def finished(genome: np.ndarray) -> bool:
+        if accept is None or accept(genome):
+            return True
+        if not fallback:
+            fallback.append(genome.copy())
+        return False
+
+    mesh = problem.mesh
+    topo = mesh.topology
+    n_e = topo.n_edges
+    # The first batch of the population only, then one local search from its best: most nets
+    # are finished by that search, and building the whole population (hundreds of heuristic
+    # trees) first would cost ten times more. The rest of the population is built only if not.
+    first = min(FIRST_BATCH, population)
+    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, budget, first, finished)
+    if hit >= 0:
+        return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
+    # Local-search effort per generation: enough to finish most nets, small enough to restart
+    # from a fresh child when the search is stuck in a local minimum.
+    chunk_iters = max(1000, 4 * mesh.n_faces)
+    step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
+    cap = 4 * mesh.n_faces
+    crease = np.zeros(n_e, dtype=np.bool_)
+
+    def improve(child: np.ndarray) -> tuple[np.ndarray, int, int]:
+        """Local search from a child genome: (improved genome, overlap score, iterations)."""
+        parent, parent_edge, _, _ = problem.decode(child)
+        crease[:] = False
+        crease[parent_edge[parent_edge >= 0]] = True
+        done_iters, score = 0, 0
+        while done_iters < chunk_iters:
+            score, it = K.local_search(
+                crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
+                mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, cap,
+                step, int(rng.integers(2**31)), temperature,
+            )
+            done_iters += max(it, 1)
+            if score == 0 or time.perf_counter() >= budget.deadline:
+                break
+        return _genome_of_tree(crease, rng), int(score), done_iters
+
+    generation = 0
+    while not budget.exhausted(generation):
+        generation += 1
+        if generation == 1:
+            child = pop[int(np.argmax(fit))].copy()
+        else:
+            if generation == 2 and len(pop) < population:
+                more, more_fit, more_origin, more_ev, hit = _seed_population(
+                    problem, rng, budget, population - len(pop), finished)
+                evaluations += more_ev
+                if hit >= 0:
+                    return more[hit].copy(), 0.0, generation, evaluations, more_origin[hit]
+                pop, fit = np.concatenate([pop, more]), np.concatenate([fit, more_fit])
+            n_pop = len(pop)
+            draws = rng.integers(0, n_pop, size=(2, tournament))
+            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
+            swap = rng.random(n_e) < p_cross
+            child = np.where(swap, pop[winners[1]], pop[winners[0]])
+        genome, score, done_iters = improve(child)
+        evaluations += done_iters
+        worst = int(np.argmin(fit))
+        pop[worst] = genome
+        fit[worst] = -float(score)
+        if progress is not None:
+            progress(generation, float(fit.max()))
+        if score == 0:
+            if finished(genome):
+                return genome, 0.0, generation, evaluations, "ga+local-search"
+            fit[worst] = -0.5
+    if fallback:
+        return fallback[0], 0.0, generation, evaluations, "ga+local-search"
+    i = int(np.argmax(fit))
+    return pop[i].copy(), float(fit[i]), generation, evaluations, "ga+local-search"
+
+
+def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator, budget: _Budget) -> tuple[np.ndarray, float, int]:
+    """Plain heuristic mode: fresh random direction per try, keep the best (fewest overlaps)."""
+    best_w, best_fit, tries = None, -np.inf, 0
+    make = HEURISTICS[name]
+    while tries < 100 and (tries == 0 or time.perf_counter() < budget.deadline):
+        w = make(problem, rng)[None, :]
+        G, L = problem.evaluate(w)
+        tries += 1
+        f = float(_fitness(G, L)[0])
+        if f > best_fit:
+            best_w, best_fit = w[0], f
+        if f == 0 or name in ("min-perimeter", "max-perimeter"):  # deterministic rules: one try
+            break
+    return best_w, best_fit, tries
+
+
+def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray,
+                      exact_limit: int = 2000, exact_seconds: float = 5.0) -> np.ndarray:
+    """Cut the fewest creases so no overlapping pair stays in one piece (ALGORITHMS.md 5.6).
+
+    Greedy set cover of the tree paths between overlapping faces (crease on most uncovered paths
+    first, numba), refined by an exact ILP when the instance is small (at most `exact_limit`
+    candidate creases). Returns a boolean mask (F,) of faces whose crease to their parent is cut.
+    """
+    n = len(parent)
+    cut = np.zeros(n, dtype=bool)
+    if len(pairs) == 0:
+        return cut
+    ptr, members = K.tree_paths(parent, order, np.ascontiguousarray(pairs, dtype=np.int64))
+    greedy = K.greedy_cover(ptr, members, n)
+    chosen = np.flatnonzero(greedy)
+    candidates = np.unique(members)
+    if len(chosen) > 1 and len(candidates) <= exact_limit:
+        try:
+            from scipy.optimize import Bounds, LinearConstraint, milp
+            from scipy.sparse import csr_matrix
+
+            col = np.searchsorted(candidates, members)
+            rows = np.repeat(np.arange(len(ptr) - 1), np.diff(ptr))
+            A = csr_matrix((np.ones(len(members)), (rows, col)), shape=(len(ptr) - 1, len(candidates)))
+            A.data[:] = 1.0  # a crease listed twice on one path still counts once
+            res = milp(np.ones(len(candidates)), constraints=LinearConstraint(A, lb=1, ub=np.inf),
+                       integrality=np.ones(len(candidates)), bounds=Bounds(0, 1),
+                       options={"time_limit": exact_seconds})
+            if res.x is not None and res.success:
+                exact = candidates[res.x > 0.5]
+                if len(exact) < len(chosen):
+                    chosen = exact
+        except Exception:  # the ILP is only a refinement of the greedy cover
+            pass
+    cut[chosen] = True
+    return cut
+
+
+def _net_from_tree(problem: UnfoldProblem, parent, parent_edge, order, coords, cut: np.ndarray | None = None) -> Net:
+    parent = parent.copy()
+    parent_edge = parent_edge.copy()
+    if cut is not None and cut.any():
+        parent[cut] = -1
+        parent_edge[cut] = -1
+        piece = K.piece_labels(order, parent)
+    else:  # one spanning tree: one piece
+        piece = np.zeros(len(parent), dtype=np.int64)
+    return Net(mesh=problem.mesh, parent=parent, parent_edge=parent_edge, order=order.copy(), coords=coords, piece=piece)
+
+
+def unfold(
+    mesh: Mesh,
+    method: str = "auto",
+    seed: int = 0,
+    time_limit: float = 60.0,
+    max_pieces: int | None = None,
+    max_generations: int = 15000,
+    progress: Callable[[int, float], None] | None = None,
+    accept: Callable[[Net], bool] | None = None,
+) -> tuple[Net, UnfoldStats]:
+    """Unfold one edge-connected component into a net (one piece when one is found in time).
+
+    method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
+    raises `NoNetFound` instead of falling back to several pieces. Deterministic for a given seed
+    (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
+    within the time limit, for a valid net that also passes this test (e.g. linear foldability);
+    `UnfoldStats.accepted` says whether one did.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    budget = _Budget(deadline=t0 + time_limit, max_generations=max_generations)
+    problem = UnfoldProblem.from_mesh(mesh)
+    if mesh.n_faces == 1:
+        weights = np.zeros(mesh.topology.n_edges)
+        fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
+    elif method == "auto":
+        accept_genome = None
+        if accept is not None:
+            def accept_genome(genome: np.ndarray) -> bool:
+                return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
+        # Large meshes: a smaller seed population, so the local search gets the time budget.
+        population = min(max(200_000 // mesh.n_faces, 50), 400)
+        weights, fitness, generations, evaluations, winner = run_memetic(
+            problem, rng, budget, population=population, progress=progress, accept=accept_genome)
+    elif method == "ga":
+        weights, fitness, generations, evaluations, winner = run_ga(problem, rng, budget, progress=progress)
+    else:
+        weights, fitness, evaluations = run_heuristic(problem, method, rng, budget)
+        generations, winner = 0, method
+    parent, parent_edge, order, coords = problem.decode(weights)
+    pairs = problem.overlaps(coords, parent)
+    timed_out = len(pairs) > 0
+    cut = None
+    if len(pairs):
+        if max_pieces == 1:
+            raise NoNetFound(
+                f"no single-piece net found in {time.perf_counter() - t0:.1f} s "
+                f"({generations} generations, best net has {len(pairs)} overlapping face pairs)"
+            )
+        cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5))
+    net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
+    accepted = None
+    if accept is not None:
+        accepted = net.n_pieces == 1 and bool(accept(net))
+    stats = UnfoldStats(
+        seconds=time.perf_counter() - t0, generations=generations, evaluations=evaluations, method=winner,
+        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs), accepted=accepted,
+    )
+    return net, stats
