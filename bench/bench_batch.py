@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 from polyfold.apps.batch import run_batch
-from polyfold.pipeline.make import MakeOptions
+from polyfold.pipeline.options import MakeOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

@@ -33,9 +33,8 @@ import numpy as np
 
 from polyfold.errors import PolyfoldError
 from polyfold.fold.plan import is_linearly_foldable, plan_fold
-from polyfold.formats.fold import net_to_fold
 from polyfold.formats.meshes import load_mesh
-from polyfold.fold.tree import collides, fold_tree
+from polyfold.fold.tree import FoldTree, collides
 from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -55,14 +54,14 @@ def cases() -> list[tuple[str, str, Path]]:
 def run(path: Path, seed: int, time_limit: float, prefer_linear: bool, contact_tol: float = 1e-7) -> dict:
     (mesh,) = load_mesh(path).components
     def accept(net) -> bool:
-        tree = fold_tree(net_to_fold([net]), contact_tol)
+        tree = FoldTree.from_net(net, contact_tol)
         return collides(tree, tree.goal) or is_linearly_foldable(tree)  # hopeless shapes: stop looking
 
     accept = accept if prefer_linear else None
     t0 = time.perf_counter()
     net, st = unfold(mesh, seed=seed, time_limit=time_limit, accept=accept)
     t1 = time.perf_counter()
-    tree = fold_tree(net_to_fold([net]), contact_tol)
+    tree = FoldTree.from_net(net, contact_tol)
     row = {"dof": len(tree.creases), "pieces": net.n_pieces, "net_s": t1 - t0}
     if collides(tree, tree.goal):
         row.update(path_s=float("nan"), frames=0, lc=None, note="goal shape itself self-intersects (input data)")
@@ -146,7 +145,7 @@ def collision_table() -> None:
     print(f"{'net':<22} {'faces':>5} {'line us':>8} {'057cf99':>8} {'path us':>8} {'057cf99':>8}  path planner")
     for label, mesh in nets:
         net, _ = unfold(mesh, seed=1, time_limit=20)
-        tree = fold_tree(net_to_fold([net]))
+        tree = FoldTree.from_net(net)
         us_path, planner = None, "-"
         if not collides(tree, tree.goal):
             path = plan_fold(tree, seed=1)

@@ -15,7 +15,8 @@ import time
 from pathlib import Path
 
 from polyfold.errors import PolyfoldError
-from polyfold.pipeline.make import make, MakeOptions
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))

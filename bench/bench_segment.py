@@ -28,9 +28,8 @@ from scipy.spatial import cKDTree
 from polyfold.segment import segment as S
 from polyfold.errors import PolyfoldError
 from polyfold.fold.plan import plan_fold
-from polyfold.formats.fold import net_to_fold
 from polyfold.formats.meshes import load_mesh
-from polyfold.fold.tree import collides, fold_tree
+from polyfold.fold.tree import FoldTree, collides
 from polyfold.mesh.mesh import Mesh
 from polyfold.formats.raster import part_colors, write_mesh_png
 from polyfold.unfold.search import unfold
@@ -58,7 +57,7 @@ def net_and_path(mesh: Mesh, seed: int, time_limit: float, contact_tol: float) -
     t0 = time.perf_counter()
     net, _ = unfold(mesh, seed=seed, time_limit=time_limit)
     t1 = time.perf_counter()
-    tree = fold_tree(net_to_fold([net]), contact_tol)
+    tree = FoldTree.from_net(net, contact_tol)
     out = {"pieces": net.n_pieces, "net_s": t1 - t0, "dof": len(tree.creases), "path": False, "path_s": float("nan")}
     if net.n_pieces > 1 or collides(tree, tree.goal):
         return out

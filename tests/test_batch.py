@@ -22,7 +22,8 @@ from test_cli import one_line, run_cli
 
 from polyfold.apps.batch import BatchRow, expand, FAULT_ENV, out_names, run_batch, run_study
 from polyfold.errors import PolyfoldError
-from polyfold.pipeline.make import make, MakeOptions
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions
 
 GOOD = ("cube-12", "icosahedron-20", "octahedron-8")
 FAULTS = "crash:crash-me.obj,segv:segv-me.obj,hang:hang-me.obj"

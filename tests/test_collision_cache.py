@@ -9,7 +9,8 @@ from polyfold.formats.fold import net_to_fold
 from polyfold.formats.meshes import load_mesh
 from polyfold.collide.triangles import triangles_collide
 from polyfold.fold.checker import collision_work, config_collides, config_collides_cached, config_collides_moving
-from polyfold.fold.tree import fold_positions, fold_tree
+from polyfold.fold.tree import fold_positions
+from polyfold.formats.fold import fold_tree
 from polyfold.unfold.search import unfold
 
 

@@ -22,7 +22,8 @@ from polyfold.fold.plan import is_linearly_foldable, plan_fold
 from polyfold.formats.fold import with_path
 from polyfold.formats.fold import dumps, net_to_fold
 from polyfold.formats.meshes import load_mesh
-from polyfold.fold.tree import fold_positions, fold_tree
+from polyfold.fold.tree import fold_positions
+from polyfold.formats.fold import fold_tree
 from polyfold.unfold.search import unfold
 
 CLI = [sys.executable, "-m", "polyfold"]

@@ -15,7 +15,8 @@ from polyfold.collide.sweep import first_collision
 from polyfold.collide.triangles import triangles_collide
 from polyfold.fold.checker import config_collides
 from polyfold.fold.kinematics import forward_kinematics
-from polyfold.fold.tree import collides, colliding_pairs, fold_positions, fold_tree
+from polyfold.fold.tree import collides, colliding_pairs, fold_positions
+from polyfold.formats.fold import fold_tree
 from polyfold.unfold.net import Net
 from polyfold.unfold.problem import UnfoldProblem
 from polyfold.unfold.search import unfold

@@ -23,7 +23,8 @@ from fold_checker import check_fold, read_mesh
 from path_checker import check_path
 from test_cli import one_line, run_cli
 
-from polyfold.pipeline.make import make, MakeOptions, paper_size
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions, paper_size
 
 NS = {"svg": "http://www.w3.org/2000/svg"}
 AREA_EPS = 1e-3  # mm^2; the SVG stores coordinates to 1e-4 mm, so touching shapes may show slivers
@@ -110,7 +111,7 @@ def run_make(tmp_path: Path, mesh: Path, **kw) -> tuple[Path, dict]:
     out = tmp_path / mesh.stem
     opts = MakeOptions(**{"time_limit": 20.0, **kw})
     result = make(mesh, out, opts)
-    return out, result.report
+    return out, result.report.to_dict()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -23,8 +23,10 @@ import pytest
 from test_cli import CLI, one_line, run_cli
 
 from polyfold.errors import PolyfoldError
-from polyfold.pipeline.make import make, MakeOptions
-from polyfold.apps.view import check_host, load_folder, make_folder, path_degrees, pose_piece, serve
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions
+from polyfold.apps.view import check_host, serve
+from polyfold.pipeline.folder import load_folder, make_folder, path_degrees, pose_piece
 
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
@@ -62,7 +64,7 @@ def test_load_folder(make_dir: Path, models_dir: Path) -> None:
     # the parts welded back are the input mesh again (same faces, same saddles)
     assert folder.whole.n_faces == original.n_faces and folder.whole.n_vertices == original.n_vertices
     assert int(folder.whole.hyperbolic.sum()) == int(original.hyperbolic.sum())
-    assert folder.options["parts"] == 3
+    assert folder.options.parts == 3
 
 
 def test_pose_follows_the_path(make_dir: Path) -> None:
@@ -325,7 +327,7 @@ def test_viewer_in_browser(make_dir: Path) -> None:
                 page.get_by_text(re.compile(r"make \(inflated mesh\) done")).wait_for(timeout=10000)
                 assert (make_dir / "again" / "assembly.json").is_file()
                 assert viewer.folder.path == (make_dir / "again").resolve()
-                assert viewer.folder.options["parts"] == 3 and len(viewer.folder.parts) >= 2
+                assert viewer.folder.options.parts == 3 and len(viewer.folder.parts) >= 2
                 page.wait_for_timeout(500)
             finally:
                 browser.close()

@@ -30,7 +30,7 @@ _API = {
     "segment": "segment.segment", "Segmentation": "segment.segment",
     "unfold": "unfold.search", "Net": "unfold.net", "UnfoldStats": "unfold.search",
     "FoldTree": "fold.tree", "plan_fold": "fold.plan", "FoldPath": "fold.plan", "sample_ratio": "fold.cspace",
-    "make": "pipeline.make", "MakeOptions": "pipeline.make", "MakeResult": "pipeline.make",
+    "make": "pipeline.make", "MakeOptions": "pipeline.options", "MakeResult": "pipeline.make", "MakeReport": "pipeline.report",
 }
 
 __all__ = sorted(_API)

@@ -38,7 +38,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Sequence
 
 if TYPE_CHECKING:
-    from ..pipeline.make import MakeOptions
+    from ..pipeline.options import MakeOptions
+    from ..pipeline.report import MakeReport
 
 MESH_SUFFIXES = {".obj", ".off", ".stl", ".ply", ".glb", ".gltf"}
 STAGES = ("load", "inflate", "segment", "unfold", "fold", "layout", "export")
@@ -182,31 +183,28 @@ def _faults() -> dict[str, str]:
     return out
 
 
-def _finished_report(mesh: Path, out: Path, opts: MakeOptions) -> dict | None:
+def _finished_report(mesh: Path, out: Path, opts: MakeOptions) -> MakeReport | None:
     """The report.json in `out` if it is from a finished make of this mesh file with these options
     and newer than the mesh, else None. make moves report.json in last, so it marks a finished run."""
+    from ..pipeline.report import MakeReport
+
     path = out / "report.json"
     try:
         if path.stat().st_mtime < mesh.stat().st_mtime:
             return None
-        report = json.loads(path.read_text())
+        # a report of another layout (older version) is redone, not trusted
+        report = MakeReport.from_dict(json.loads(path.read_text()))
     except (OSError, ValueError):
         return None
-    try:
-        same = report["options"] == json.loads(json.dumps(asdict(opts))) and report["input"]["file"] == mesh.name
-        _make_values(report)  # a report of another layout (older version) is redone, not trusted
-        float(report["seconds"])
-    except (KeyError, TypeError, ValueError):
-        return None
-    return report if same else None
+    return report if report.options == opts and report.input.file == mesh.name else None
 
 
-def _make_values(report: dict) -> dict:
+def _make_values(report: MakeReport) -> dict:
     """BatchRow fields out of a make report."""
-    stages = report.get("stages", {})
-    values = {f"{s}_s": stages[s]["seconds"] for s in STAGES if "seconds" in stages.get(s, {})}
-    return {**values, "faces": report["input"]["faces"], "parts": stages["segment"]["parts"],
-            "pieces": len(report["pieces"]), "pages": stages["layout"]["pages"]}
+    stages = report.stages
+    values = {f"{s}_s": getattr(stages, s).seconds for s in STAGES}
+    return {**values, "faces": report.input.faces, "parts": stages.segment.parts, "pieces": len(report.pieces),
+            "pages": stages.layout.pages}
 
 
 def _row(cls: type, mesh: str, outcome: dict, **extra) -> Row:
@@ -250,7 +248,8 @@ def _run_task(spec: dict) -> dict:
 
 
 def _task_make(spec: dict) -> dict:
-    from ..pipeline.make import make, MakeOptions
+    from ..pipeline.make import make
+    from ..pipeline.options import MakeOptions
 
     result = make(spec["mesh"], spec["out"], MakeOptions(**spec["options"]))
     return _make_values(result.report)
@@ -288,15 +287,14 @@ def _warm_up() -> None:
 
 def _task_cspace(spec: dict) -> dict:
     from ..fold.cspace import sample_ratio
-    from ..formats.fold import net_to_fold
     from ..formats.meshes import load_mesh
-    from ..fold.tree import fold_tree
+    from ..fold.tree import FoldTree
     from ..unfold.search import unfold
 
     loaded = load_mesh(spec["mesh"])
     comp = max(loaded.components, key=lambda m: m.n_faces)
     net, _ = unfold(comp, seed=spec["seed"], time_limit=spec["time_limit"])
-    tree = fold_tree(net_to_fold([net]), spec["contact_tol"])
+    tree = FoldTree.from_net(net, spec["contact_tol"])
     dv, n = sample_ratio(tree, spec["samples"], "discrete", spec["seed"])
     cv, _ = sample_ratio(tree, spec["samples"], "continuous", spec["seed"])
     return {"faces": comp.n_faces, "pieces": net.n_pieces, "dof": len(tree.creases), "samples": n,
@@ -485,10 +483,10 @@ def run_batch(patterns: str | os.PathLike | Sequence[str | os.PathLike], out_dir
     task is killed (default 2 x opts.time_limit + 30). force: redo meshes that have a finished
     report.json with the same options (otherwise skipped). progress(row, done, total) after each
     mesh. Writes out_dir/summary.csv and summary.jsonl; -> BatchResult (rows in mesh order)."""
-    from ..pipeline.make import MakeOptions
+    from ..pipeline.options import MakeOptions, check_options
 
     opts = opts or MakeOptions()
-    _check_options(opts)
+    check_options(opts)  # one error for options make would reject on every mesh, not N
     t0 = time.perf_counter()
     meshes = expand(patterns)
     out = Path(out_dir)
@@ -510,7 +508,7 @@ def run_batch(patterns: str | os.PathLike | Sequence[str | os.PathLike], out_dir
         report = None if force else _finished_report(mesh, out / name, opts)
         if report is not None:
             finish(i, _row(BatchRow, str(mesh), {"status": "skipped", "values": _make_values(report),
-                                                 "seconds": report["seconds"]}, out=name))
+                                                 "seconds": report.seconds}, out=name))
             continue
         specs.append({"kind": "make", "mesh": os.path.abspath(mesh), "out": os.path.abspath(out / name),
                       "options": asdict(opts), "hard_limit": limit, "fault": faults.get(mesh.name)})
@@ -519,20 +517,6 @@ def run_batch(patterns: str | os.PathLike | Sequence[str | os.PathLike], out_dir
          lambda k, outcome: finish(index[k], _row(BatchRow, str(meshes[index[k]]), outcome, out=names[index[k]])))
     files = write_summary([r for r in rows if r is not None], out)
     return BatchResult(out_dir=out, rows=tuple(rows), files=files, seconds=time.perf_counter() - t0)
-
-
-def _check_options(opts: MakeOptions) -> None:
-    """Raise PolyfoldError for options make would reject on every mesh: one error, not N."""
-    from ..errors import PolyfoldError
-    from ..pipeline.make import FOOTER_MM, paper_size
-
-    if opts.inflate not in ("none", "constrained", "uniform"):
-        raise PolyfoldError(f"--inflate must be none, constrained or uniform, not {opts.inflate!r}")
-    if opts.segment not in ("auto", "none"):
-        raise PolyfoldError(f"--segment must be auto or none, not {opts.segment!r}")
-    width, height = paper_size(opts.paper)
-    if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
-        raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")
 
 
 def _cell(v) -> str:

@@ -73,15 +73,13 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner
     """
     from ..errors import PolyfoldError
     from ..fold.plan import plan_fold
-    from ..formats.fold import net_to_fold
-    from ..fold.tree import collides, fold_tree
+    from ..fold.tree import FoldTree, collides
     from ..unfold.search import unfold
 
     t0 = time.perf_counter()
     net, st = unfold(mesh, seed=seed, time_limit=time_limit)
     t1 = time.perf_counter()
-    fold = net_to_fold([net])
-    tree = fold_tree(fold, contact_tol)
+    tree = FoldTree.from_net(net, contact_tol)
     row = {"dof": int(len(tree.creases)), "pieces": int(net.n_pieces), "net_s": t1 - t0, "path": False,
            "lc": None, "path_s": float(time_limit), "note": "", "tree": tree, "planner": None}
     if net.n_pieces > 1:

@@ -140,7 +140,9 @@ def unfold(
     if max_pieces not in ("auto", "1"):
         _fail(f"--max-pieces must be 'auto' or '1', not {max_pieces!r}", 2)
     from ..errors import NoNetFound, PolyfoldError
-    from ..formats.fold import dumps, net_to_fold
+    from ..formats.fold import dumps, pattern_fold
+    from ..fold.tree import FoldTree
+    from ..unfold.pattern import crease_pattern
     from ..formats.files import atomic_write
     from ..unfold.search import unfold as unfold_mesh
 
@@ -164,9 +166,9 @@ def unfold(
 
             def accept(candidate, _res=resolution_deg) -> bool:
                 from ..fold.plan import is_linearly_foldable
-                from ..fold.tree import collides, fold_tree
+                from ..fold.tree import FoldTree, collides
 
-                tree = fold_tree(net_to_fold([candidate]), contact_tol)
+                tree = FoldTree.from_net(candidate, contact_tol)
                 if hopeless or collides(tree, tree.goal):
                     hopeless.append(True)  # the shape itself intersects: no net can fold, stop looking
                     return True
@@ -182,16 +184,16 @@ def unfold(
             print("\r" + " " * 60 + "\r", end="", file=sys.stderr)
         nets.append(net)
         stats.append(st)
-    fold_dict = net_to_fold(nets, title=mesh.stem)
+    pattern = crease_pattern(nets)
+    fold_dict = pattern_fold(pattern, title=mesh.stem)
     path_note = ""
     if fold:
         from ..fold.plan import plan_fold
         from ..formats.fold import with_path
-        from ..fold.tree import fold_tree
 
         remaining = max(1.0, time_limit - (time.perf_counter() - t0))
         try:
-            path = plan_fold(fold_tree(fold_dict, contact_tol), planner=planner.value, resolution_deg=resolution_deg,
+            path = plan_fold(FoldTree.from_pattern(pattern, contact_tol), planner=planner.value, resolution_deg=resolution_deg,
                              time_limit=remaining, seed=seed)
         except PolyfoldError as exc:  # e.g. the goal shape itself intersects: keep the valid flat net
             atomic_write(output, dumps(fold_dict))
@@ -204,9 +206,7 @@ def unfold(
         path_note = f", folding path {len(path.frames)} frames ({path.planner}, {path.seconds:.2f} s)"
     if prefer_linear:
         from ..fold.plan import is_linearly_foldable
-        from ..fold.tree import fold_tree
-
-        lc = is_linearly_foldable(fold_tree(fold_dict, contact_tol), resolution_deg)
+        lc = is_linearly_foldable(FoldTree.from_pattern(pattern, contact_tol), resolution_deg)
         path_note += ", linearly foldable" if lc else ", no linearly foldable net found in time"
     atomic_write(output, dumps(fold_dict))
     if svg is not None or png is not None:
@@ -247,7 +247,7 @@ def fold_cmd(
     from ..formats.fold import with_path
     from ..formats.fold import dumps, read_fold
     from ..formats.files import atomic_write
-    from ..fold.tree import fold_tree
+    from ..formats.fold import fold_tree
 
     fold = read_fold(net)
     tree = fold_tree(fold, contact_tol)
@@ -273,7 +273,7 @@ def cspace(
     """Print the valid configuration ratio |C_valid| / |C_sampled| of a net (paper Fig. 5)."""
     from ..fold.cspace import sample_ratio
     from ..formats.fold import read_fold
-    from ..fold.tree import fold_tree
+    from ..formats.fold import fold_tree
 
     tree = fold_tree(read_fold(net), contact_tol)
     valid, total = sample_ratio(tree, samples, strategy.value, seed)
@@ -404,22 +404,20 @@ def make(
 
             result = run_make(mesh, output, opts, progress)
     rep = result.report
+    lay = rep.stages.layout
     if not quiet:
-        for w in rep["input"]["warnings"]:
+        for w in rep.input.warnings:
             _say(f"warning: {mesh.name}: {w}")
-        for row in rep["pieces"]:
-            if not row["path_verified"] and fold:
-                _say(f"warning: piece {row['piece']}: no verified folding path ({row['note']})")
-        lay = rep["stages"]["layout"]
-        if lay["untabbed_edges"]:
-            _say(f"warning: {len(lay['untabbed_edges'])} glue edge(s) without a tab (no room on either side): "
-                 f"{', '.join(lay['untabbed_edges'][:10])}{' ...' if len(lay['untabbed_edges']) > 10 else ''}")
-        if lay["splits_for_page"]:
-            _say(f"split {lay['splits_for_page']} crease(s) so every piece fits on {paper} paper at {size:g} mm")
-    seg = rep["stages"]["segment"]
-    if not quiet:
-        _say(f"{mesh.name}: {seg['parts']} part(s), {len(rep['pieces'])} piece(s), {rep['stages']['layout']['pages']} "
-             f"page(s), {rep['checks']['paths_verified']}/{len(rep['pieces'])} folding paths verified, "
+        for row in rep.pieces:
+            if not row.path_verified and fold:
+                _say(f"warning: piece {row.piece}: no verified folding path ({row.note})")
+        if lay.untabbed_edges:
+            _say(f"warning: {len(lay.untabbed_edges)} glue edge(s) without a tab (no room on either side): "
+                 f"{', '.join(lay.untabbed_edges[:10])}{' ...' if len(lay.untabbed_edges) > 10 else ''}")
+        if lay.splits_for_page:
+            _say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
+        _say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
+             f"page(s), {rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 
 

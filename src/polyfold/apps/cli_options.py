@@ -27,7 +27,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
         fail("give --tau or --parts, not both", 2)
     if tabs not in ("auto", "none"):
         fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
-    from ..pipeline.make import MakeOptions
+    from ..pipeline.options import MakeOptions
 
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,

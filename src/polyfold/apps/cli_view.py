@@ -30,7 +30,8 @@ def register(app, guard, say, fail) -> None:
         import sys
         import tempfile
 
-        from .view import check_host, DEFAULT_HOST, load_folder, make_folder, serve, wait
+        from ..pipeline.folder import load_folder, make_folder
+        from .view import DEFAULT_HOST, check_host, serve, wait
 
         # Check the address before any slow work: a refused --host should fail at once.
         check_host(host if host is not None else DEFAULT_HOST, explicit=host is not None)
@@ -45,7 +46,7 @@ def register(app, guard, say, fail) -> None:
                 folder = load_folder(path)
             else:
                 from ..formats.meshes import load_mesh
-                from ..pipeline.make import MakeOptions
+                from ..pipeline.options import MakeOptions
 
                 loaded = load_mesh(path)
                 for w in loaded.warnings:

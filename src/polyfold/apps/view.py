@@ -7,25 +7,21 @@ folding animation along the verified path of every piece, an inflation panel (mo
 stiffness ratio, steps; hyperbolic vertices in red, their count as "HV: N") and buttons that run
 `make` / export the inflated mesh into the folder.
 
-Plain functions do the work so tests can use them without a browser: `load_folder` (the folder as
-a frozen `MakeFolder`), `pose_piece` / `ViewPiece.pose` (face corners in the model frame at a
-fraction t of the folding path), `check_host`, `serve` (starts the server and returns at once) and
-`wait` (blocks until Ctrl+C, for the CLI).
+The folder itself is read by `pipeline.folder.load_folder` (a frozen `MakeFolder`, whose pieces
+pose themselves along their folding paths); here: `check_host`, `serve` (starts the server and
+returns at once), `wait` (blocks until Ctrl+C, for the CLI) and the `Viewer` (the page).
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import io
 import ipaddress
-import json
-import math
 import re
-import shutil
-import tempfile
 import threading
 import time
-from dataclasses import dataclass, fields
+from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
@@ -33,8 +29,9 @@ import numpy as np
 
 from ..errors import PolyfoldError
 from ..formats.meshes import obj_text
-from ..fold.tree import fold_positions, fold_tree, FoldTree
 from ..mesh.mesh import Mesh
+from ..pipeline.folder import MakeFolder, ViewPiece, load_folder, make_folder
+from ..pipeline.options import MakeOptions
 
 DEFAULT_HOST = "127.0.0.1"
 DEBOUNCE_S = 0.3  # inflation re-runs wait until the sliders rest this long
@@ -49,232 +46,6 @@ INFLATED_COLOR = (150, 175, 215)
 ALL_PARTS = "all parts"
 NET_GAP = 0.8  # view units (the model is 2 long): model to nets, on the right
 INFLATED_GAP = 1.4  # model to the inflated copy, on the left
-
-
-# ----------------------------------------------------------------------------------------------
-# The folder
-
-
-@dataclass(frozen=True, eq=False)
-class ViewPiece:
-    """One piece of a make folder, ready to animate.
-
-    fold: its FOLD dict; tree: `fold_tree(fold)`; frames (K, E): `polyfold:path` (FOLD degrees,
-    valley positive), None when the piece has no verified path (it is then shown folded only);
-    rotation (P, 3, 3) / translation (P, 3): per FOLD piece, the rigid motion (Kabsch fit of the
-    goal pose onto the foldedForm) that puts the folded net onto the model; fit_error: largest
-    corner distance between the aligned goal pose and the foldedForm, in model units (nan
-    without a foldedForm frame).
-    """
-
-    name: str
-    part: int
-    fold: dict
-    tree: FoldTree
-    frames: np.ndarray | None
-    rotation: np.ndarray
-    translation: np.ndarray
-    fit_error: float
-
-    @property
-    def verified(self) -> bool:
-        return self.frames is not None
-
-    def pose(self, t: float) -> np.ndarray:
-        """Face corners (F, 3, 3) in the model frame at fraction t in [0, 1] of the folding path
-        (0 flat, 1 folded onto the model). Without a path the piece stays folded."""
-        deg = _goal_degrees(self.fold, self.tree) if self.frames is None else path_degrees(self.frames, t)
-        corners = fold_positions(self.tree, -np.radians(deg))
-        piece = self.tree.piece
-        return np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
-
-
-@dataclass(frozen=True, eq=False)
-class MakeFolder:
-    """A `polyfold make` output folder: parts (in part order), pieces (in assembly order), the
-    whole model (the parts welded back together), the model's file name and the make options of
-    report.json (empty when it is missing)."""
-
-    path: Path
-    model: str
-    parts: tuple[Mesh, ...]
-    pieces: tuple[ViewPiece, ...]
-    whole: Mesh
-    options: dict
-
-
-def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
-    """FOLD angles (E,) in degrees at fraction t of a path (K, E): linear between consecutive
-    frames, every segment the same share of t."""
-    frames = np.asarray(frames, dtype=np.float64)
-    t = min(1.0, max(0.0, float(t)))
-    if len(frames) == 1:
-        return frames[0].copy()
-    s = t * (len(frames) - 1)
-    i = min(int(math.floor(s)), len(frames) - 2)
-    u = s - i
-    return (1.0 - u) * frames[i] + u * frames[i + 1]
-
-
-def _goal_degrees(fold: dict, tree: FoldTree) -> np.ndarray:
-    path = fold.get("polyfold:path")
-    if path:
-        return np.asarray(path[-1], dtype=np.float64)
-    angles = fold.get("edges_foldAngle")
-    if angles is None:  # no angles in the file: the tree's own goal (rho radians)
-        return -np.degrees(tree.goal)
-    return np.asarray(angles, dtype=np.float64)
-
-
-def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation R and translation t minimising |R p + t - q| over the rows (a proper rotation)."""
-    cp, cq = p.mean(axis=0), q.mean(axis=0)
-    u, _, vt = np.linalg.svd((p - cp).T @ (q - cq))
-    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-    return r, cq - r @ cp
-
-
-def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
-    """A ViewPiece of a FOLD dict: builds the fold tree, checks the path and fits the rigid motion
-    that lands the goal pose on the foldedForm (fold_positions keeps each root face flat)."""
-    tree = fold_tree(fold)
-    frames = None
-    if fold.get("polyfold:path"):
-        frames = np.asarray(fold["polyfold:path"], dtype=np.float64)
-        if frames.ndim != 2 or frames.shape[1] != tree.n_edges:
-            raise PolyfoldError(f"piece {name}: polyfold:path frames must have one angle per edge ({tree.n_edges})")
-    elif tree.n_faces == 1:
-        frames = np.zeros((2, tree.n_edges))  # a single face is trivially foldable
-    goal = fold_positions(tree, -np.radians(_goal_degrees(fold, tree)))
-    n_p = int(tree.piece.max()) + 1
-    rotation = np.repeat(np.eye(3)[None], n_p, axis=0)
-    translation = np.zeros((n_p, 3))
-    fit_error = float("nan")
-    if tree.folded is not None:
-        target = tree.folded[tree.faces]
-        fit_error = 0.0
-        for k in range(n_p):
-            on = tree.piece == k
-            if not on.any():
-                continue
-            r, t = _kabsch(goal[on].reshape(-1, 3), target[on].reshape(-1, 3))
-            rotation[k], translation[k] = r, t
-            moved = goal[on] @ r.T + t
-            fit_error = max(fit_error, float(np.abs(moved - target[on]).max()))
-    return ViewPiece(name=name, part=part, fold=fold, tree=tree, frames=frames, rotation=rotation,
-                     translation=translation, fit_error=fit_error)
-
-
-def pose_piece(fold: dict, t: float) -> np.ndarray:
-    """Face corners (F, 3, 3) of a FOLD piece in the model frame at fraction t of its folding
-    path (see `ViewPiece.pose`; prepare the piece once with `prepare_piece` to pose it often)."""
-    return prepare_piece(fold).pose(t)
-
-
-def weld_parts(parts: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
-    """The whole model from its parts: vertices at the same position become one (make writes
-    them bit-exact). When that would join more than two faces at an edge (the input had split a
-    non-manifold vertex) the parts are kept side by side instead."""
-    verts = np.concatenate([p.vertices for p in parts])
-    offsets = np.cumsum([0] + [p.n_vertices for p in parts])[:-1]
-    faces = np.concatenate([p.faces + o for p, o in zip(parts, offsets)])
-    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
-    welded = Mesh(uniq, inverse.reshape(-1)[faces])
-    if (welded.topology.face_count > 2).any():
-        return Mesh(verts, faces)
-    return welded
-
-
-def _read_obj(path: Path) -> Mesh:
-    """The OBJ files make writes (v / f lines, triangles): read them exactly, without repairs."""
-    verts, faces = [], []
-    for line in path.read_text(encoding="utf-8").splitlines():
-        tok = line.split()
-        if not tok:
-            continue
-        if tok[0] == "v":
-            verts.append([float(x) for x in tok[1:4]])
-        elif tok[0] == "f":
-            faces.append([int(x.split("/")[0]) - 1 for x in tok[1:4]])
-    v, f = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(faces, dtype=np.int64).reshape(-1, 3)
-    if len(f) == 0 or f.min() < 0 or f.max() >= len(v):
-        raise PolyfoldError(f"{path.name}: not a usable part mesh (no faces or bad vertex indices)")
-    return Mesh(v, f)
-
-
-def _inside(root: Path, name: str) -> Path:
-    """root / name for a plain file name from assembly.json, refusing anything that leaves root."""
-    if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
-        raise PolyfoldError(f"{root.name}/assembly.json: bad file name {name!r}")
-    return root / name
-
-
-def load_folder(path: str | Path) -> MakeFolder:
-    """Read a `polyfold make` output folder. Raises PolyfoldError (one line) when it is not one."""
-    from ..formats.fold import read_fold
-
-    root = Path(path)
-    if not root.is_dir():
-        raise PolyfoldError(f"{root}: no such folder")
-    asm_path = root / "assembly.json"
-    if not asm_path.is_file():
-        raise PolyfoldError(f"{root}: not a `polyfold make` output folder (no assembly.json)")
-    try:
-        assembly = json.loads(asm_path.read_text(encoding="utf-8"))
-        part_rows, piece_rows = assembly["parts"], assembly["pieces"]
-        obj_names = [str(p["obj"]) for p in part_rows]
-        piece_specs = [(str(r["piece"]), int(r["part"]), str(r["fold"])) for r in piece_rows]
-    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError) as exc:
-        raise PolyfoldError(f"{asm_path}: not a readable assembly file ({type(exc).__name__}: {exc})") from None
-    if not obj_names:
-        raise PolyfoldError(f"{asm_path}: no parts")
-    parts = []
-    for name in obj_names:
-        f = _inside(root, name)
-        if not f.is_file():
-            raise PolyfoldError(f"{root}: {name} is missing")
-        parts.append(_read_obj(f))
-    pieces = []
-    for name, part, fold_name in piece_specs:
-        if not 0 <= part < len(parts):
-            raise PolyfoldError(f"{asm_path}: piece {name} belongs to part {part}, which does not exist")
-        fold = read_fold(_inside(root, fold_name))
-        try:
-            pieces.append(prepare_piece(fold, name, part))
-        except PolyfoldError as exc:
-            raise PolyfoldError(f"{fold_name}: {exc}") from None
-        except (ValueError, TypeError, KeyError, IndexError) as exc:  # malformed values in the JSON
-            raise PolyfoldError(f"{fold_name}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
-    options: dict = {}
-    report_path = root / "report.json"
-    if report_path.is_file():
-        try:
-            options = dict(json.loads(report_path.read_text(encoding="utf-8")).get("options") or {})
-        except (OSError, UnicodeDecodeError, ValueError, AttributeError, TypeError):
-            options = {}
-    return MakeFolder(path=root, model=str(assembly.get("model") or root.name), parts=tuple(parts),
-                      pieces=tuple(pieces), whole=weld_parts(parts), options=options)
-
-
-def make_folder(mesh_path: str | Path, out_dir: str | Path, opts=None,
-                progress: Callable[[str, str], None] | None = None) -> MakeFolder:
-    """Run `polyfold make` on a mesh file into out_dir and load the result (the MESH form of
-    `polyfold view`)."""
-    from ..pipeline.make import make, MakeOptions
-
-    make(mesh_path, out_dir, opts or MakeOptions(), progress=progress)
-    return load_folder(out_dir)
-
-
-def make_options(saved: dict, **changes):
-    """MakeOptions from report.json's options (unknown keys dropped) with `changes` applied."""
-    from ..pipeline.make import MakeOptions
-
-    known = {f.name for f in fields(MakeOptions)}
-    kw = {k: v for k, v in saved.items() if k in known}
-    kw.update(changes)
-    return MakeOptions(**kw)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -700,23 +471,15 @@ class Viewer:
         out = self.output_dir()
         mesh, kind = self._mesh_for_make()
         t0 = time.perf_counter()
-        tmp = Path(tempfile.mkdtemp(prefix="polyfold-view-"))
-        try:
-            if kind == "original" and self.source_path is not None:
-                src = self.source_path
-            else:
-                # make reads a file: the mesh as an OBJ named after the model (the report names it)
-                suffix = "" if kind == "original" else "-inflated"
-                src = tmp / f"{self._stem()}{suffix}.obj"
-                src.write_text(obj_text(mesh.vertices, mesh.faces, f"{self.folder.model} ({kind})"))
-            opts = make_options(self.folder.options, inflate="none")
+        opts = replace(self.folder.options or MakeOptions(), inflate="none")
 
-            def progress(stage: str, msg: str) -> None:
-                self.make_status.content = f"make: {stage}: {msg}"
+        def progress(stage: str, msg: str) -> None:
+            self.make_status.content = f"make: {stage}: {msg}"
 
-            folder = make_folder(src, out, opts, progress)
-        finally:
-            shutil.rmtree(tmp, ignore_errors=True)
+        if kind == "original" and self.source_path is not None:
+            folder = make_folder(self.source_path, out, opts, progress)
+        else:  # the mesh in memory, named after the model (the report and the sheets name it)
+            folder = make_folder(mesh, out, opts, progress, name=f"{self._stem()}{'' if kind == 'original' else '-inflated'}")
         self.make_runs += 1
         verified = sum(p.verified for p in folder.pieces)
         self.make_status.content = (f"make ({kind} mesh) done in {time.perf_counter() - t0:.1f} s: "

@@ -16,7 +16,6 @@ not move), since both endpoints are valid.
 from __future__ import annotations
 
 import math
-import time
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -24,6 +23,7 @@ from numba import njit
 
 from ..collide.sweep import fill_face_geometry, gather_boxes, largest_group, sort_by_lo_x, sweep_collides
 from ..collide.triangles import GEO_SIZE
+from ..deadline import Deadline
 from .kinematics import fold_faces
 
 if TYPE_CHECKING:
@@ -206,14 +206,14 @@ def first_blocked_segment(check: ValidityChecker, frames: np.ndarray, step: floa
     return -1
 
 
-def shortcut(frames: list[np.ndarray], check: ValidityChecker, deadline: float, step: float | None = None) -> np.ndarray:
+def shortcut(frames: list[np.ndarray], check: ValidityChecker, deadline: Deadline, step: float | None = None) -> np.ndarray:
     """Greedy shortcut: from each kept frame jump to the farthest later frame reachable directly
     (checked at `step`, default the checker's resolution); after the deadline, no more jumps."""
     out = [frames[0]]
     i = 0
     while i < len(frames) - 1:
         j = len(frames) - 1
-        while j > i + 1 and (time.perf_counter() >= deadline or not check.segment(frames[i], frames[j], step)):
+        while j > i + 1 and (deadline.expired() or not check.segment(frames[i], frames[j], step)):
             j -= 1
         out.append(frames[j])
         i = j

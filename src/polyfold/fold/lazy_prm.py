@@ -8,11 +8,10 @@ half the resolution.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 from numba import njit
 
+from ..deadline import Deadline
 from .checker import ValidityChecker, first_blocked_segment, shortcut
 from .tree import FoldTree, crease_depth_size
 
@@ -177,65 +176,88 @@ def _ordered_states(tree: FoldTree, levels: int = 8) -> list[np.ndarray]:
     return states
 
 
-def plan_lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: float, rng: np.random.Generator, n0: int, k: int):
-    """Lazy PRM over discrete configurations b in {0,1}^n, q = b * goal (ALGORITHMS.md 6.5).
+def plan_lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: Deadline, rng: np.random.Generator,
+                  n0: int = 100, k: int = 10) -> tuple[np.ndarray, int] | None:
+    """Lazy PRM over discrete configurations b in {0,1}^n, q = b * goal (ALGORITHMS.md 6.5):
+    (frames flat -> goal, roadmap nodes), or None when out of time.
 
     Node 0 is the flat net, node 1 the goal. Edges are checked only when A* puts them on a
     candidate path: first a coarse look at every edge of the path (the first bisection samples),
     then the full check; blocked edges are dropped and A* runs again. More samples (doubling
-    batches) when the start and goal are disconnected.
+    batches from n0; k nearest neighbours per node) when the start and goal are disconnected.
     """
-    creases = tree.creases
-    n = len(creases)
-    goal_c = tree.goal[creases]
+    search = _LazySearch(tree, check, k)
+    batch = n0
+    while not deadline.expired():
+        search.sample(batch, rng, deadline)
+        found = search.solve(deadline)
+        if found is not None:
+            return found
+        batch = min(2 * batch, MAX_BATCH)
+    return None
 
-    def config(bits: np.ndarray) -> np.ndarray:
-        q = np.zeros(len(tree.goal))
-        q[creases] = bits * goal_c
+
+class _LazySearch:
+    """The roadmap of `plan_lazy_prm` and the lazy checks of its edges."""
+
+    def __init__(self, tree: FoldTree, check: ValidityChecker, k: int) -> None:
+        self.tree, self.check, self.k = tree, check, k
+        self.creases = tree.creases
+        n = len(self.creases)
+        self.goal_c = tree.goal[self.creases]
+        self.rm = _Roadmap(n, np.abs(self.goal_c))
+        start_bits, goal_bits = np.zeros(n, dtype=bool), np.ones(n, dtype=bool)
+        self.seen = {start_bits.tobytes(), goal_bits.tobytes()}
+        self.rm.add_nodes([start_bits, goal_bits], k)
+        # Natural folding orders as extra nodes: fold the outer branches first (by tree depth or by
+        # subtree size), or the inner ones first. Cheap, and they often give a 3-frame path at once.
+        seeded = []
+        for b in _ordered_states(tree):
+            key = b.tobytes()
+            if key not in self.seen:
+                self.seen.add(key)
+                if check.valid(self.config(b)):
+                    seeded.append(b)
+        self.rm.add_nodes(seeded, k)
+
+    def config(self, bits: np.ndarray) -> np.ndarray:
+        q = np.zeros(len(self.tree.goal))
+        q[self.creases] = bits * self.goal_c
         return q
 
-    rm = _Roadmap(n, np.abs(goal_c))
-    seen = set()
-    start_bits, goal_bits = np.zeros(n, dtype=bool), np.ones(n, dtype=bool)
-    seen.update((start_bits.tobytes(), goal_bits.tobytes()))
-    rm.add_nodes([start_bits, goal_bits], k)
-    # Natural folding orders as extra nodes: fold the outer branches first (by tree depth or by
-    # subtree size), or the inner ones first. Cheap, and they often give a 3-frame path at once.
-    seeded = []
-    for b in _ordered_states(tree):
-        key = b.tobytes()
-        if key not in seen:
-            seen.add(key)
-            if check.valid(config(b)):
-                seeded.append(b)
-    rm.add_nodes(seeded, k)
+    def sample(self, batch: int, rng: np.random.Generator, deadline: Deadline) -> None:
+        """Add up to `batch` new valid nodes (at most 20 * batch draws)."""
+        new = []
+        tries = 0
+        n = len(self.creases)
+        while len(new) < batch and tries < 20 * batch and not deadline.expired():
+            tries += 1
+            b = rng.random(n) < rng.random()  # Hamming level p ~ U(0, 1), then bits ~ Bernoulli(p)
+            key = b.tobytes()
+            if key in self.seen:
+                continue
+            self.seen.add(key)
+            if self.check.valid(self.config(b)):
+                new.append(b)
+        self.rm.add_nodes(new, self.k)
 
-    def check_edge(e: int, coarse: bool) -> bool:
+    def check_edge(self, e: int, coarse: bool) -> bool:
+        rm = self.rm
         st = rm.state[e]
         if st == rm.BLOCKED:
             return False
         if st == rm.FREE or (coarse and st == rm.COARSE_OK):
             return True
-        qa, qb = config(rm.bits[rm.eu[e]]), config(rm.bits[rm.ev[e]])
-        ok = check.segment(qa, qb, max_samples=COARSE_SAMPLES) if coarse else check.segment(qa, qb)
+        qa, qb = self.config(rm.bits[rm.eu[e]]), self.config(rm.bits[rm.ev[e]])
+        ok = self.check.segment(qa, qb, max_samples=COARSE_SAMPLES) if coarse else self.check.segment(qa, qb)
         rm.state[e] = (rm.COARSE_OK if coarse else rm.FREE) if ok else rm.BLOCKED
         return ok
 
-    batch = n0
-    while time.perf_counter() < deadline:
-        new = []
-        tries = 0
-        while len(new) < batch and tries < 20 * batch and time.perf_counter() < deadline:
-            tries += 1
-            b = rng.random(n) < rng.random()  # Hamming level p ~ U(0, 1), then bits ~ Bernoulli(p)
-            key = b.tobytes()
-            if key in seen:
-                continue
-            seen.add(key)
-            if check.valid(config(b)):
-                new.append(b)
-        rm.add_nodes(new, k)
-        while time.perf_counter() < deadline:
+    def solve(self, deadline: Deadline) -> tuple[np.ndarray, int] | None:
+        """Shortest roadmap paths, checked lazily, until one is free (-> frames, nodes) or none is
+        left on the roadmap (-> None: sample more)."""
+        rm, check = self.rm, self.check
+        while not deadline.expired():
             path = rm.shortest_path()
             if len(path) == 0:
                 break
@@ -243,11 +265,11 @@ def plan_lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: float, rng: 
             # Coarse pass over every edge of the path first: most blocked edges show up within a
             # few samples, and dropping all of them at once saves A* runs and full checks of edges
             # on paths that are blocked elsewhere anyway.
-            if not all([check_edge(e, True) for e in edges]):
+            if not all([self.check_edge(e, True) for e in edges]):
                 continue
-            if not all(check_edge(e, False) for e in edges):
+            if not all(self.check_edge(e, False) for e in edges):
                 continue
-            raw = np.stack([config(rm.bits[i]) for i in path.tolist()])
+            raw = np.stack([self.config(rm.bits[i]) for i in path.tolist()])
             frames = shortcut(list(raw), check, deadline)
             if first_blocked_segment(check, frames, check.step / 2) < 0:  # re-validate at half the resolution
                 return frames, len(rm.bits)
@@ -255,7 +277,6 @@ def plan_lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: float, rng: 
                 return raw, len(rm.bits)
             # Some roadmap edge fails only the finer check: block the ones that do.
             for e in edges:
-                if not check.segment(config(rm.bits[rm.eu[e]]), config(rm.bits[rm.ev[e]]), check.step / 2):
+                if not check.segment(self.config(rm.bits[rm.eu[e]]), self.config(rm.bits[rm.ev[e]]), check.step / 2):
                     rm.state[e] = rm.BLOCKED
-        batch = min(2 * batch, MAX_BATCH)
-    return None
+        return None

@@ -21,17 +21,17 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
+from ..deadline import Deadline
+from ..errors import PolyfoldError
+from ..mesh.geometry import rho_to_fold_deg
 from .checker import ValidityChecker, first_blocked_segment
 from .lazy_prm import plan_lazy_prm
 from .sequential import plan_sequential
-from ..errors import PolyfoldError
 from .tree import FoldTree, colliding_pairs
-
-
-PLANNERS = ("auto", "linear", "sequential", "lazy-prm")
 
 
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
@@ -51,7 +51,66 @@ class FoldPath:
 
     def degrees_fold(self) -> list[list[float]]:
         """The path in FOLD convention (degrees, valley positive) for `polyfold:path`."""
-        return (-np.degrees(self.frames)).tolist()
+        return rho_to_fold_deg(self.frames).tolist()
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """What a planner may use besides the tree, the checker and the deadline: the seed of its own
+    random generator, and the Lazy PRM's first batch of samples and neighbours per node."""
+
+    seed: int = 0
+    n0: int = 100
+    k_neighbours: int = 10
+
+
+@dataclass(frozen=True, eq=False)
+class Found:
+    """A planner's path: frames (K, E) flat -> goal, the name it reports, roadmap nodes, and
+    whether it is the straight line."""
+
+    frames: np.ndarray
+    planner: str
+    nodes: int
+    linear: bool
+
+
+Planner = Callable[[FoldTree, ValidityChecker, Deadline, PlannerSettings], "Found | None"]
+
+
+def plan_linear(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settings: PlannerSettings) -> Found | None:
+    """The straight line flat -> goal (the paper's LC test), checked at half the resolution at
+    once (its samples include the full-resolution ones; a blocked line fails as early, at its
+    first bisection samples)."""
+    straight = np.stack([np.zeros(len(tree.goal)), tree.goal.copy()])
+    if first_blocked_segment(check, straight, check.step / 2) < 0:
+        return Found(straight, "linear", 2, True)
+    return None
+
+
+def _sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settings: PlannerSettings) -> Found | None:
+    found = plan_sequential(tree, check, deadline, np.random.default_rng(settings.seed))
+    if found is None:
+        return None
+    frames, continuous = found
+    return Found(frames, "sequential-rrt" if continuous else "sequential", len(frames), False)
+
+
+def _lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settings: PlannerSettings) -> Found | None:
+    found = plan_lazy_prm(tree, check, deadline, np.random.default_rng(settings.seed), settings.n0, settings.k_neighbours)
+    if found is None:
+        return None
+    frames, nodes = found
+    return Found(frames, "lazy-prm", nodes, len(frames) == 2)
+
+
+# Planners by name, interchangeable over one validity checker and one deadline.
+PLANNER_REGISTRY: dict[str, Planner] = {"linear": plan_linear, "sequential": _sequential, "lazy-prm": _lazy_prm}
+# "auto": each in turn, each until its share of the time limit (from the start) is used; the Lazy
+# PRM keeps a third for the rare net the sequential planner cannot unlock (it finds nothing on
+# large nets, but may on a small one).
+AUTO = (("linear", 1.0), ("sequential", SEQUENTIAL_SHARE), ("lazy-prm", 1.0))
+PLANNERS = ("auto", *PLANNER_REGISTRY)
 
 
 def plan_fold(
@@ -62,8 +121,10 @@ def plan_fold(
     seed: int = 0,
     n0: int = 100,
     k_neighbours: int = 10,
+    deadline: Deadline | None = None,
 ) -> FoldPath | None:
-    """Plan a collision-free folding path; None when none is found within `time_limit`.
+    """Plan a collision-free folding path; None when none is found in time (`time_limit` seconds,
+    or until `deadline` when one is given).
 
     planner: "linear" (straight line only), "sequential" (crease-by-crease unfolding of the goal
     only), "lazy-prm" (Lazy PRM only, as the paper after its LC test), "auto" (straight line,
@@ -73,49 +134,37 @@ def plan_fold(
     if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}")
     t0 = time.perf_counter()
-    deadline = t0 + time_limit
+    deadline = Deadline(t0 + time_limit) if deadline is None else deadline
     check = ValidityChecker(tree, math.radians(resolution_deg))
-    zero = np.zeros(len(tree.goal))
-    goal = tree.goal.copy()
-    if not check.valid(zero):
+    _check_ends(tree, check)
+    if len(tree.creases) == 0:  # single faces (no DOF): the flat net is the goal, whatever the planner
+        found = Found(np.stack([np.zeros(len(tree.goal)), tree.goal.copy()]), "linear", 2, True)
+    else:
+        settings = PlannerSettings(seed, n0, k_neighbours)
+        steps = AUTO if planner == "auto" else ((planner, 1.0),)
+        found = None
+        for name, share in steps:
+            until = deadline if share >= 1.0 else Deadline(t0 + (deadline.at - t0) * share)
+            found = PLANNER_REGISTRY[name](tree, check, until, settings)
+            if found is not None:
+                break
+    if found is None:
+        return None
+    return FoldPath(frames=found.frames, linear=found.linear, planner=found.planner, seconds=time.perf_counter() - t0,
+                    edges_checked=check.edges, configs_checked=check.configs, nodes=found.nodes)
+
+
+def _check_ends(tree: FoldTree, check: ValidityChecker) -> None:
+    """PolyfoldError when the flat net or the folded goal self-intersects: no path can exist."""
+    if not check.valid(np.zeros(len(tree.goal))):
         raise PolyfoldError("the flat net overlaps itself: not a valid net")
-    if not check.valid(goal):
-        pairs = colliding_pairs(tree, goal)
+    if not check.valid(tree.goal.copy()):
+        pairs = colliding_pairs(tree, tree.goal)
         raise PolyfoldError(
             f"the folded goal shape intersects itself (net faces {pairs[0, 0]} and {pairs[0, 1]} cross, "
             f"{len(pairs)} pair{'s' if len(pairs) != 1 else ''} in all, beyond the contact tolerance "
             f"{tree.tol / tree.scale:.0e} of the model size): no folding path can exist; if that is within "
             f"the paper's thickness, raise --contact-tol")
-
-    def done(frames: np.ndarray, linear: bool, name: str, nodes: int) -> FoldPath:
-        return FoldPath(frames=frames, linear=linear, planner=name, seconds=time.perf_counter() - t0,
-                        edges_checked=check.edges, configs_checked=check.configs, nodes=nodes)
-
-    if len(tree.creases) == 0:  # single faces (no DOF): the flat net is the goal, whatever the planner
-        return done(np.stack([zero, goal]), True, "linear", 2)
-    if planner in ("auto", "linear"):
-        straight = np.stack([zero, goal])
-        # at half the resolution at once (its samples include the full-resolution ones; a blocked
-        # line fails as early, at its first bisection samples)
-        if first_blocked_segment(check, straight, check.step / 2) < 0:
-            return done(straight, True, "linear", 2)
-        if planner == "linear":
-            return None
-    if planner in ("auto", "sequential"):
-        # auto: the Lazy PRM keeps a third of the time for the rare net the sequential planner
-        # cannot unlock (it finds nothing on large nets, but may on a small one)
-        seq_deadline = deadline if planner == "sequential" else t0 + time_limit * SEQUENTIAL_SHARE
-        found = plan_sequential(tree, check, seq_deadline, np.random.default_rng(seed))
-        if found is not None:
-            frames, continuous = found
-            return done(frames, False, "sequential-rrt" if continuous else "sequential", len(frames))
-        if planner == "sequential":
-            return None
-    result = plan_lazy_prm(tree, check, deadline, np.random.default_rng(seed), n0, k_neighbours)
-    if result is None:
-        return None
-    frames, nodes = result
-    return done(frames, len(frames) == 2, "lazy-prm", nodes)
 
 
 def is_linearly_foldable(tree: FoldTree, resolution_deg: float = 1.0) -> bool:

@@ -8,9 +8,10 @@ creases lock in the discrete domain, `rrt_connect` searches their continuous sub
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
+
+from ..deadline import Deadline
 
 from .checker import ValidityChecker, shortcut
 from .tree import FoldTree, crease_depth_size
@@ -18,15 +19,12 @@ from .tree import FoldTree, crease_depth_size
 
 # The sequential planner's continuous search over the creases it cannot open (`rrt_connect`):
 RRT_MAX_DOF = 32  # stuck sets of up to this many creases get one
-
-
 RRT_STEP_DEG = 15.0  # longest extension of a tree, per crease
-
-
 RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much on either side
 
 
-def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: float, rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
+def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
+                    rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
     """Reverse sequential unfolding: (frames flat -> goal, continuous?), or None (stuck or out of time).
 
     Start at the folded goal and open one crease at a time (its angle to 0), always the first
@@ -48,8 +46,7 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: float, rng
     Such a path leaves the discrete domain in its first frames (`continuous?` is then True).
     Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
     """
-    creases, goal = tree.creases, tree.goal
-    n = len(creases)
+    creases = tree.creases
     depth, size = crease_depth_size(tree)
     smaller_side = np.minimum(size, len(tree.order) - size)
     # Two tracks of restarts, taken in turn, each with its own base order and promotions: creases
@@ -58,61 +55,27 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: float, rng
     tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
     tried: list[set[frozenset]] = [set(), set()]
     searched: set[frozenset] = set()  # stuck sets given to the continuous search already
-    fine = check.step / 2
     restart = 0
-    while time.perf_counter() < deadline:
+    while not deadline.expired():
         track = restart % 2
         prio = tracks[track]
         restart += 1
-        q = goal.copy()
-        frames = [q]  # q is replaced, never changed in place
-        is_open = np.zeros(n, dtype=bool)
-        fails = np.zeros(n, dtype=np.int64)
-        retry_at = np.zeros(n, dtype=np.int64)
-        group, step = 1, 0
-        while not is_open.all() and time.perf_counter() < deadline:
-            step += 1
-            todo = [i for i in prio if not is_open[i]]
-            # Open the next `group` creases in one motion when that is free (one check instead of
-            # `group`: a segment costs its largest angle change, not its crease count); the group
-            # doubles after each success, else one crease at a time: the first free one. A crease
-            # that was blocked waits 2, 4, 8, ... steps before it is tried again (it is usually
-            # still blocked); only when nothing else moves are the waiting ones tried at once.
-            ready = [i for i in todo if retry_at[i] <= step]
-            waiting = [i for i in todo if retry_at[i] > step]
-            moves = [ready[:group]] if group > 1 and len(ready) > 1 else []
-            moves += ([i] for i in ready + waiting)
-            for move in moves:
-                if time.perf_counter() >= deadline:  # a scan of a large net can take a while
-                    return None
-                nxt = q.copy()
-                nxt[creases[move]] = 0.0
-                # the new state itself first (segments assume valid endpoints), then the motion,
-                # at half the resolution straight away: the path needs no re-validation
-                if check.valid(nxt) and check.segment(q, nxt, fine):
-                    is_open[move] = True
-                    q = nxt  # a fresh array: frames may keep it
-                    frames.append(q)
-                    group = min(2 * len(move), len(todo))
-                    break
-                if len(move) == 1:
-                    fails[move[0]] += 1
-                    retry_at[move[0]] = step + (1 << min(int(fails[move[0]]), 6))
-            else:
-                break
+        opened = _open_in_order(tree, check, prio, deadline)
+        if opened is None:
+            return None
+        frames, is_open = opened
         if is_open.all():
             frames.reverse()  # (plan_fold answers nets without creases before this runs)
             return np.stack(frames), False
         stuck = [i for i in prio if not is_open[i]]
-        if time.perf_counter() >= deadline:
+        if deadline.expired():
             return None
         key = frozenset(stuck)
         if len(stuck) <= RRT_MAX_DOF and key not in searched:
             # Locked in the discrete domain, but only a few creases are left: search their
             # continuous subspace (once per stuck set, with half the time left).
             searched.add(key)
-            sub_deadline = min(deadline, time.perf_counter() + 0.5 * (deadline - time.perf_counter()))
-            rest = rrt_connect(check, q, creases[stuck], sub_deadline, rng)
+            rest = rrt_connect(check, frames[-1], creases[stuck], deadline.within(0.5 * deadline.left()), rng)
             if rest is not None:
                 frames += rest
                 frames.reverse()
@@ -124,7 +87,54 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: float, rng
     return None
 
 
-def rrt_connect(check: ValidityChecker, start: np.ndarray, moving: np.ndarray, deadline: float,
+def _open_in_order(tree: FoldTree, check: ValidityChecker, prio: list[int],
+                   deadline: Deadline) -> tuple[list[np.ndarray], np.ndarray] | None:
+    """One restart of `plan_sequential`: from the goal, open creases (indices into tree.creases)
+    in priority order `prio` while one can move. Returns (frames goal -> last state, which creases
+    are open), or None when time ran out in the middle of a scan."""
+    creases = tree.creases
+    n = len(creases)
+    fine = check.step / 2
+    q = tree.goal.copy()
+    frames = [q]  # q is replaced, never changed in place
+    is_open = np.zeros(n, dtype=bool)
+    fails = np.zeros(n, dtype=np.int64)
+    retry_at = np.zeros(n, dtype=np.int64)
+    group, step = 1, 0
+    while not is_open.all() and not deadline.expired():
+        step += 1
+        todo = [i for i in prio if not is_open[i]]
+        # Open the next `group` creases in one motion when that is free (one check instead of
+        # `group`: a segment costs its largest angle change, not its crease count); the group
+        # doubles after each success, else one crease at a time: the first free one. A crease
+        # that was blocked waits 2, 4, 8, ... steps before it is tried again (it is usually
+        # still blocked); only when nothing else moves are the waiting ones tried at once.
+        ready = [i for i in todo if retry_at[i] <= step]
+        waiting = [i for i in todo if retry_at[i] > step]
+        moves = [ready[:group]] if group > 1 and len(ready) > 1 else []
+        moves += ([i] for i in ready + waiting)
+        for move in moves:
+            if deadline.expired():  # a scan of a large net can take a while
+                return None
+            nxt = q.copy()
+            nxt[creases[move]] = 0.0
+            # the new state itself first (segments assume valid endpoints), then the motion,
+            # at half the resolution straight away: the path needs no re-validation
+            if check.valid(nxt) and check.segment(q, nxt, fine):
+                is_open[move] = True
+                q = nxt  # a fresh array: frames may keep it
+                frames.append(q)
+                group = min(2 * len(move), len(todo))
+                break
+            if len(move) == 1:
+                fails[move[0]] += 1
+                retry_at[move[0]] = step + (1 << min(int(fails[move[0]]), 6))
+        else:
+            break
+    return frames, is_open
+
+
+def rrt_connect(check: ValidityChecker, start: np.ndarray, moving: np.ndarray, deadline: Deadline,
                  rng: np.random.Generator) -> list[np.ndarray] | None:
     """Continuous path from the valid state `start` to `start` with the edges `moving` at 0, by
     RRT-Connect (Kuffner & LaValle 2000) in the subspace of those edges; None when out of time.
@@ -174,11 +184,11 @@ def rrt_connect(check: ValidityChecker, start: np.ndarray, moving: np.ndarray, d
         return out
 
     t = 0
-    while time.perf_counter() < deadline:
+    while not deadline.expired():
         k, _ = extend(t, lo + rng.random(len(moving)) * (hi - lo))
         if k >= 0:
             x = nodes[t][k]
-            while time.perf_counter() < deadline:  # connect: the other tree steps towards x
+            while not deadline.expired():  # connect: the other tree steps towards x
                 j, reached = extend(1 - t, x)
                 if j < 0:
                     break

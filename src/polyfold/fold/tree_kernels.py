@@ -1,4 +1,4 @@
-"""numba kernels of `kinematics.fold_tree`: a FOLD net's edge table, crease tree and crease axes.
+"""numba kernels of `tree.build_tree`: a FOLD net's edge table, crease tree and crease axes.
 
 `net_tree` checks what fold_tree's one-line errors name, in the order fold_tree names them, and
 returns an error code with the indices the message needs (OK = 0, info -1 elsewhere); fold_tree
@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from ..mesh.geometry import fold_deg_to_rho
 
 OK = 0
 # faces
@@ -373,15 +375,14 @@ def extent(pts):
 def _fold_angle_errors(deg, kind, n_cut, mountain, valley, goal):
     """First non-cut edge (kind >= n_cut) whose fold angle deg (E,) is not within [-180, 180] (nan
     and inf included) or has the wrong sign for a mountain (<= 0) / valley (>= 0): (edge, out of
-    range), (-1, False) for none. Fills goal (E,): -radians(deg), 0 on the cut edges (np.radians
-    is x * (pi / 180) too: the same bits)."""
+    range), (-1, False) for none. Fills goal (E,): `fold_deg_to_rho(deg)`, 0 on the cut edges."""
     first = -1
     out_of_range = False
     for e in range(deg.shape[0]):
         if kind[e] < n_cut:
             goal[e] = 0.0
             continue
-        goal[e] = -(deg[e] * (np.pi / 180.0))
+        goal[e] = fold_deg_to_rho(deg[e])
         if first >= 0:
             continue
         d = deg[e]

@@ -1,7 +1,7 @@
 """FOLD 1.1 files: the canonical net format (https://github.com/edemaine/fold).
 
-`net_to_fold` turns the nets of all components of a mesh into one FOLD dict: the flat crease
-pattern (2D `vertices_coords`, outer side facing +z), `edges_assignment` B/M/V/F,
+`pattern_fold` writes a crease pattern (`unfold.pattern.crease_pattern` of the nets of all components
+of a mesh) as one FOLD dict: the flat crease pattern (2D `vertices_coords`, outer side facing +z), `edges_assignment` B/M/V/F,
 `edges_foldAngle` in degrees (valley positive, mountain negative: convex mesh edges are
 mountains), and a `foldedForm` frame holding the 3D position of every net vertex. Custom keys:
 `polyfold:faces_meshFace` (source face in the input file's face order), `polyfold:faces_piece`,
@@ -13,90 +13,27 @@ crease, -1 at the root of a piece), `polyfold:edges_meshEdge` (twin cut edges sh
 from __future__ import annotations
 
 import json
-import math
 import os
 from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
+from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
-from ..mesh.geometry import FLAT_EPS, vector_norm
-from ..unfold import pattern_kernels as FK
+from ..fold.tree import ASSIGNMENT_KIND, FoldTree, bbox_diagonal, build_tree, malformed_net
 from ..unfold.net import Net
+from ..unfold.pattern import CreasePattern, crease_pattern
+from .files import atomic_write
 
 if TYPE_CHECKING:
     from ..fold.plan import FoldPath
-PIECE_GAP = 0.05  # gap between packed pieces, as a fraction of the model's bounding-box diagonal
-_ASSIGNMENTS = ("B", "F", "M", "V")  # edges_assignment by kind: cut, flat, mountain, valley
+
+REQUIRED = ("vertices_coords", "faces_vertices", "edges_vertices", "edges_assignment")
 
 
-def _piece_offsets(lo: np.ndarray, hi: np.ndarray, gap: float) -> np.ndarray:
-    """Shelf-pack the pieces' bounding boxes (lo, hi (P, 2)): translation (P, 2) per piece."""
-    n_p = len(lo)
-    size = (hi - lo).tolist()
-    lo = lo.tolist()
-    # (the row width only matters once a shelf holds a piece: not for a single piece)
-    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5) if n_p > 1 else 0.0
-    offsets = [None] * n_p
-    x = y = shelf = 0.0
-    # a handful of pieces: plain Python over lists is cheaper than numpy here
-    for p in sorted(range(n_p), key=lambda i: -size[i][1]) if n_p > 1 else (0,):
-        w, h = size[p]
-        if x > 0 and x + w > row_width:
-            x, y, shelf = 0.0, y + shelf + gap, 0.0
-        offsets[p] = (x - lo[p][0], -(y + h) - lo[p][1])
-        x += w + gap
-        shelf = max(shelf, h)
-    return np.array(offsets)
-
-
-def _joined(parts: list[np.ndarray]) -> list:
-    """The parts (one per component) as one list (a single part is not copied first)."""
-    return (parts[0] if len(parts) == 1 else np.concatenate(parts)).tolist()
-
-
-def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | None = None) -> dict:
-    """FOLD dict of the nets of one mesh (one Net per component, each with one or more pieces)."""
-    # per net (numba): net vertices, numbered on from the previous nets', their 3D points, piece boxes
-    found = []
-    mv_off = 0
-    for n in nets:
-        found.append(FK.net_vertices(n.mesh.faces, n.parent, n.parent_edge, n.mesh.topology.edges, n.mesh.vertices,
-                                     n.coords, n.piece, mv_off))
-        mv_off += len(n.mesh.vertices)
-    # the net vertices' 3D points are the mesh's used vertices: their box is Mesh.bbox_diagonal's
-    scale = max(max(vector_norm(extent) for _, _, _, extent, _, _ in found), 1e-300)
-    # Pack all pieces of all components together, so the sheet has no overlaps between pieces either.
-    boxes = [(lo, hi) for *_, lo, hi in found]
-    lo, hi = boxes[0] if len(boxes) == 1 else (np.concatenate([b[0] for b in boxes]), np.concatenate([b[1] for b in boxes]))
-    offsets = _piece_offsets(lo, hi, PIECE_GAP * scale)
-    coords2d, coords3d, mesh_vertex = [], [], []
-    faces_v, faces_src, faces_piece, faces_comp, faces_parent = [], [], [], [], []
-    edges_v, edges_a, edges_ang, edges_mesh = [], [], [], []
-    v_off = f_off = p_off = e_off = 0
-    for c, (net, (corner_v, mv, folded, _, lo, _)) in enumerate(zip(nets, found)):
-        mesh = net.mesh
-        topo = mesh.topology
-        xy, fv, piece, parent, ev, em, angle, kind = FK.net_edges(
-            corner_v, len(mv), net.coords, offsets[p_off:p_off + len(lo)], net.piece, topo.face_edges, net.parent,
-            net.parent_edge, mesh.fold_angles, FLAT_EPS, v_off, f_off, p_off, e_off)
-        coords2d.append(xy)
-        coords3d.append(folded)
-        mesh_vertex.append(mv)
-        faces_v.append(fv)
-        faces_src.append(mesh.face_source)
-        faces_piece.append(piece)
-        faces_comp.extend([c] * mesh.n_faces)
-        faces_parent.append(parent)
-        edges_v.append(ev)
-        edges_a.extend(map(_ASSIGNMENTS.__getitem__, kind.tolist()))
-        edges_ang.append(angle)
-        edges_mesh.append(em)
-        v_off += len(mv)
-        f_off += mesh.n_faces
-        p_off += len(lo)
-        e_off += topo.n_edges
-    fold = {
+def pattern_fold(pattern: CreasePattern, *, creator: str = "polyfold", title: str | None = None) -> dict:
+    """The FOLD dict of a crease pattern (see the module docstring for the keys)."""
+    return {
         "file_spec": 1.1,
         "file_creator": creator,
         "file_classes": ["singleModel"],
@@ -104,33 +41,42 @@ def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | 
         "frame_classes": ["creasePattern"],
         "frame_attributes": ["2D"],
         "frame_unit": "unit",
-        "vertices_coords": _joined(coords2d),
-        "faces_vertices": _joined(faces_v),
-        "edges_vertices": _joined(edges_v),
-        "edges_assignment": edges_a,
-        "edges_foldAngle": _joined(edges_ang),
-        "polyfold:faces_meshFace": _joined(faces_src),
-        "polyfold:faces_piece": _joined(faces_piece),
-        "polyfold:faces_component": faces_comp,
-        "polyfold:faces_parent": _joined(faces_parent),
-        "polyfold:edges_meshEdge": _joined(edges_mesh),
-        "polyfold:vertices_meshVertex": _joined(mesh_vertex),
+        "vertices_coords": pattern.coords.tolist(),
+        "faces_vertices": pattern.faces.tolist(),
+        "edges_vertices": pattern.edges.tolist(),
+        "edges_assignment": pattern.assignments,
+        "edges_foldAngle": pattern.fold_deg.tolist(),
+        "polyfold:faces_meshFace": pattern.mesh_face.tolist(),
+        "polyfold:faces_piece": pattern.piece.tolist(),
+        "polyfold:faces_component": pattern.component.tolist(),
+        "polyfold:faces_parent": pattern.parent.tolist(),
+        "polyfold:edges_meshEdge": pattern.mesh_edge.tolist(),
+        "polyfold:vertices_meshVertex": pattern.mesh_vertex.tolist(),
         "file_frames": [
             {
                 "frame_classes": ["foldedForm"],
                 "frame_attributes": ["3D"],
                 "frame_inherit": True,
                 "frame_parent": 0,
-                "vertices_coords": _joined(coords3d),
+                "vertices_coords": pattern.folded.tolist(),
             }
         ],
     }
-    return fold
+
+
+def net_to_fold(nets: Sequence[Net], *, creator: str = "polyfold", title: str | None = None) -> dict:
+    """The FOLD dict of the nets of one mesh (one Net per component, each with one or more pieces)."""
+    return pattern_fold(crease_pattern(nets), creator=creator, title=title)
 
 
 def dumps(fold: dict) -> str:
     """FOLD JSON text (floats written with full precision)."""
     return json.dumps(fold, separators=(",", ":"))
+
+
+def write_fold(path: str | os.PathLike, fold: dict) -> None:
+    """Write a FOLD dict to `path` (atomically)."""
+    atomic_write(path, dumps(fold))
 
 
 def read_fold(path: str | os.PathLike) -> dict:
@@ -143,10 +89,154 @@ def read_fold(path: str | os.PathLike) -> dict:
         raise PolyfoldError(f"{name}: no such file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise PolyfoldError(f"{name}: not a readable FOLD (JSON) file: {exc}") from None
-    for key in ("vertices_coords", "faces_vertices", "edges_vertices", "edges_assignment"):
+    for key in REQUIRED:
         if key not in fold:
             raise PolyfoldError(f"{name}: FOLD file has no {key!r}")
     return fold
+
+
+# ----------------------------------------------------------------------------------------------
+# FOLD -> FoldTree
+
+
+def _int_array(fold: dict, key: str, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
+    try:
+        arr = np.asarray(fold[key])
+        if arr.size == 0:
+            arr = arr.reshape((0,) + shape_tail)
+        if arr.dtype == object or arr.ndim != 1 + len(shape_tail) or arr.shape[1:] != shape_tail:
+            raise ValueError
+        if arr.dtype != np.int64 and not np.issubdtype(arr.dtype, np.integer):  # (JSON ints: int64)
+            if not np.issubdtype(arr.dtype, np.floating) or not np.all(arr == np.round(arr)):
+                raise ValueError
+        return arr.astype(np.int64)
+    except (ValueError, TypeError):
+        raise malformed_net(f"{key!r} is not a list of {what}") from None
+
+
+def _float_array(value, key: str, n_cols: tuple[int, ...]) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (ValueError, TypeError):
+        raise malformed_net(f"{key!r} is not a list of coordinates") from None
+    if arr.ndim != 2 or arr.shape[1] not in n_cols:
+        raise malformed_net(f"{key!r} must hold {' or '.join(map(str, n_cols))} coordinates per vertex")
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = np.flatnonzero(~finite.all(axis=1))
+        raise malformed_net(f"{key!r}: vertex {bad[0]} has a non-finite coordinate")
+    return arr
+
+
+def _folded_coords(fold: dict, n_v: int) -> np.ndarray | None:
+    frames = fold.get("file_frames")
+    if not frames:
+        return None
+    frame = next((fr for fr in frames if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or [])), frames[0])
+    if not isinstance(frame, dict) or "vertices_coords" not in frame:
+        return None
+    coords = _float_array(frame["vertices_coords"], "file_frames[0].vertices_coords", (3,))
+    if len(coords) != n_v:
+        raise malformed_net(f"the foldedForm frame has {len(coords)} vertices, the net has {n_v}")
+    return coords
+
+
+def _check_triangles(rows) -> None:
+    """Every face is a sequence of 3 corners (before the corners themselves are parsed)."""
+    # the usual case (lists of 3-lists, as JSON gives) without a Python loop over the faces
+    if type(rows) is list and set(map(type, rows)) <= {list} and set(map(len, rows)) <= {3}:
+        return
+    for f, corners in enumerate(rows):
+        if not isinstance(corners, (list, tuple, np.ndarray)) or len(corners) != 3:
+            raise malformed_net(f"face {f} is not a triangle (only triangulated nets can be folded)")
+
+
+def _assignments(assign, n_e: int) -> np.ndarray:
+    """The kinds (E,) int8 (index into ASSIGNMENT_CODES) of the assignments (any case)."""
+    if not isinstance(assign, (list, tuple)) or len(assign) != n_e:
+        raise malformed_net(f"'edges_assignment' must have one entry per edge ({n_e})")
+    if set(map(type, assign)) <= {str}:
+        try:  # the usual case: all upper-case and known already
+            return np.fromiter(map(ASSIGNMENT_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
+        except KeyError:
+            pass
+    assign = [str(a).upper() for a in assign]
+    for e, a in enumerate(assign):
+        if a not in ASSIGNMENT_KIND:
+            raise malformed_net(f"edge {e} has unknown assignment {a!r}")
+    return np.fromiter(map(ASSIGNMENT_KIND.__getitem__, assign), dtype=np.int8, count=n_e)
+
+
+def _fold_angles(fold: dict, n_e: int) -> np.ndarray:
+    """'edges_foldAngle' as (E,) float64 degrees (values are checked by the kernel)."""
+    try:
+        deg = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
+    except (ValueError, TypeError):
+        raise malformed_net("'edges_foldAngle' is not a list of numbers") from None
+    if deg.shape != (n_e,):
+        raise malformed_net(f"'edges_foldAngle' has {deg.size} entries for {n_e} edges")
+    return deg
+
+
+def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
+    """The FoldTree of a FOLD net (as written by `pattern_fold`).
+
+    Uses `polyfold:faces_parent` when present, else a BFS over the crease (non-B) edges from the
+    lowest-index face of each piece. Raises PolyfoldError (one line naming the face / edge) when the
+    net cannot be folded: non-triangular faces, bad indices, clockwise faces, a parent that is not
+    joined by a crease, cycles, pieces inconsistent with the tree, zero-length creases, ...
+    The per-face work is `fold.tree.build_tree` (one numba kernel); so that it runs once, the later
+    inputs are parsed first and a parse error is raised where its check comes in this order.
+    """
+    if not isinstance(fold, dict):
+        raise malformed_net("not a FOLD dict")
+    for key in REQUIRED:
+        if key not in fold:
+            raise malformed_net(f"no {key!r}")
+    xy = _float_array(fold["vertices_coords"], "vertices_coords", (2, 3))
+    n_v = len(xy)
+    folded = _folded_coords(fold, n_v)
+    scale = bbox_diagonal(folded if folded is not None else xy)
+    if not scale > 0:
+        raise malformed_net("the net has zero size")
+    if xy.shape[1] == 3:
+        bad = np.flatnonzero(np.abs(xy[:, 2]) > 1e-9 * scale)
+        if len(bad):
+            raise malformed_net(f"vertex {bad[0]} of the crease pattern is not in the plane z = 0")
+        xy = np.ascontiguousarray(xy[:, :2])
+    _check_triangles(fold["faces_vertices"])
+    faces = _int_array(fold, "faces_vertices", (3,), "vertex triples")
+    n_f = len(faces)
+    if n_f == 0:
+        raise malformed_net("no faces")
+
+    # parsed ahead of their checks (errors kept for later): edges, then the tree, then fold angles
+    none = np.empty(0, dtype=np.int64)
+    edges, kind, parent_in, piece_in, deg = none.reshape(0, 2), none.astype(np.int8), none, none, np.empty(0)
+    stage, late = 1, None
+    try:
+        edges = _int_array(fold, "edges_vertices", (2,), "vertex pairs")
+        kind = _assignments(fold["edges_assignment"], len(edges))
+        stage = 2
+        if "polyfold:faces_piece" in fold:
+            piece_in = _int_array(fold, "polyfold:faces_piece", (), "integers")
+            if len(piece_in) != n_f:
+                raise malformed_net(f"'polyfold:faces_piece' has {len(piece_in)} entries for {n_f} faces")
+        if "polyfold:faces_parent" in fold:
+            parent_in = _int_array(fold, "polyfold:faces_parent", (), "integers")
+            if len(parent_in) != n_f:
+                raise malformed_net(f"'polyfold:faces_parent' has {len(parent_in)} entries for {n_f} faces")
+        stage = 3
+        if "edges_foldAngle" in fold:
+            deg = _fold_angles(fold, len(edges))
+            stage = 4
+    except Exception as exc:  # noqa: BLE001 (raised below, after the checks that come first)
+        late = exc
+    return build_tree(xy, faces, edges, kind, parent_in, piece_in, deg, folded, contact_tol, scale, stage, late)
+
+
+# ----------------------------------------------------------------------------------------------
+# Folding paths
 
 
 def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float) -> dict:

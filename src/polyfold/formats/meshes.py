@@ -11,13 +11,9 @@ import os
 
 import numpy as np
 
+from ..errors import PolyfoldError
 from ..mesh.repair import LoadedMesh, RawMesh, mesh_error, repair
-
-
-TEXT_FORMATS = {".obj", ".off"}
-
-
-TRIMESH_FORMATS = {".stl", ".ply", ".glb", ".gltf"}
+from .files import atomic_write
 
 
 def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
@@ -169,19 +165,23 @@ def _load_trimesh(path: str, name: str) -> RawMesh:
 
 def _read(path: str, name: str) -> RawMesh:
     ext = os.path.splitext(path)[1].lower()
-    if ext not in TEXT_FORMATS | TRIMESH_FORMATS:
-        known = ", ".join(sorted(TEXT_FORMATS | TRIMESH_FORMATS))
+    if ext not in READERS:
+        known = ", ".join(sorted(READERS))
         raise mesh_error(name, f"unknown format {ext or '(no extension)'!r} (expected one of {known})")
+    parse = READERS[ext]
     try:
         with open(path, "rb") as fh:
-            data = fh.read() if ext in TEXT_FORMATS else b""
+            data = fh.read() if parse is not None else b""
     except OSError as exc:
         raise mesh_error(name, f"cannot read: {exc.strerror or exc}") from None
-    if ext in TRIMESH_FORMATS:
+    if parse is None:
         return _load_trimesh(path, name)
     # Comments may hold any encoding; the data we need is ASCII.
-    text = data.decode("utf-8", errors="replace")
-    return _parse_obj(text, name) if ext == ".obj" else _parse_off(text, name)
+    return parse(data.decode("utf-8", errors="replace"), name)
+
+
+# The readers by file suffix: a text parser of ours, or None for trimesh's loader.
+READERS = {".obj": _parse_obj, ".off": _parse_off, ".stl": None, ".ply": None, ".glb": None, ".gltf": None}
 
 
 def obj_text(vertices: np.ndarray, faces: np.ndarray, header: list[str] | str = ()) -> str:
@@ -192,6 +192,49 @@ def obj_text(vertices: np.ndarray, faces: np.ndarray, header: list[str] | str = 
     lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, dtype=np.float64).tolist()]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.asarray(faces).tolist()]
     return "\n".join(lines) + "\n"
+
+
+def _obj(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+    return obj_text(vertices, faces, header).encode("utf-8")  # (OBJ has no standard face colours)
+
+
+def _trimesh_writer(file_type: str):
+    def write(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+        import trimesh
+
+        rgba = None if face_colors is None else np.concatenate(
+            [face_colors, np.full((len(face_colors), 1), 255, np.uint8)], axis=1)
+        if file_type == "glb" and rgba is not None:
+            # glTF has no face colours: every face gets its own corners, coloured as the face
+            tm = trimesh.Trimesh(vertices[faces].reshape(-1, 3), np.arange(3 * len(faces)).reshape(-1, 3),
+                                 vertex_colors=np.repeat(rgba, 3, axis=0), process=False)
+        else:
+            tm = trimesh.Trimesh(vertices, faces, face_colors=rgba, process=False)
+        return tm.export(file_type=file_type)
+    return write
+
+
+# The writers by file suffix: (vertices, faces, face colours (F, 3) uint8 or None, header lines) -> bytes.
+WRITERS = {".obj": _obj, ".ply": _trimesh_writer("ply"), ".glb": _trimesh_writer("glb"),
+           ".off": _trimesh_writer("off"), ".stl": _trimesh_writer("stl")}
+
+
+def mesh_bytes(suffix: str, vertices: np.ndarray, faces: np.ndarray, *, face_colors: np.ndarray | None = None,
+               header: list[str] | str = ()) -> bytes:
+    """A triangle mesh as the file a suffix names (.obj, .ply, .glb, .off, .stl); face colours are
+    kept where the format has them (PLY faces, GLB vertices)."""
+    writer = WRITERS.get(suffix.lower())
+    if writer is None:
+        raise PolyfoldError(f"cannot write {suffix or 'a file without suffix'!r} meshes: use one of {', '.join(WRITERS)}")
+    return writer(np.asarray(vertices, dtype=np.float64), np.asarray(faces), face_colors,
+                  [header] if isinstance(header, str) else list(header))
+
+
+def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, *,
+               face_colors: np.ndarray | None = None, header: list[str] | str = ()) -> None:
+    """Write a mesh file, its format by the path's suffix (`mesh_bytes`), atomically."""
+    atomic_write(path, mesh_bytes(os.path.splitext(os.fspath(path))[1], vertices, faces, face_colors=face_colors,
+                                  header=header))
 
 
 def load_mesh(path: str | os.PathLike) -> LoadedMesh:

@@ -3,7 +3,9 @@ angle sums, signed fold angles, concavity.
 
 Sign convention: faces are CCW seen from outside (outward normals). The signed fold angle `rho`
 of an edge is the angle between the normals of its two faces, positive on convex edges (mountains
-seen from outside), negative on reflex edges, 0 on flat ones.
+seen from outside), negative on reflex edges, 0 on flat ones. Every stage works in rho (radians);
+files use FOLD's fold angle (degrees, valley positive, mountain negative): `rho_to_fold_deg` and
+`fold_deg_to_rho` are the one place the sign flips.
 
 The floating-point results are bitwise those of the numpy formulas (see `kernels.py`): every stage
 must see the same bits.
@@ -15,6 +17,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from . import kernels as MK
 
@@ -24,6 +27,21 @@ if TYPE_CHECKING:
 
 HYPERBOLIC_EPS = 1e-9  # hyperbolic vertex: angle sum > 2 pi + HYPERBOLIC_EPS
 FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F" in FOLD, not scored on sheets)
+
+
+@njit(cache=True)
+def rho_to_fold_deg(rho):
+    """FOLD fold angle (degrees, valley positive) of signed fold angles rho (radians, + = convex =
+    mountain); a scalar or an array, in Python or inside kernels. x * (180 / pi) is how
+    np.degrees rounds: the same bits."""
+    return -(rho * (180.0 / np.pi))
+
+
+@njit(cache=True)
+def fold_deg_to_rho(deg):
+    """Signed fold angle rho (radians, + = mountain) of FOLD fold angles in degrees (valley
+    positive); the inverse of `rho_to_fold_deg` (np.radians rounds as x * (pi / 180))."""
+    return -(deg * (np.pi / 180.0))
 
 
 def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

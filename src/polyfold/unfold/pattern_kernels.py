@@ -1,13 +1,15 @@
-"""numba kernels of `foldfile.net_to_fold`: net vertices, piece boxes and net edges of one Net.
+"""numba kernels of `pattern.crease_pattern`: net vertices, piece boxes and net edges of one Net.
 
-Exact operations only (gathers, sums of two numbers, min / max, and x * (180 / pi), which is how
-np.degrees rounds), so the FOLD dict is bitwise the one numpy's formulas gave.
+Exact operations only (gathers, sums of two numbers, min / max, and `rho_to_fold_deg`, which
+rounds as np.degrees), so the pattern is bitwise the one numpy's formulas gave.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from ..mesh.geometry import rho_to_fold_deg
 
 
 @njit(cache=True)
@@ -171,6 +173,6 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
         if crease[e]:
             kind[j] = 1 if abs(r) < flat_eps else (2 if r > 0 else 3)
         if kind[j] >= 2:
-            angle[j] = -(r * (180.0 / np.pi))
+            angle[j] = rho_to_fold_deg(r)
         j += 1
     return xy, faces, piece_out, parent_out, ev, em, angle, kind

@@ -1,0 +1,105 @@
+"""make's export stage: the make folder, written through formats/ into a staged folder and moved
+in at the end (report.json last, so it marks a finished run).
+
+The folder: sheets.pdf (all pages), sheet-NN.svg and sheet-NN.dxf per page, part-K.obj per part,
+piece-X.fold per piece (net, folding path, source faces), assembly.json, instructions.html and
+report.json. Files of an earlier run that this run does not produce are removed (they would be
+mistaken for this run's).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from ..fabricate.layout import page_of
+from ..fabricate.page import Page
+from ..formats.dxf import dxf_document
+from ..formats.files import StagedFolder
+from ..formats.fold import dumps, pattern_fold, with_path
+from ..formats.meshes import obj_text
+from ..formats.pdf import pdf_bytes
+from ..formats.svg import svg_page_string
+from ..mesh.mesh import Mesh
+from .folding import FoldedPiece
+from .instructions import instructions_html
+from .options import FOOTER_MM, MakeOptions
+from .parts import Part
+from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, PieceReport
+from .sheets import Sheets
+
+STALE = ("sheet-*.svg", "sheet-*.dxf", "piece-*.fold", "part-*.obj")
+
+
+def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
+    """One `Page` per sheet, with its footer line."""
+    n_pages = sheets.packing.n_pages
+    on_page = sheets.page_of_piece()
+    footer_y = sheets.height - opts.margin - FOOTER_MM / 2
+    return [page_of([p for i, p in enumerate(sheets.pieces) if on_page[i] == k], sheets.width, sheets.height,
+                    f"{name} - sheet {k + 1}/{n_pages} - {opts.size:g} mm - polyfold", footer_y)
+            for k in range(n_pages)]
+
+
+def piece_fold(fp: FoldedPiece, piece_name: str, model: str, opts: MakeOptions) -> dict:
+    """The FOLD document of one piece: its net, its folding path (when verified), its source faces."""
+    fold = pattern_fold(fp.pattern, title=f"part {fp.part} piece")
+    if fp.path is not None:
+        fold = with_path(fold, fp.path, opts.resolution_deg, opts.contact_tol)
+    fold["file_title"] = f"{model} piece {piece_name} (part {fp.part})"
+    fold["polyfold:faces_wholeMeshFace"] = [int(x) for x in fp.mesh_faces]
+    return fold
+
+
+def piece_reports(folded: list[FoldedPiece], sheets: Sheets) -> tuple[PieceReport, ...]:
+    """report.json's row of every piece."""
+    pages = sheets.page_of_piece()
+    return tuple(PieceReport(piece=p.name, part=fp.part, faces=int(len(fp.fids)), page=pages[i] + 1,
+                             fold_file=f"piece-{p.name}.fold", path_verified=fp.info.path, linear=fp.info.linear,
+                             planner=fp.info.planner, path_seconds=fp.info.seconds, frames=fp.info.frames,
+                             note=fp.info.note)
+                 for i, (fp, p) in enumerate(zip(folded, sheets.pieces)))
+
+
+def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
+             rows: tuple[PieceReport, ...]) -> Assembly:
+    """assembly.json: parts, pieces and glue pairs."""
+    pieces = sheets.pieces
+    return Assembly(
+        model=model, size_mm=opts.size, paper=opts.paper, pages=sheets.packing.n_pages,
+        parts=tuple(AssemblyPart(part=k, faces=int(len(part.faces)), obj=f"part-{k}.obj",
+                                 pieces=tuple(p.name for p in pieces if p.part == k)) for k, part in enumerate(parts)),
+        pieces=tuple(AssemblyPiece(piece=r.piece, part=r.part, page=r.page, fold=r.fold_file) for r in rows),
+        glue=tuple(GlueRow(label=g.label, pieces=(pieces[g.pieces[0]].name, pieces[g.pieces[1]].name),
+                           between_parts=pieces[g.pieces[0]].part != pieces[g.pieces[1]].part,
+                           tab_on=pieces[g.tab_piece].name if g.tab_piece is not None else None,
+                           mesh_vertices=tuple(int(v) for v in g.mesh_edge)) for g in sheets.glue))
+
+
+def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],
+                      folded: list[FoldedPiece], sheets: Sheets,
+                      finish: Callable[[tuple[PieceReport, ...], list[str]], MakeReport]
+                      ) -> tuple[tuple[str, ...], MakeReport]:
+    """Write the make folder (see the module docstring); return the file names, in the order
+    written, and the report. finish(piece rows, outputs so far) gives the report, written last."""
+    pages = sheet_pages(sheets, model, opts)
+    with StagedFolder(out_dir, "make") as stage:
+        stage.write("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))
+        svgs = []
+        for k, page in enumerate(pages):
+            svgs.append(f"sheet-{k + 1:02d}.svg")
+            stage.write(svgs[-1], svg_page_string(page))
+            dxf_document(page).saveas(stage.path(f"sheet-{k + 1:02d}.dxf"))
+        for k, part in enumerate(parts):
+            sub = mesh.submesh(part.faces)
+            stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
+        rows = piece_reports(folded, sheets)
+        for fp, piece, row in zip(folded, sheets.pieces, rows):
+            stage.write(row.fold_file, dumps(piece_fold(fp, piece.name, model, opts)))
+        stage.write("assembly.json", assembly(model, opts, parts, sheets, rows).to_json())
+        stage.write("instructions.html", instructions_html(
+            model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),
+            sheets.packing.n_pages, opts, svgs))
+        report = finish(rows, list(stage.names))
+        stage.write("report.json", report.to_json())
+        return stage.commit(stale=STALE), report

@@ -1,0 +1,241 @@
+"""A `polyfold make` output folder, read back: `load_folder` -> `MakeFolder`.
+
+In: the folder (assembly.json, report.json, part-K.obj, piece-X.fold). Out: the parts as meshes,
+the whole model (the parts welded back together), and every piece ready to be posed along its
+folding path (`ViewPiece.pose`: face corners in the model frame at a fraction t of the path). The
+viewer draws it; tests and scripts use it without a browser. `make_folder` runs make, then reads
+the result.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..errors import PolyfoldError
+from ..fold.tree import FoldTree, fold_positions
+from ..formats.fold import fold_tree, read_fold
+from ..mesh.geometry import fold_deg_to_rho, rho_to_fold_deg
+from ..mesh.mesh import Mesh
+from ..mesh.repair import LoadedMesh
+from .options import MakeOptions
+from .report import Assembly, MakeReport
+
+
+@dataclass(frozen=True, eq=False)
+class ViewPiece:
+    """One piece of a make folder, ready to animate.
+
+    fold: its FOLD dict; tree: `fold_tree(fold)`; frames (K, E): `polyfold:path` (FOLD degrees,
+    valley positive), None when the piece has no verified path (it is then shown folded only);
+    rotation (P, 3, 3) / translation (P, 3): per FOLD piece, the rigid motion (Kabsch fit of the
+    goal pose onto the foldedForm) that puts the folded net onto the model; fit_error: largest
+    corner distance between the aligned goal pose and the foldedForm, in model units (nan
+    without a foldedForm frame).
+    """
+
+    name: str
+    part: int
+    fold: dict
+    tree: FoldTree
+    frames: np.ndarray | None
+    rotation: np.ndarray
+    translation: np.ndarray
+    fit_error: float
+
+    @property
+    def verified(self) -> bool:
+        return self.frames is not None
+
+    def pose(self, t: float) -> np.ndarray:
+        """Face corners (F, 3, 3) in the model frame at fraction t in [0, 1] of the folding path
+        (0 flat, 1 folded onto the model). Without a path the piece stays folded."""
+        deg = _goal_degrees(self.fold, self.tree) if self.frames is None else path_degrees(self.frames, t)
+        corners = fold_positions(self.tree, fold_deg_to_rho(deg))
+        piece = self.tree.piece
+        return np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
+
+
+@dataclass(frozen=True, eq=False)
+class MakeFolder:
+    """A `polyfold make` output folder: parts (in part order), pieces (in assembly order), the
+    whole model (the parts welded back together), the model's file name and the make options of
+    report.json (None when there is no readable report)."""
+
+    path: Path
+    model: str
+    parts: tuple[Mesh, ...]
+    pieces: tuple[ViewPiece, ...]
+    whole: Mesh
+    options: MakeOptions | None
+
+
+def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
+    """FOLD angles (E,) in degrees at fraction t of a path (K, E): linear between consecutive
+    frames, every segment the same share of t."""
+    frames = np.asarray(frames, dtype=np.float64)
+    t = min(1.0, max(0.0, float(t)))
+    if len(frames) == 1:
+        return frames[0].copy()
+    s = t * (len(frames) - 1)
+    i = min(int(math.floor(s)), len(frames) - 2)
+    u = s - i
+    return (1.0 - u) * frames[i] + u * frames[i + 1]
+
+
+def _goal_degrees(fold: dict, tree: FoldTree) -> np.ndarray:
+    path = fold.get("polyfold:path")
+    if path:
+        return np.asarray(path[-1], dtype=np.float64)
+    angles = fold.get("edges_foldAngle")
+    if angles is None:  # no angles in the file: the tree's own goal (rho radians)
+        return rho_to_fold_deg(tree.goal)
+    return np.asarray(angles, dtype=np.float64)
+
+
+def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation R and translation t minimising |R p + t - q| over the rows (a proper rotation)."""
+    cp, cq = p.mean(axis=0), q.mean(axis=0)
+    u, _, vt = np.linalg.svd((p - cp).T @ (q - cq))
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return r, cq - r @ cp
+
+
+def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
+    """A ViewPiece of a FOLD dict: builds the fold tree, checks the path and fits the rigid motion
+    that lands the goal pose on the foldedForm (fold_positions keeps each root face flat)."""
+    tree = fold_tree(fold)
+    frames = None
+    if fold.get("polyfold:path"):
+        frames = np.asarray(fold["polyfold:path"], dtype=np.float64)
+        if frames.ndim != 2 or frames.shape[1] != tree.n_edges:
+            raise PolyfoldError(f"piece {name}: polyfold:path frames must have one angle per edge ({tree.n_edges})")
+    elif tree.n_faces == 1:
+        frames = np.zeros((2, tree.n_edges))  # a single face is trivially foldable
+    goal = fold_positions(tree, fold_deg_to_rho(_goal_degrees(fold, tree)))
+    n_p = int(tree.piece.max()) + 1
+    rotation = np.repeat(np.eye(3)[None], n_p, axis=0)
+    translation = np.zeros((n_p, 3))
+    fit_error = float("nan")
+    if tree.folded is not None:
+        target = tree.folded[tree.faces]
+        fit_error = 0.0
+        for k in range(n_p):
+            on = tree.piece == k
+            if not on.any():
+                continue
+            r, t = _kabsch(goal[on].reshape(-1, 3), target[on].reshape(-1, 3))
+            rotation[k], translation[k] = r, t
+            moved = goal[on] @ r.T + t
+            fit_error = max(fit_error, float(np.abs(moved - target[on]).max()))
+    return ViewPiece(name=name, part=part, fold=fold, tree=tree, frames=frames, rotation=rotation,
+                     translation=translation, fit_error=fit_error)
+
+
+def pose_piece(fold: dict, t: float) -> np.ndarray:
+    """Face corners (F, 3, 3) of a FOLD piece in the model frame at fraction t of its folding
+    path (see `ViewPiece.pose`; prepare the piece once with `prepare_piece` to pose it often)."""
+    return prepare_piece(fold).pose(t)
+
+
+def weld_parts(parts: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
+    """The whole model from its parts: vertices at the same position become one (make writes
+    them bit-exact). When that would join more than two faces at an edge (the input had split a
+    non-manifold vertex) the parts are kept side by side instead."""
+    verts = np.concatenate([p.vertices for p in parts])
+    offsets = np.cumsum([0] + [p.n_vertices for p in parts])[:-1]
+    faces = np.concatenate([p.faces + o for p, o in zip(parts, offsets)])
+    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
+    welded = Mesh(uniq, inverse.reshape(-1)[faces])
+    if (welded.topology.face_count > 2).any():
+        return Mesh(verts, faces)
+    return welded
+
+
+def _read_obj(path: Path) -> Mesh:
+    """The OBJ files make writes (v / f lines, triangles): read them exactly, without repairs."""
+    verts, faces = [], []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        tok = line.split()
+        if not tok:
+            continue
+        if tok[0] == "v":
+            verts.append([float(x) for x in tok[1:4]])
+        elif tok[0] == "f":
+            faces.append([int(x.split("/")[0]) - 1 for x in tok[1:4]])
+    v, f = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if len(f) == 0 or f.min() < 0 or f.max() >= len(v):
+        raise PolyfoldError(f"{path.name}: not a usable part mesh (no faces or bad vertex indices)")
+    return Mesh(v, f)
+
+
+def _inside(root: Path, name: str) -> Path:
+    """root / name for a plain file name from assembly.json, refusing anything that leaves root."""
+    if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
+        raise PolyfoldError(f"{root.name}/assembly.json: bad file name {name!r}")
+    return root / name
+
+
+def _read_assembly(root: Path) -> Assembly:
+    path = root / "assembly.json"
+    if not path.is_file():
+        raise PolyfoldError(f"{root}: not a `polyfold make` output folder (no assembly.json)")
+    try:
+        assembly = Assembly.from_dict(json.loads(path.read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise PolyfoldError(f"{path}: not a readable assembly file ({type(exc).__name__}: {exc})") from None
+    if not assembly.parts:
+        raise PolyfoldError(f"{path}: no parts")
+    return assembly
+
+
+def _read_options(root: Path) -> MakeOptions | None:
+    """The make options of report.json; None when there is no readable report of this version."""
+    try:
+        return MakeReport.from_dict(json.loads((root / "report.json").read_text(encoding="utf-8"))).options
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+
+
+def load_folder(path: str | Path) -> MakeFolder:
+    """Read a `polyfold make` output folder. Raises PolyfoldError (one line) when it is not one."""
+    root = Path(path)
+    if not root.is_dir():
+        raise PolyfoldError(f"{root}: no such folder")
+    assembly = _read_assembly(root)
+    parts = []
+    for row in assembly.parts:
+        f = _inside(root, row.obj)
+        if not f.is_file():
+            raise PolyfoldError(f"{root}: {row.obj} is missing")
+        parts.append(_read_obj(f))
+    pieces = []
+    for row in assembly.pieces:
+        if not 0 <= row.part < len(parts):
+            raise PolyfoldError(f"{root / 'assembly.json'}: piece {row.piece} belongs to part {row.part}, "
+                                "which does not exist")
+        fold = read_fold(_inside(root, row.fold))
+        try:
+            pieces.append(prepare_piece(fold, row.piece, row.part))
+        except PolyfoldError as exc:
+            raise PolyfoldError(f"{row.fold}: {exc}") from None
+        except (ValueError, TypeError, KeyError, IndexError) as exc:  # malformed values in the JSON
+            raise PolyfoldError(f"{row.fold}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
+    return MakeFolder(path=root, model=assembly.model or root.name, parts=tuple(parts), pieces=tuple(pieces),
+                      whole=weld_parts(parts), options=_read_options(root))
+
+
+def make_folder(source: str | Path | Mesh | LoadedMesh, out_dir: str | Path, opts: MakeOptions | None = None,
+                progress: Callable[[str, str], None] | None = None, *, name: str | None = None) -> MakeFolder:
+    """Run make on a mesh (a file, or in memory named `name`) into out_dir and read the result back
+    (the MESH form of `polyfold view`, and the viewer's Make button)."""
+    from .make import make
+
+    make(source, out_dir, opts or MakeOptions(), progress, name=name)
+    return load_folder(out_dir)

@@ -1,0 +1,127 @@
+"""make's fold stage: a verified folding path for every piece.
+
+A piece without a path in its time share is split in two (fewer faces always fold more easily)
+and both halves are planned again, at most MAX_SPLITS times per piece.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..deadline import Deadline
+from ..errors import PolyfoldError
+from ..fold.plan import FoldPath, plan_fold
+from ..fold.tree import FoldTree, collides
+from ..unfold.net import Net, balanced_cut, cut_creases, piece_net
+from ..unfold.pattern import CreasePattern, crease_pattern
+from .options import MakeOptions
+from .parts import Part
+from .report import FoldReport
+
+FOLD_BUDGET_S = 3.0  # planning time per piece before it is split: this + per face
+FOLD_BUDGET_PER_FACE_S = 0.03
+MAX_SPLITS = 3  # halvings of one piece at most
+
+
+@dataclass(frozen=True)
+class PathInfo:
+    """What the report says about a piece's path (`path` is whether one was found and verified)."""
+
+    path: bool = False
+    linear: bool | None = None
+    planner: str | None = None
+    seconds: float = 0.0
+    frames: int = 0
+    note: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class FoldedPiece:
+    """One piece: its part, the part's faces (ids into the mesh), the piece as a single-piece net,
+    its faces in the part (fids: ids into the part's faces), its crease pattern, its folding path
+    (None when there is none or folding was not asked for) and the facts for the report."""
+
+    part: int
+    part_faces: np.ndarray
+    net: Net
+    fids: np.ndarray
+    pattern: CreasePattern
+    path: FoldPath | None
+    info: PathInfo = field(default_factory=PathInfo)
+
+    @property
+    def mesh_faces(self) -> np.ndarray:
+        """The piece's faces as ids into the whole mesh."""
+        return self.part_faces[self.fids]
+
+
+class _Planner:
+    """The fold stage's state: pieces still to plan (for the time shares), splits, results."""
+
+    def __init__(self, opts: MakeOptions, deadline: Deadline, n_parts: int, pending: int,
+                 say: Callable[[str, str], None]) -> None:
+        self.opts, self.deadline, self.n_parts, self.say = opts, deadline, n_parts, say
+        self.pending = pending
+        self.splits = 0
+        self.results: list[FoldedPiece] = []
+
+    def plan(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, depth: int) -> None:
+        """Plan one single-piece net (fids: its faces in the part); split and recurse on failure."""
+        opts = self.opts
+        pattern = crease_pattern([pnet])
+        path, info = None, PathInfo()
+        if pnet.mesh.n_faces == 1:
+            info = PathInfo(path=True, linear=True, planner="trivial", note="single face")
+        elif opts.fold:
+            self.say("fold", f"part {pi + 1}/{self.n_parts}: planning a path for {pnet.mesh.n_faces} faces")
+            tf = time.perf_counter()
+            tree = FoldTree.from_pattern(pattern, opts.contact_tol)
+            note = ""
+            if collides(tree, tree.goal):
+                note = "the folded shape itself intersects (input geometry); no path can exist"
+            else:
+                # a short budget, then split: two halves usually fold at once, while a hard
+                # piece can eat the whole time limit
+                share = max(0.5, min(self.deadline.left() / max(1, self.pending),
+                                     FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
+                try:
+                    path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
+                except PolyfoldError as exc:
+                    path, note = None, str(exc)
+                if path is None and depth < MAX_SPLITS and self.deadline.left() > 0:
+                    self.say("fold", f"no path in {share:.1f} s: split the piece in two")
+                    self._split(pi, faces, pnet, fids, depth)
+                    return
+                if path is None and not note:
+                    note = "no path within the time limit"
+            seconds = time.perf_counter() - tf
+            info = PathInfo(note=note, seconds=seconds) if path is None else PathInfo(
+                path=True, linear=bool(path.linear), planner=path.planner, seconds=seconds, frames=len(path.frames))
+        self.pending -= 1
+        self.results.append(FoldedPiece(pi, faces, pnet, fids, pattern, path, info))
+
+    def _split(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, depth: int) -> None:
+        halves = cut_creases(pnet, np.array([balanced_cut(pnet, 0)]))
+        self.splits += 1
+        self.pending += 1
+        for h in range(2):
+            sub, sub_fids = piece_net(halves, h)
+            self.plan(pi, faces, sub, fids[sub_fids], depth + 1)
+
+
+def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline,
+                say: Callable[[str, str], None]) -> tuple[list[FoldedPiece], FoldReport]:
+    """Every piece of every part's net, with its folding path (see the module docstring)."""
+    t0 = time.perf_counter()
+    planner = _Planner(opts, deadline, len(parts), sum(p.net.n_pieces for p in parts), say)
+    for pi, part in enumerate(parts):
+        for k in range(part.net.n_pieces):
+            planner.plan(pi, part.faces, *piece_net(part.net, k), 0)
+    results = planner.results
+    report = FoldReport(enabled=opts.fold, seconds=time.perf_counter() - t0, splits_for_folding=planner.splits,
+                        verified=sum(r.info.path for r in results), pieces=len(results))
+    return results, report

@@ -1,0 +1,67 @@
+"""What `make` is asked to do: `MakeOptions`, the paper sizes, and the checks every front end
+(command line, batch, viewer) runs before any work. Light: no numpy, the CLI imports it at start.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from ..collide.tolerance import CONTACT_TOL
+from ..errors import PolyfoldError
+
+PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
+INFLATE_MODES = ("none", "constrained", "uniform")
+SEGMENT_MODES = ("auto", "none")
+FOOTER_MM = 6.0  # strip at the bottom of the printable area for the page footer
+GAP_MM = 3.0  # minimum distance between pieces on a page (room for scissors)
+
+
+@dataclass(frozen=True)
+class MakeOptions:
+    """Options of `make` (the command line's `polyfold make` options, one for one)."""
+
+    inflate: str = "none"  # none | constrained | uniform
+    segment: str = "auto"  # auto | none (ignored when tau or parts is given)
+    tau: float | None = None
+    parts: int | None = None
+    paper: str = "a4"
+    size: float = 150.0  # longest dimension of the built model, mm
+    margin: float = 10.0
+    tabs: bool = True
+    seed: int = 1
+    time_limit: float = 60.0
+    fold: bool = True  # plan and verify a folding path per piece
+    contact_tol: float = CONTACT_TOL
+    resolution_deg: float = 1.0
+
+
+def paper_size(spec: str) -> tuple[float, float]:
+    """'a4' | 'letter' | 'a3' | '12x12in' | 'WxHmm' (e.g. '200x300mm') -> (width, height) in mm."""
+    key = spec.strip().lower()
+    if key in PAPERS:
+        return PAPERS[key]
+    m = re.fullmatch(r"(\d+(?:\.\d+)?)x(\d+(?:\.\d+)?)(mm|in)", key)
+    if not m:
+        raise PolyfoldError(f"unknown paper {spec!r}: use a4, letter, a3, 12x12in or WxHmm (e.g. 200x300mm)")
+    f = 25.4 if m.group(3) == "in" else 1.0
+    w, h = float(m.group(1)) * f, float(m.group(2)) * f
+    if not (w > 0 and h > 0):
+        raise PolyfoldError(f"paper {spec!r} has zero size")
+    return w, h
+
+
+def check_options(opts: MakeOptions) -> tuple[float, float]:
+    """PolyfoldError (one line) for options make would reject on every mesh; else the page size
+    (width, height) in mm."""
+    if opts.inflate not in INFLATE_MODES:
+        raise PolyfoldError(f"--inflate must be none, constrained or uniform, not {opts.inflate!r}")
+    if opts.segment not in SEGMENT_MODES:
+        raise PolyfoldError(f"--segment must be auto or none, not {opts.segment!r}")
+    if not (opts.size > 0 and math.isfinite(opts.size)):
+        raise PolyfoldError(f"--size must be a positive number of mm, not {opts.size}")
+    width, height = paper_size(opts.paper)
+    if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
+        raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")
+    return width, height

@@ -1,0 +1,126 @@
+"""From a mesh to nets: which faces make a part, and the net of every part.
+
+`make_parts` is make's segment + unfold stage: with `--tau` / `--parts` the mesh is segmented
+first; with `--segment auto` every connected component stays whole when it has a single-piece net
+(found within its share of half the time limit) and is segmented otherwise. `unfold_components`
+is the `unfold` command's: every component unfolded in its share of the time left.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..deadline import Deadline
+from ..errors import NoNetFound
+from ..mesh.mesh import Mesh, face_components
+from ..segment.segment import DEFAULT_TAU, segment
+from ..unfold.net import Net
+from ..unfold.search import UnfoldStats, unfold
+from .options import MakeOptions
+from .report import NetReport, SegmentReport, UnfoldReport
+
+MIN_UNFOLD_S = 0.5  # the least time a part's search gets, however little is left
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """A part of the mesh (faces: ids into the mesh, ascending or in segmentation order) and its net."""
+
+    faces: np.ndarray
+    net: Net
+
+
+def component_faces(mesh: Mesh) -> tuple[np.ndarray, list[np.ndarray]]:
+    """(component label of every face, the face ids of every edge-connected component)."""
+    comp = face_components(mesh.n_faces, mesh.topology)
+    return comp, [np.flatnonzero(comp == c) for c in range(int(comp.max()) + 1)]
+
+
+class _Segmenter:
+    """Segmentations of sets of faces of one mesh, and what they add up to for the report."""
+
+    def __init__(self, mesh: Mesh) -> None:
+        self.mesh = mesh
+        self.seconds = 0.0
+        self.tau: float | None = None
+        self.concavity: list[float] = []
+
+    def __call__(self, faces: np.ndarray, tau: float | None, parts: int | None) -> list[np.ndarray]:
+        ts = time.perf_counter()
+        seg = segment(self.mesh.submesh(faces), tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=0)
+        self.seconds += time.perf_counter() - ts
+        self.tau = seg.tau
+        self.concavity += [float(c) for c in seg.concavity]
+        return [faces[f] for f in seg.face_ids]
+
+
+def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline,
+               say: Callable[[str, str], None]) -> tuple[list[Part], SegmentReport, UnfoldReport]:
+    """The parts of the mesh with their nets (see the module docstring), and the stage reports."""
+    comp, components = component_faces(mesh)
+    explicit = opts.tau is not None or opts.parts is not None
+    mode = "tau" if opts.tau is not None else "parts" if opts.parts is not None else opts.segment
+    segmenter = _Segmenter(mesh)
+    segmented: list[int] = []
+    nets: list[NetReport] = []
+    unfold_s = 0.0
+    budget = max(1.0, 0.5 * opts.time_limit)  # unfolding gets at most half the time limit
+    if explicit:
+        say("segment", f"segmenting ({mode})")
+        todo = segmenter(np.arange(mesh.n_faces), opts.tau, opts.parts)
+    else:
+        todo = list(components)
+    out: list[Part] = []
+    while todo:
+        faces = todo.pop(0)
+        part_mesh = mesh.submesh(faces)
+        left = max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
+        say("unfold", f"part {len(out) + 1}: {len(faces)} faces")
+        tu = time.perf_counter()
+        try:
+            single = mode == "auto" and len(faces) > 1
+            net, st = unfold(part_mesh, seed=opts.seed, time_limit=left, max_pieces=1 if single else None)
+        except NoNetFound:
+            # auto: no single net for this component in time -> split it into nearly convex parts
+            unfold_s += time.perf_counter() - tu
+            say("segment", f"no single net for a {len(faces)}-face component: segmenting it")
+            segmented.append(int(comp[faces[0]]))
+            subs = segmenter(faces, None, None)
+            if len(subs) == 1:  # already nearly convex: accept several pieces instead
+                net, st = unfold(part_mesh, seed=opts.seed, time_limit=left)
+            else:
+                todo = subs + todo
+                continue
+        unfold_s += time.perf_counter() - tu
+        nets.append(NetReport(faces=int(len(faces)), pieces=int(net.n_pieces), seconds=st.seconds, method=st.method,
+                              timed_out=bool(st.timed_out)))
+        out.append(Part(faces, net))
+    tau = segmenter.tau if explicit else (DEFAULT_TAU if segmented else None)
+    seg_report = SegmentReport(mode=mode, tau=tau, parts=len(out), concavity=tuple(segmenter.concavity),
+                               seconds=segmenter.seconds, segmented_components=tuple(segmented))
+    return out, seg_report, UnfoldReport(seconds=unfold_s, nets=tuple(nets))
+
+
+def unfold_components(components: list[Mesh] | tuple[Mesh, ...], *, method: str = "auto", seed: int = 1,
+                      deadline: Deadline, max_pieces: int | None = None,
+                      progress: Callable[[int, int, float], None] | None = None,
+                      accept: Callable[[Net], bool] | None = None) -> list[tuple[Net, UnfoldStats]]:
+    """Unfold every component (seed + i for component i) in its share of the time left.
+
+    progress(component, generation, best fitness); accept: see `unfold.search.unfold`. Raises
+    NoNetFound naming the component (when there are several) if max_pieces=1 cannot be met."""
+    out = []
+    for i, comp in enumerate(components):
+        share = deadline.left() / (len(components) - i)  # what is left, shared among the components still to do
+        label = f"component {i + 1}/{len(components)} " if len(components) > 1 else ""
+        report = None if progress is None else (lambda gen, best, _i=i: progress(_i, gen, best))
+        try:
+            out.append(unfold(comp, method=method, seed=seed + i, time_limit=share, max_pieces=max_pieces,
+                              progress=report, accept=accept))
+        except NoNetFound as exc:
+            raise NoNetFound(f"{label}{exc}") from None
+    return out

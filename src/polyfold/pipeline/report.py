@@ -1,0 +1,287 @@
+"""The two documents of a make folder, as types: `MakeReport` (report.json) and `Assembly`
+(assembly.json). `make` writes them, the viewer and batch read them back through `from_dict`,
+so the keys live here only (the README documents them).
+
+`to_json` gives the files' exact text (key order = field order). `from_dict` raises ValueError
+(with the offending key) on a document of another layout: callers treat that as "not a finished
+make of this version".
+"""
+
+from __future__ import annotations
+
+import json
+import types
+import typing
+from dataclasses import MISSING, dataclass, fields, is_dataclass
+
+import numpy as np
+
+from .options import MakeOptions
+
+REPORT_VERSION = 1
+
+
+# ----------------------------------------------------------------------------------------------
+# report.json
+
+
+@dataclass(frozen=True)
+class InputReport:
+    file: str
+    faces: int
+    vertices: int
+    components: int
+    warnings: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class LoadReport:
+    seconds: float
+
+
+@dataclass(frozen=True)
+class InflateReport:
+    """mode "none": only mode and seconds are written."""
+
+    mode: str
+    seconds: float
+    steps: int | None = None
+    stop_reason: str | None = None
+    hyperbolic_before: int | None = None
+    hyperbolic_after: int | None = None
+    inflation_rate: float | None = None
+    notes: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class SegmentReport:
+    mode: str
+    tau: float | None
+    parts: int
+    concavity: tuple[float, ...]
+    seconds: float
+    segmented_components: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class NetReport:
+    faces: int
+    pieces: int
+    seconds: float
+    method: str
+    timed_out: bool
+
+
+@dataclass(frozen=True)
+class UnfoldReport:
+    seconds: float
+    nets: tuple[NetReport, ...]
+
+
+@dataclass(frozen=True)
+class FoldReport:
+    enabled: bool
+    seconds: float
+    splits_for_folding: int
+    verified: int
+    pieces: int
+
+
+@dataclass(frozen=True)
+class LayoutReport:
+    seconds: float
+    scale_mm_per_unit: float
+    paper: str
+    page_mm: tuple[float, float]
+    margin_mm: float
+    pages: int
+    utilisation: float
+    splits_for_page: int
+    glue_edges: int
+    tabs: int
+    tabs_shrunk: int
+    tabs_moved: int
+    untabbed_edges: tuple[str, ...]
+    small_labels: int
+    open_edges: int
+
+
+@dataclass(frozen=True)
+class ExportReport:
+    seconds: float
+    pages: int
+
+
+@dataclass(frozen=True)
+class StageReports:
+    load: LoadReport
+    inflate: InflateReport
+    segment: SegmentReport
+    unfold: UnfoldReport
+    fold: FoldReport
+    layout: LayoutReport
+    export: ExportReport
+
+
+@dataclass(frozen=True)
+class PieceReport:
+    piece: str
+    part: int
+    faces: int
+    page: int  # 1-based
+    fold_file: str
+    path_verified: bool
+    linear: bool | None
+    planner: str | None
+    path_seconds: float
+    frames: int
+    note: str
+
+
+@dataclass(frozen=True)
+class ChecksReport:
+    seconds: float
+    page_overlaps: int
+    net_overlaps: int
+    tab_overlaps: int
+    outside_margins: int
+    problems: tuple[str, ...]
+    paths_verified: int
+    pieces: int
+    untabbed_edges: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class MakeReport:
+    """report.json. polyfold_report: REPORT_VERSION."""
+
+    input: InputReport
+    options: MakeOptions
+    stages: StageReports
+    pieces: tuple[PieceReport, ...]
+    checks: ChecksReport
+    outputs: tuple[str, ...]
+    seconds: float
+    polyfold_report: int = REPORT_VERSION
+
+    def to_dict(self) -> dict:
+        d = _plain(self)
+        d = {"polyfold_report": d.pop("polyfold_report"), **d}
+        if self.stages.inflate.mode == "none":
+            d["stages"]["inflate"] = {"mode": "none", "seconds": self.stages.inflate.seconds}
+        return d
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=1) + "\n"
+
+    @classmethod
+    def from_dict(cls, data: dict) -> MakeReport:
+        if not isinstance(data, dict) or data.get("polyfold_report") != REPORT_VERSION:
+            raise ValueError("not a polyfold make report of this version")
+        return _build(cls, data, "report")
+
+
+# ----------------------------------------------------------------------------------------------
+# assembly.json
+
+
+@dataclass(frozen=True)
+class AssemblyPart:
+    part: int
+    faces: int
+    obj: str
+    pieces: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class AssemblyPiece:
+    piece: str
+    part: int
+    page: int  # 1-based
+    fold: str
+
+
+@dataclass(frozen=True)
+class GlueRow:
+    """Two cut edges glued together: their label, the two pieces, whether they join two parts,
+    the piece whose side carries the tab (None: no tab fits), the mesh edge's two vertices."""
+
+    label: str
+    pieces: tuple[str, str]
+    between_parts: bool
+    tab_on: str | None
+    mesh_vertices: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """assembly.json: what the pieces are, where they go, what glues to what."""
+
+    model: str
+    size_mm: float
+    paper: str
+    pages: int
+    parts: tuple[AssemblyPart, ...]
+    pieces: tuple[AssemblyPiece, ...]
+    glue: tuple[GlueRow, ...]
+
+    def to_json(self) -> str:
+        return json.dumps(_plain(self), indent=1) + "\n"
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Assembly:
+        return _build(cls, data, "assembly")
+
+
+# ----------------------------------------------------------------------------------------------
+# (de)serialisation
+
+
+def _plain(obj):
+    """JSON-ready value of a report dataclass (numpy scalars as Python numbers)."""
+    if is_dataclass(obj):
+        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj)}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return obj
+
+
+def _build(cls, data, where: str):
+    """An instance of dataclass `cls` from its JSON dict (nested dataclasses and tuples by the
+    field types); ValueError naming the key when something is missing or of the wrong kind."""
+    if not isinstance(data, dict):
+        raise ValueError(f"{where}: expected an object")
+    hints = typing.get_type_hints(cls)
+    kw = {}
+    for f in fields(cls):
+        if f.name in data:
+            kw[f.name] = _value(hints[f.name], data[f.name], f"{where}.{f.name}")
+        elif f.default is MISSING:
+            raise ValueError(f"{where}: no {f.name!r}")
+    return cls(**kw)
+
+
+def _value(tp, value, where: str):
+    """`value` (from JSON) as type `tp`: X | None, tuple[X, ...], tuple[X, Y], a dataclass, or a
+    plain int / float / str / bool."""
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        if value is None and type(None) in typing.get_args(tp):
+            return None
+        (tp,) = [a for a in typing.get_args(tp) if a is not type(None)]
+    if is_dataclass(tp):
+        return _build(tp, value, where)
+    if typing.get_origin(tp) is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, list) or (args[-1] is not Ellipsis and len(value) != len(args)):
+            raise ValueError(f"{where}: expected a list of {len(args) if args[-1] is not Ellipsis else 'any'} values")
+        items = [args[0]] * len(value) if args[-1] is Ellipsis else args
+        return tuple(_value(t, v, f"{where}[{k}]") for k, (t, v) in enumerate(zip(items, value)))
+    if tp is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if not isinstance(value, tp) or (tp is int and isinstance(value, bool)):
+        raise ValueError(f"{where}: expected {tp.__name__}, got {type(value).__name__}")
+    return value
