@@ -49,7 +49,7 @@ def test_help() -> None:
 
 
 def test_cli_import_is_light() -> None:
-    code = "import sys, polyfold.apps.cli; print(any(m in sys.modules for m in ('numba', 'trimesh', 'scipy')))"
+    code = "import sys, polyfold.apps.cli.app; print(any(m in sys.modules for m in ('numba', 'trimesh', 'scipy')))"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "False"

@@ -1,6 +1,6 @@
 """`python -m polyfold`: the command line (`apps/cli.py`)."""
 
-from .apps.cli import main
+from .apps.cli.app import main
 
 if __name__ == "__main__":
     main()

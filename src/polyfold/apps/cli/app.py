@@ -1,0 +1,72 @@
+"""The typer app behind `polyfold`: one-line errors, exit codes, and the entry point `main`."""
+
+from __future__ import annotations
+
+import sys
+from functools import wraps
+from pathlib import Path
+
+import typer
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="Turn 3D triangle meshes into verified paper nets (FOLD, SVG, PNG).",
+)
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks against the paper.")
+app.add_typer(bench_app, name="bench")
+
+
+def say(line: str) -> None:
+    """One line on stderr, prefixed `polyfold:`."""
+    print(f"polyfold: {line}", file=sys.stderr, flush=True)
+
+
+def fail(message: str, code: int) -> None:
+    """One error line on stderr, then exit with `code`."""
+    say(f"error: {message}")
+    raise typer.Exit(code)
+
+
+def guard(func):
+    """Run a command body; turn known errors into one line + exit code, never a traceback."""
+
+    @wraps(func)
+    def wrapper(*args, **kwargs):
+        from ...errors import PolyfoldError
+
+        try:
+            return func(*args, **kwargs)
+        except PolyfoldError as exc:
+            fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__, exc.exit_code)
+        except KeyboardInterrupt:
+            fail("interrupted", 130)
+        except typer.Exit:
+            raise
+        except Exception as exc:  # last resort: still one line, no traceback
+            fail(f"internal error ({type(exc).__name__}): {str(exc).splitlines()[0] if str(exc) else ''}", 3)
+
+    return wrapper
+
+
+def load(path: Path, quiet: bool = False):
+    """The mesh file, loaded and repaired; a warning line per repair unless quiet."""
+    from ...formats.meshes import load_mesh
+
+    loaded = load_mesh(path)
+    if not quiet:
+        for w in loaded.warnings:
+            say(f"warning: {path.name}: {w}")
+    return loaded
+
+
+def main() -> None:
+    app()
+
+
+# The verbs register themselves on `app` when imported, in this order: --help lists them in the
+# order of the pipeline.
+from . import mesh_commands  # noqa: E402,F401,I001
+from . import net_commands  # noqa: E402,F401,I001
+from . import make_commands  # noqa: E402,F401,I001

@@ -1,0 +1,77 @@
+"""Command-line options shared by several verbs: declared once, checked once, turned into
+`MakeOptions` once; their defaults are the API's (`MakeOptions`, `CONTACT_TOL`). Only light
+modules are imported here (start-up stays fast)."""
+
+from __future__ import annotations
+
+import contextlib
+from enum import Enum
+from typing import Callable, Iterator, Optional
+
+import typer
+
+from ...collide.tolerance import CONTACT_TOL
+from ...pipeline.options import MakeOptions
+
+_D = MakeOptions()
+
+
+class Planner(str, Enum):
+    auto = "auto"
+    linear = "linear"
+    sequential = "sequential"
+    lazy_prm = "lazy-prm"
+
+
+def contact_tol_option() -> typer.models.OptionInfo:
+    return typer.Option(CONTACT_TOL, "--contact-tol", min=0.0,
+                        help="Faces closer than this (fraction of the model size) touch rather than cross.")
+
+
+INFLATE = typer.Option(_D.inflate, "--inflate", help="none | constrained | uniform: inflate the mesh first (paper Sec. 3).")
+SEGMENT = typer.Option(_D.segment, "--segment", help="auto (one part per component unless no single net is found) | none.")
+TAU = typer.Option(None, "--tau", min=0.0, help="Segment into parts of concavity <= tau (fraction of the bbox diagonal).")
+PARTS = typer.Option(None, "--parts", min=1, help="Segment into this many parts.")
+PAPER = typer.Option(_D.paper, "--paper", help="a4 | letter | a3 | 12x12in | WxHmm.")
+SIZE = typer.Option(_D.size, "--size", min=1e-6, help="Longest dimension of the built model, mm.")
+MARGIN = typer.Option(_D.margin, "--margin", min=0.0, help="Page margin, mm.")
+TABS = typer.Option("auto", "--tabs", help="auto (glue tabs where they fit) | none.")
+FOLD = typer.Option(_D.fold, "--fold/--no-fold", help="Plan and verify a folding path for every piece.")
+CONTACT_TOL_OPTION = contact_tol_option()
+
+
+def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str, tau: Optional[float],
+                 parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
+                 time_limit: float, fold: bool, contact_tol: float) -> MakeOptions:
+    """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
+    if tau is not None and parts is not None:
+        fail("give --tau or --parts, not both", 2)
+    if tabs not in ("auto", "none"):
+        fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
+    return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
+                       margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
+                       contact_tol=contact_tol)
+
+
+@contextlib.contextmanager
+def make_progress(say: Callable[[str], None], quiet: bool, title: str) -> Iterator[Callable[[str, str], None] | None]:
+    """The progress(stage, message) of a make run: a live status line on a terminal, else one
+    stderr line per stage; None when quiet."""
+    if quiet:
+        yield None
+        return
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    if console.is_terminal:
+        with console.status(title) as status:
+            yield lambda stage, msg: status.update(f"[bold]{stage}[/bold]: {msg}")
+        return
+    last = [None]
+
+    def progress(stage: str, msg: str) -> None:
+        if stage != last[0]:
+            say(f"{stage}: {msg}")
+            last[0] = stage
+
+    yield progress
