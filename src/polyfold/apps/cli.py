@@ -210,15 +210,17 @@ def unfold(
         path_note += ", linearly foldable" if lc else ", no linearly foldable net found in time"
     atomic_write(output, dumps(fold_dict))
     if svg is not None or png is not None:
-        from ..formats.sheet import sheet_layout, write_png, write_svg
+        from ..fabricate.sheet import net_sheet
+        from ..formats.png import write_page_png
+        from ..formats.svg import write_svg_page
 
+        sheet = net_sheet(nets, size, labels=labels, tabs=tabs, title=mesh.name)
         if svg is not None:
-            layout = sheet_layout(fold_dict, size)
-            if layout.oversize and not quiet:
-                _say(f"warning: sheet is {layout.width:.0f} x {layout.height:.0f} mm, larger than 300 x 300 mm; lower --size")
-            write_svg(fold_dict, svg, size_mm=size, labels=labels, tabs=tabs)
+            if sheet.oversize and not quiet:
+                _say(f"warning: sheet is {sheet.page.width:.0f} x {sheet.page.height:.0f} mm, larger than 300 x 300 mm; lower --size")
+            write_svg_page(sheet.page, svg)
         if png is not None:
-            write_png(fold_dict, png)
+            write_page_png(sheet.page, png)
     pieces = sum(s.pieces for s in stats)
     gens = sum(s.generations for s in stats)
     methods = ",".join(sorted({s.method for s in stats}))

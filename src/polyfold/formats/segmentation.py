@@ -36,7 +36,8 @@ def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces:
 
     import trimesh
 
-    from .raster import part_colors, write_mesh_png
+    from .png import write_mesh_png
+    from .raster import part_colors
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -226,56 +226,6 @@ def _fold_pieces(parts: list, opts: MakeOptions, clock: _Clock, say) -> tuple[li
     return results, report
 
 
-def _check_pages(placed: list, page_index: list[int], n_pages: int, width: float, height: float,
-                 margin: float, gap: float) -> dict:
-    """Independent checks of the final sheets (shapely), on the placed geometry: no two pieces
-    (with their tabs) overlap or come closer than `gap`, no two faces of a piece overlap, no tab
-    overlaps a face or another tab, every outline and label lies inside the margins (height is the
-    area available to pieces). Returns counts per kind and the problems as text."""
-    import shapely
-    from shapely.geometry import Polygon, box
-
-    from ..fabricate.layout import OVERLAP_MM2
-
-    counts = {"page_overlaps": 0, "net_overlaps": 0, "tab_overlaps": 0, "outside_margins": 0}
-    problems: list[str] = []
-    inner = box(margin, margin, width - margin, height - margin).buffer(1e-6)
-    for page in range(n_pages):
-        on = [p for i, p in enumerate(placed) if page_index[i] == page]
-        outlines = [p.outline for p in on]
-        for a in range(len(on)):
-            for b in range(a + 1, len(on)):
-                if outlines[a].distance(outlines[b]) < gap - 1e-6:
-                    counts["page_overlaps"] += 1
-                    problems.append(f"page {page + 1}: pieces {on[a].name} and {on[b].name} overlap or touch")
-        for p in on:
-            if not inner.contains(p.outline):
-                counts["outside_margins"] += 1
-                problems.append(f"page {page + 1}: piece {p.name} crosses the margin")
-            tris = shapely.polygons(p.faces_xy)
-            i, j = shapely.STRtree(tris).query(tris, predicate="intersects")
-            keep = i < j
-            if keep.any():
-                bad = int((shapely.area(shapely.intersection(tris[i[keep]], tris[j[keep]])) > OVERLAP_MM2).sum())
-                if bad:
-                    counts["net_overlaps"] += bad
-                    problems.append(f"piece {p.name}: {bad} overlapping face pairs")
-            tabs = [Polygon(t) for t in p.tabs]
-            for k, t in enumerate(tabs):
-                if shapely.area(shapely.intersection(t, p.body)) > OVERLAP_MM2:
-                    counts["tab_overlaps"] += 1
-                    problems.append(f"piece {p.name}: a tab overlaps a face")
-                for u in tabs[k + 1:]:
-                    if shapely.area(shapely.intersection(t, u)) > OVERLAP_MM2:
-                        counts["tab_overlaps"] += 1
-                        problems.append(f"piece {p.name}: two tabs overlap")
-            for t in p.texts:
-                if not (margin <= t.x <= width - margin and margin <= t.y <= height - margin):
-                    counts["outside_margins"] += 1
-                    problems.append(f"page {page + 1}: a label of piece {p.name} lies outside the margins")
-    return {**counts, "problems": problems}
-
-
 # ----------------------------------------------------------------------------------------------
 # Outputs
 
@@ -283,7 +233,8 @@ def _check_pages(placed: list, page_index: list[int], n_pages: int, width: float
 def _png_b64(mesh, part_faces: list[np.ndarray], highlight: int | None) -> str:
     import base64
 
-    from ..formats.raster import part_colors, png_bytes, render_mesh
+    from ..formats.png import png_bytes
+    from ..formats.raster import part_colors, render_mesh
 
     colors = np.full((mesh.n_faces, 3), 215, dtype=np.uint8)
     pal = part_colors(len(part_faces))
@@ -358,8 +309,11 @@ def make(mesh_path: str | os.PathLike, out_dir: str | os.PathLike, opts: MakeOpt
     written) on bad input, a piece too large for the paper, or a failed sheet check."""
     from ..formats.fold import dumps
     from ..formats.meshes import load_mesh, obj_text
-    from ..fabricate.layout import build_sheet_pieces, page_of, PieceInput, PieceTooLarge, place, split_to_fit
+    from ..fabricate.check import check_pages
+    from ..fabricate.fit import PieceTooLarge, split_to_fit
     from ..fabricate.pack import pack_outlines
+    from ..fabricate.page import page_of, place
+    from ..fabricate.pieces import build_sheet_pieces, piece_input
     from ..formats.dxf import dxf_document
     from ..formats.pdf import pdf_bytes
     from ..formats.svg import svg_page_string
@@ -415,12 +369,7 @@ def make(mesh_path: str | os.PathLike, out_dir: str | os.PathLike, opts: MakeOpt
 
     tl = time.perf_counter()
     say("layout", f"tabs and labels for {len(folded)} pieces")
-    inputs = []
-    for pi, faces, pnet, fids, _, _ in folded:
-        part_mesh_faces = mesh.faces[faces]
-        part_vertices = np.unique(part_mesh_faces)
-        piece_part_vertices = np.unique(np.searchsorted(part_vertices, part_mesh_faces[fids]))
-        inputs.append(PieceInput(net=pnet, part=pi, vertex_ids=part_vertices[piece_part_vertices], face_ids=faces[fids]))
+    inputs = [piece_input(pnet, pi, mesh.faces[faces[fids]], faces[fids]) for pi, faces, pnet, fids, _, _ in folded]
     pieces, glue, lstats = build_sheet_pieces(inputs, scale, tabs=opts.tabs)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     outlines = [p.outline for p in pieces]
@@ -431,8 +380,8 @@ def make(mesh_path: str | os.PathLike, out_dir: str | os.PathLike, opts: MakeOpt
 
     say("check", "checking every page")
     tc = time.perf_counter()
-    checks = _check_pages(placed, [pl.page for pl in packing.placements], packing.n_pages, width,
-                          height - FOOTER_MM, opts.margin, GAP_MM)
+    checks = check_pages(placed, [pl.page for pl in packing.placements], packing.n_pages, width,
+                         height - FOOTER_MM, opts.margin, GAP_MM)
     problems = checks["problems"]
     report["checks"] = {"seconds": time.perf_counter() - tc, **checks,
                         "paths_verified": report["stages"]["fold"]["verified"], "pieces": len(pieces),
