@@ -50,9 +50,10 @@ FAULT_ENV = "POLYFOLD_BATCH_FAULT"
 SCHEDULER_ENV = "POLYFOLD_SCHEDULER"
 # imported once by the forkserver, so each task process starts with them loaded (saves ~1 s each)
 PRELOAD = ("polyfold.apps.batch", "polyfold.pipeline.make", "polyfold.formats.meshes", "polyfold.unfold.search",
-           "polyfold.fold.plan", "polyfold.fold.tree", "polyfold.formats.fold", "polyfold.fabricate.layout",
-           "polyfold.fabricate.pack", "polyfold.formats.svg", "polyfold.formats.pdf", "polyfold.formats.dxf",
-           "polyfold.segment.segment", "polyfold.formats.raster")
+           "polyfold.fold.plan", "polyfold.fold.tree", "polyfold.formats.fold", "polyfold.fabricate.pieces",
+           "polyfold.fabricate.fit", "polyfold.fabricate.check", "polyfold.fabricate.pack", "polyfold.formats.svg",
+           "polyfold.formats.pdf", "polyfold.formats.dxf", "polyfold.segment.segment", "polyfold.formats.raster",
+           "polyfold.formats.png")
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,11 @@
 """Fabrication: pieces on paper, in millimetres (the one sheet pipeline of make and unfold --svg).
 
-    layout.py     pieces in mm: cut outline, scored creases, glue tabs, labels; splitting to fit a page
-    pack.py       packing pieces onto pages by their real outlines
-    page.py       the sheet model (`Page`, `TextItem`) the writers of formats/ draw
+    pieces.py     nets' pieces in mm (`build_sheet_pieces`): outline, scored creases, cut edges paired for gluing
+    tabs.py       the glue tab of a glued edge (`choose_tab`): which side, which trapezoid
+    labels.py     glue labels beside cut edges, piece names and their labels
+    fit.py        splitting a net until every piece fits a page (`split_to_fit`, `PieceTooLarge`)
+    pack.py       packing pieces onto pages by their real outlines; shelves
+    page.py       the sheet model (`Page`, `TextItem`) the writers of formats/ draw; `place`, `page_of`
+    check.py      independent shapely checks of finished pages (`check_pages`)
+    sheet.py      one sheet for a whole net, as `polyfold unfold --svg/--png` draws it (`net_sheet`)
 """

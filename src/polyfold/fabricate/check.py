@@ -1,21 +1,21 @@
-"""Independent checks of finished sheets (shapely, on the placed geometry), run before anything
-is written: pieces apart, no face over a face, no tab over a face or a tab, everything inside the
-margins."""
+"""Independent checks of finished sheets (shapely, on the placed geometry), before anything is
+written: pieces apart, no overlapping faces or tabs, everything inside the margins."""
 
 from __future__ import annotations
 
-import shapely
-from shapely.geometry import Polygon, box
-
-from .layout import OVERLAP_MM2
+from .pieces import SheetPiece
+from .tabs import OVERLAP_MM2
 
 
-def check_pages(placed: list, page_index: list[int], n_pages: int, width: float, height: float,
-                 margin: float, gap: float) -> dict:
+def check_pages(placed: list[SheetPiece], page_index: list[int], n_pages: int, width: float, height: float,
+                margin: float, gap: float) -> dict:
     """Independent checks of the final sheets (shapely), on the placed geometry: no two pieces
     (with their tabs) overlap or come closer than `gap`, no two faces of a piece overlap, no tab
     overlaps a face or another tab, every outline and label lies inside the margins (height is the
     area available to pieces). Returns counts per kind and the problems as text."""
+    import shapely
+    from shapely.geometry import Polygon, box
+
     counts = {"page_overlaps": 0, "net_overlaps": 0, "tab_overlaps": 0, "outside_margins": 0}
     problems: list[str] = []
     inner = box(margin, margin, width - margin, height - margin).buffer(1e-6)

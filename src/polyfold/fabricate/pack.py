@@ -14,12 +14,16 @@ cell are therefore at least ``gap`` apart, exactly; the result is nevertheless r
 shapely (`check_packing`) before it is returned. The scan over positions is a numba kernel that
 checks a piece row by row as runs of cells against a "last occupied column" table and jumps past
 the obstacle it hits, so no loop visits every cell.
+
+`shelf_offsets` puts bounding boxes on plain shelves: the fallback when the time budget runs out,
+and the layout of the one sheet of `polyfold unfold --svg` (`sheet.py`).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +33,7 @@ from shapely import MultiPolygon, Polygon
 
 from ..errors import PolyfoldError
 
+GAP_MM = 3.0  # minimum distance between pieces on a page, tabs included (room for scissors)
 _CELLS = 600  # grid cells along the long printable side: ~0.46 mm on A4
 _QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
 _TOL = 1e-9  # mm: float noise allowed by check_packing
@@ -339,36 +344,141 @@ def _best_on_page(page: _Page, piece: _Piece, res: float) -> tuple[_Shape, int, 
 
 
 # ----------------------------------------------------------------------------------------------
-# fallbacks
+# shelves (the fallback, and sheets that grow to fit)
+
+
+def shelf_offsets(sizes: Sequence[Sequence[float]], width: float, height: float,
+                  gap: float) -> list[tuple[int, float, float]]:
+    """Boxes `sizes` (n, 2) = (width, height) mm on shelves: tallest first (ties in input order),
+    left to right in rows no wider than `width` (a box wider than that gets a row of its own),
+    boxes and rows `gap` apart, a new page when a row would pass `height`. Returns (page, x, y) of
+    each box's min corner, relative to the printable area, in input order."""
+    order = sorted(range(len(sizes)), key=lambda j: (-sizes[j][1], j))
+    out: list[tuple[int, float, float]] = [(0, 0.0, 0.0)] * len(sizes)
+    page, x, y, shelf_h = 0, 0.0, 0.0, 0.0
+    for j in order:
+        bw, bh = sizes[j]
+        if x > 0 and x + bw > width:
+            x, y, shelf_h = 0.0, y + shelf_h + gap, 0.0
+        if y > 0 and y + bh > height:
+            page, x, y, shelf_h = page + 1, 0.0, 0.0, 0.0
+        out[j] = (page, x, y)
+        x, shelf_h = x + bw + gap, max(shelf_h, bh)
+    return out
 
 
 def _shelf(items: list[tuple[int, _Piece]], pw: float, ph: float, margin: float, gap: float, first_page: int) -> dict[int, Placement]:
     """Bounding-box shelf packing onto new pages from `first_page` on: quick and always valid,
     used for what is left when the time budget runs out. Each piece takes its flattest rotation."""
-    boxes = []
-    for i, p in items:
+    items = sorted(items, key=lambda item: item[0])  # ties between equal heights go by piece index
+    rots, sizes = [], []
+    for _, p in items:
         ext = p.hi - p.lo
         with np.errstate(divide="ignore"):
             scale = np.minimum(pw / ext[:, 0], ph / ext[:, 1])
         ok = np.flatnonzero(scale >= 1.0 - 1e-12)  # as in pack_outlines: some rotation fits
         k = int(ok[np.argmin(ext[ok, 1])])
-        boxes.append((float(ext[k, 1]), float(ext[k, 0]), i, k, p))
-    boxes.sort(key=lambda b: (-b[0], b[2]))
+        rots.append(k)
+        sizes.append((float(ext[k, 0]), float(ext[k, 1])))
     out: dict[int, Placement] = {}
-    page, x, y, shelf_h = first_page, 0.0, 0.0, 0.0
-    for bh, bw, i, k, p in boxes:
-        if x > 0 and x + bw > pw:
-            x, y, shelf_h = 0.0, y + shelf_h + gap, 0.0
-        if y > 0 and y + bh > ph:
-            page, x, y, shelf_h = page + 1, 0.0, 0.0, 0.0
+    for (i, p), k, (page, x, y) in zip(items, rots, shelf_offsets(sizes, pw, ph, gap)):
         lo = p.lo[k]
-        out[i] = Placement(page, float(p.degs[k]), (margin + x - lo[0], margin + y - lo[1]))
-        x, shelf_h = x + bw + gap, max(shelf_h, bh)
+        out[i] = Placement(first_page + page, float(p.degs[k]), (margin + x - lo[0], margin + y - lo[1]))
     return out
 
 
 # ----------------------------------------------------------------------------------------------
-# public
+# the bottom-left fill
+
+
+@dataclass(frozen=True)
+class _Grid:
+    """The occupancy grid of a page: cells of `res` mm, pieces grown by `grow` mm (`pad` cells),
+    gh x gw cells; the printable area pw x ph mm inside `margin`."""
+
+    res: float
+    grow: float
+    pad: int
+    gh: int
+    gw: int
+    pw: float
+    ph: float
+    margin: float
+
+
+def _grid(pw: float, ph: float, margin: float, gap: float) -> _Grid:
+    res = max(pw, ph) / _CELLS
+    # grow each piece by half the gap plus half a cell diagonal, and by 1/cos(half an arc segment)
+    # because shapely's arcs are chords inside the true circle: the grown polygon then contains
+    # every cell that the half-gap-grown piece touches (see the module docstring)
+    grow = (gap / 2 + res * math.sqrt(0.5)) / math.cos(math.pi / (4 * _QUAD_SEGS)) + 1e-6
+    pad = math.ceil(grow / res)
+    return _Grid(res, grow, pad, math.ceil(ph / res) + 2 * pad + 2, math.ceil(pw / res) + 2 * pad + 2, pw, ph, margin)
+
+
+def _pieces(geoms: list, angles: int, phase: float, grid: _Grid, W: float, H: float) -> list[_Piece]:
+    """A `_Piece` per outline with the rotations to try; PolyfoldError if one fits in none."""
+    pw, ph, margin = grid.pw, grid.ph, grid.margin
+    pieces = []
+    for i, g in enumerate(geoms):
+        xy = shapely.get_coordinates(g)
+        degs = _angles(g, angles, phase)
+        if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too
+            degs = np.append(degs, _best_fit(xy, _angles(g, angles, 0.0), pw, ph)[1])
+        scale, _ = _best_fit(xy, degs, pw, ph)
+        if scale < 1.0 - 1e-12:  # float noise of the rotation; check_packing allows 1e-9 mm
+            raise PolyfoldError(
+                f"piece {i} does not fit a {W:g} x {H:g} mm page with {margin:g} mm margins; "
+                f"the largest scale that fits is {math.floor(scale * 1000) / 1000:.3f}"
+            )
+        pieces.append(_Piece(g, degs, grid.grow, grid.res, grid.pad, pw, ph))
+    return pieces
+
+
+def _place_alone(p: _Piece, page: _Page, pg: int, grid: _Grid) -> Placement:
+    """A piece that fits exactly but not on the conservative grid: alone in the middle of its new
+    page, with its grown raster stamped so later pieces can still use the rest of the page."""
+    res, pad, margin = grid.res, grid.pad, grid.margin
+    _, a = _best_fit(p.xy, p.degs, grid.pw, grid.ph)
+    lo, hi = _extents(p.xy, np.array([a]))
+    off = np.array([margin, margin]) + (np.array([grid.pw, grid.ph]) - (hi[0] - lo[0])) / 2 - lo[0]
+    origin = margin - pad * res
+    rot = _rot(a).T
+    mask = _raster((p.p0 @ rot + off - origin) / res, (p.p1 @ rot + off - origin) / res, grid.gh, grid.gw)
+    page.stamp(mask, 0, 0)
+    return Placement(pg, a, (off[0], off[1]))
+
+
+def _fill_pages(pieces: list[_Piece], order: list[int], grid: _Grid, gap: float,
+                deadline: float) -> dict[int, Placement]:
+    """First-fit decreasing over pages in `order`; shelves for the rest once `deadline` passed."""
+    res, margin = grid.res, grid.margin
+    pages: list[_Page] = []
+    place: dict[int, Placement] = {}
+    for n_done, i in enumerate(order):
+        p, hit, pg = pieces[i], None, len(pages)
+        for pg, page in enumerate(pages):  # first fit: the first open page that takes the piece
+            if time.perf_counter() > deadline:
+                break
+            hit = _best_on_page(page, p, res)
+            if hit is not None:
+                break
+        if hit is None and time.perf_counter() > deadline:
+            # out of time: shelves on new pages for this piece and the rest (valid, quick)
+            rest = [(int(j), pieces[j]) for j in order[n_done:]]
+            place.update(_shelf(rest, grid.pw, grid.ph, margin, gap, len(pages)))
+            break
+        if hit is None:
+            pg, page = len(pages), _Page(grid.gh, grid.gw)
+            pages.append(page)
+            hit = _best_on_page(page, p, res)
+        if hit is None:
+            place[i] = _place_alone(p, page, pg, grid)
+            continue
+        s, y, x = hit
+        page.stamp(s.mask, y, x)
+        place[i] = Placement(pg, s.angle, (margin + x * res - s.lo[0], margin + y * res - s.lo[1]))
+    return place
 
 
 def pack_outlines(
@@ -397,66 +507,11 @@ def pack_outlines(
         raise PolyfoldError(f"page {W:g} x {H:g} mm has no printable area inside {margin:g} mm margins")
     rng = np.random.default_rng(seed)
     phase = 0.0 if seed == 0 else float(rng.uniform(0.0, 360.0 / max(angles, 1)))
-
-    res = max(pw, ph) / _CELLS
-    # grow each piece by half the gap plus half a cell diagonal, and by 1/cos(half an arc segment)
-    # because shapely's arcs are chords inside the true circle: the grown polygon then contains
-    # every cell that the half-gap-grown piece touches (see the module docstring)
-    grow = (gap / 2 + res * math.sqrt(0.5)) / math.cos(math.pi / (4 * _QUAD_SEGS)) + 1e-6
-    pad = math.ceil(grow / res)
-    gh, gw = math.ceil(ph / res) + 2 * pad + 2, math.ceil(pw / res) + 2 * pad + 2
-
-    pieces = []
-    for i, g in enumerate(geoms):
-        xy = shapely.get_coordinates(g)
-        degs = _angles(g, angles, phase)
-        if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too
-            degs = np.append(degs, _best_fit(xy, _angles(g, angles, 0.0), pw, ph)[1])
-        scale, _ = _best_fit(xy, degs, pw, ph)
-        if scale < 1.0 - 1e-12:  # float noise of the rotation; check_packing allows 1e-9 mm
-            raise PolyfoldError(
-                f"piece {i} does not fit a {W:g} x {H:g} mm page with {margin:g} mm margins; "
-                f"the largest scale that fits is {math.floor(scale * 1000) / 1000:.3f}"
-            )
-        pieces.append(_Piece(g, degs, grow, res, pad, pw, ph))
-
+    grid = _grid(pw, ph, margin, gap)
+    pieces = _pieces(geoms, angles, phase, grid, W, H)
     areas = np.array([p.area for p in pieces])
     order = np.lexsort((rng.random(len(pieces)), -areas))  # larger first, seeded ties
-    pages: list[_Page] = []
-    place: dict[int, Placement] = {}
-    deadline = t0 + time_limit
-    for n_done, i in enumerate(order.tolist()):
-        p, hit, pg = pieces[i], None, len(pages)
-        for pg, page in enumerate(pages):  # first fit: the first open page that takes the piece
-            if time.perf_counter() > deadline:
-                break
-            hit = _best_on_page(page, p, res)
-            if hit is not None:
-                break
-        if hit is None and time.perf_counter() > deadline:
-            # out of time: shelves on new pages for this piece and the rest (valid, quick)
-            rest = [(int(j), pieces[j]) for j in order[n_done:]]
-            place.update(_shelf(rest, pw, ph, margin, gap, len(pages)))
-            break
-        if hit is None:
-            pg, page = len(pages), _Page(gh, gw)
-            pages.append(page)
-            hit = _best_on_page(page, p, res)
-        if hit is not None:
-            s, y, x = hit
-            page.stamp(s.mask, y, x)
-            place[i] = Placement(pg, s.angle, (margin + x * res - s.lo[0], margin + y * res - s.lo[1]))
-            continue
-        # fits exactly but not on the conservative grid: alone in the middle of its new page,
-        # with its grown raster stamped so later pieces can still use the rest of the page
-        _, a = _best_fit(p.xy, p.degs, pw, ph)
-        lo, hi = _extents(p.xy, np.array([a]))
-        off = np.array([margin, margin]) + (np.array([pw, ph]) - (hi[0] - lo[0])) / 2 - lo[0]
-        place[i] = Placement(pg, a, (off[0], off[1]))
-        origin = margin - pad * res
-        rot = _rot(a).T
-        mask = _raster((p.p0 @ rot + off - origin) / res, (p.p1 @ rot + off - origin) / res, gh, gw)
-        page.stamp(mask, 0, 0)
+    place = _fill_pages(pieces, order.tolist(), grid, gap, t0 + time_limit)
 
     placements = [place[i] for i in range(len(geoms))]
     # the grid argument is exact, but never hand out a packing that fails the independent check

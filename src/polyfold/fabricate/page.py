@@ -1,5 +1,6 @@
 """The sheet model: a `Page` of placed pieces (cut outlines, scored creases, tabs, labels) in
-millimetres, origin at the page's top-left corner, y pointing down (as in SVG).
+millimetres, origin at the page's top-left corner, y pointing down (as in SVG); and putting
+pieces on it (`place` a piece where packing put it, `page_of` the placed pieces).
 
 Text placement: (x, y) is the centre of the text, `size` is the font size (em) in mm, `angle` is
 the reading direction in degrees, counter-clockwise as seen on the page. The writers of
@@ -9,9 +10,14 @@ the reading direction in degrees, counter-clockwise as seen on the page. The wri
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .pack import Placement
+    from .pieces import SheetPiece
 
 
 TEXT_KINDS = frozenset({"edge-label", "piece-label", "title"})
@@ -90,3 +96,48 @@ def _finite(a, name: str, shape: tuple[int, ...]) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name}: coordinates must be finite")
     return arr
+
+
+def upright(angle: float) -> float:
+    """Angle (deg) turned by 180 if needed so text never reads upside down: in (-90, 90]."""
+    a = (angle + 180.0) % 360.0 - 180.0
+    if a > 90.0:
+        a -= 180.0
+    elif a <= -90.0:
+        a += 180.0
+    return a
+
+
+def place(piece: SheetPiece, placement: Placement) -> SheetPiece:
+    """The piece moved by a `pack.Placement` (rotation then translation, in page mm, y down)."""
+    from shapely import affinity
+
+    def tf(a: np.ndarray) -> np.ndarray:
+        a = np.asarray(a, dtype=np.float64)
+        return placement.apply(a.reshape(-1, 2)).reshape(a.shape) if a.size else a
+
+    def tg(g):
+        g = affinity.rotate(g, placement.angle, origin=(0, 0), use_radians=False)
+        return affinity.translate(g, *placement.offset)
+
+    # Placement rotates by +angle in the (x, y-down) frame, which looks clockwise on the page.
+    texts = []
+    for t in piece.texts:
+        x, y = placement.apply(np.array([[t.x, t.y]]))[0]
+        texts.append(replace(t, x=float(x), y=float(y), angle=upright(t.angle - placement.angle)))
+    return replace(piece, faces_xy=tf(piece.faces_xy), body=tg(piece.body), outline=tg(piece.outline),
+                   mountain=tf(piece.mountain), valley=tf(piece.valley), slits=tf(piece.slits),
+                   tabs=tuple(tf(t) for t in piece.tabs), tab_folds=tf(piece.tab_folds), texts=tuple(texts))
+
+
+def page_of(pieces: list[SheetPiece], width: float, height: float, footer: str | None = None,
+            footer_y: float | None = None) -> Page:
+    """A `Page` with the (already placed) pieces; an optional footer line of text."""
+    texts = [t for p in pieces for t in p.texts]
+    if footer:
+        texts.append(TextItem(footer, width / 2, footer_y if footer_y is not None else height - 12, 0.0, 2.5, "title"))
+    cat = lambda name: np.concatenate([getattr(p, name).reshape(-1, 2, 2) for p in pieces]) if pieces else np.zeros((0, 2, 2))
+    return Page(width=width, height=height, cut=tuple(r for p in pieces for r in p.cut_rings()),
+                mountain=cat("mountain"), valley=cat("valley"), tab_folds=cat("tab_folds"), texts=tuple(texts),
+                faces=tuple(p.faces_xy for p in pieces), slits=cat("slits"),
+                tabs=tuple(t for p in pieces for t in p.tabs))

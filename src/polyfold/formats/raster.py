@@ -1,34 +1,17 @@
-"""Tiny software rasteriser: PNG encoding, distinct part colours and a flat-shaded 3D mesh view.
+"""Tiny software rasteriser: distinct part colours, filled triangles, line segments and a
+flat-shaded 3D mesh view.
 
-Used for previews (segmentation pictures, net PNGs) without Pillow or matplotlib. In: numpy
-arrays; out: (H, W, 3) uint8 images or PNG bytes.
+Used for previews (segmentation pictures, sheet PNGs) without Pillow or matplotlib. In: numpy
+arrays; out: (H, W, 3) uint8 images (`png.png_bytes` encodes them).
 """
 
 from __future__ import annotations
 
 import colorsys
 import math
-import struct
-import zlib
 
 import numpy as np
 from numba import njit
-
-from .files import atomic_write
-
-
-def png_bytes(img: np.ndarray) -> bytes:
-    """(H, W, 3) uint8 RGB image -> PNG file bytes (8-bit truecolour, no filtering)."""
-    h, w = img.shape[:2]
-    raw = np.zeros((h, 1 + 3 * w), dtype=np.uint8)  # filter byte 0 per row
-    raw[:, 1:] = np.ascontiguousarray(img, dtype=np.uint8).reshape(h, 3 * w)
-
-    def chunk(tag: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
-
-    ihdr = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
-            + chunk(b"IEND", b""))
 
 
 def part_colors(n: int, saturation: float = 0.65, value: float = 0.92) -> np.ndarray:
@@ -81,6 +64,28 @@ def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> Non
     _zfill(img, zbuf, tris, np.zeros(tris.shape[:2]), np.ascontiguousarray(colors, dtype=np.uint8))
 
 
+def draw_segments(img: np.ndarray, seg: np.ndarray, color: tuple[int, int, int], thick: int = 1) -> None:
+    """Draw pixel-space segments (n, 2, 2) into img (H, W, 3) in place: points every half pixel
+    along each segment, one pixel wide, or a 2 x 2 pixel pen when thick > 1."""
+    if len(seg) == 0:
+        return
+    H, W = img.shape[:2]
+    a, b = seg[:, 0], seg[:, 1]
+    length = np.hypot(*(b - a).T)
+    counts = np.ceil(length / 0.5).astype(np.int64) + 1
+    idx = np.repeat(np.arange(len(seg)), counts)
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    t = (np.arange(counts.sum()) - starts) / np.repeat(np.maximum(counts - 1, 1), counts)
+    pts = a[idx] + t[:, None] * (b - a)[idx]
+    offs = [0.0] if thick <= 1 else [-0.5, 0.5]
+    for dx in offs:
+        for dy in offs:
+            ix = np.floor(pts[:, 0] + dx).astype(np.int64)
+            iy = np.floor(pts[:, 1] + dy).astype(np.int64)
+            ok = (ix >= 0) & (ix < W) & (iy >= 0) & (iy < H)
+            img[iy[ok], ix[ok]] = color
+
+
 def view_rotation(elevation_deg: float, azimuth_deg: float, up_axis: int) -> np.ndarray:
     """3x3 rotation taking model coordinates to view coordinates (x right, y up, z towards the viewer).
 
@@ -131,8 +136,3 @@ def render_mesh(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray
     zbuf = np.full((height, width), np.inf)
     _zfill(img, zbuf, np.ascontiguousarray(px[f]), np.ascontiguousarray(depth[f]), cols)
     return img
-
-
-def write_mesh_png(path, vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray, **kw) -> None:
-    """`render_mesh` written atomically as a PNG file."""
-    atomic_write(path, png_bytes(render_mesh(vertices, faces, face_colors, **kw)))

@@ -9,7 +9,7 @@ from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
 from .files import StagedFolder
 from .meshes import mesh_bytes, obj_text
-from .raster import png_bytes
+from .png import png_bytes
 
 
 def input_face_labels(seg: Segmentation, face_source: np.ndarray, n_input_faces: int) -> np.ndarray:

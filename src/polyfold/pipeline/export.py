@@ -12,8 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-from ..fabricate.layout import page_of
-from ..fabricate.page import Page
+from ..fabricate.page import Page, page_of
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
 from ..formats.fold import dumps, pattern_fold, with_path

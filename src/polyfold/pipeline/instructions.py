@@ -7,7 +7,8 @@ from html import escape
 
 import numpy as np
 
-from ..formats.raster import part_colors, png_bytes, render_mesh
+from ..formats.png import png_bytes
+from ..formats.raster import part_colors, render_mesh
 from ..mesh.mesh import Mesh
 from .options import MakeOptions
 

@@ -18,11 +18,12 @@ from typing import Callable
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fabricate.check import check_pages
+from ..fabricate.pack import GAP_MM
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
 from .export import write_make_folder
 from .folding import fold_pieces
-from .options import GAP_MM, MakeOptions, check_options
+from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
                      PieceReport, StageReports)

@@ -15,7 +15,6 @@ PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), 
 INFLATE_MODES = ("none", "constrained", "uniform")
 SEGMENT_MODES = ("auto", "none")
 FOOTER_MM = 6.0  # strip at the bottom of the printable area for the page footer
-GAP_MM = 3.0  # minimum distance between pieces on a page (room for scissors)
 
 
 @dataclass(frozen=True)

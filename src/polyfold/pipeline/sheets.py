@@ -16,12 +16,13 @@ import numpy as np
 
 from ..deadline import Deadline
 from ..errors import PolyfoldError
-from ..fabricate.layout import GlueEdge, LayoutStats, PieceInput, PieceTooLarge, SheetPiece, build_sheet_pieces, \
-    place, split_to_fit
-from ..fabricate.pack import Packing, pack_outlines
+from ..fabricate.fit import PieceTooLarge, split_to_fit
+from ..fabricate.pack import GAP_MM, Packing, pack_outlines
+from ..fabricate.page import place
+from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
 from ..mesh.mesh import Mesh
 from .folding import FoldedPiece
-from .options import FOOTER_MM, GAP_MM, MakeOptions
+from .options import FOOTER_MM, MakeOptions
 from .parts import Part
 
 
@@ -77,14 +78,7 @@ class Sheets:
 
 def piece_inputs(mesh: Mesh, folded: list[FoldedPiece]) -> list[PieceInput]:
     """What fabricate needs of every piece: its net, part, and its vertices and faces in the mesh."""
-    inputs = []
-    for fp in folded:
-        part_mesh_faces = mesh.faces[fp.part_faces]
-        part_vertices = np.unique(part_mesh_faces)
-        piece_part_vertices = np.unique(np.searchsorted(part_vertices, part_mesh_faces[fp.fids]))
-        inputs.append(PieceInput(net=fp.net, part=fp.part, vertex_ids=part_vertices[piece_part_vertices],
-                                 face_ids=fp.mesh_faces))
-    return inputs
+    return [piece_input(fp.net, fp.part, mesh.faces[fp.mesh_faces], fp.mesh_faces) for fp in folded]
 
 
 def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptions, width: float, height: float,

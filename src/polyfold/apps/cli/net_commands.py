@@ -86,22 +86,25 @@ def unfold(
     if result.path_error is not None:
         raise NoNetFound(f"{mesh.name}: {result.path_error} (the flat net was written to {output.name})")
     if svg is not None or png is not None:
-        _write_sheet(result, svg, png, size, labels, tabs, quiet)
+        _write_sheet(result, mesh.name, svg, png, size, labels, tabs, quiet)
     _say_unfolded(mesh.name, result, time.perf_counter() - t0)
 
 
-def _write_sheet(result, svg: Optional[Path], png: Optional[Path], size: float, labels: bool, tabs: bool,
-                 quiet: bool) -> None:
-    """The --svg cut sheet and the --png preview of the nets."""
-    from ...formats.sheet import sheet_layout, write_png, write_svg
+def _write_sheet(result, title: str, svg: Optional[Path], png: Optional[Path], size: float, labels: bool,
+                 tabs: bool, quiet: bool) -> None:
+    """The --svg cut sheet and the --png preview of the nets: one page, as make draws its sheets."""
+    from ...fabricate.sheet import net_sheet
+    from ...formats.png import write_page_png
+    from ...formats.svg import write_svg_page
 
+    sheet = net_sheet(result.nets, size, labels=labels, tabs=tabs, title=title)
     if svg is not None:
-        layout = sheet_layout(result.fold, size)
-        if layout.oversize and not quiet:
-            say(f"warning: sheet is {layout.width:.0f} x {layout.height:.0f} mm, larger than 300 x 300 mm; lower --size")
-        write_svg(result.fold, svg, size_mm=size, labels=labels, tabs=tabs)
+        if sheet.oversize and not quiet:
+            say(f"warning: sheet is {sheet.page.width:.0f} x {sheet.page.height:.0f} mm, larger than 300 x 300 mm; "
+                "lower --size")
+        write_svg_page(sheet.page, svg)
     if png is not None:
-        write_png(result.fold, png)
+        write_page_png(sheet.page, png)
 
 
 def _say_unfolded(name: str, result, seconds: float) -> None:
