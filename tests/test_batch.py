@@ -1,12 +1,13 @@
 """`polyfold batch` (issue 9): one isolated process per mesh, statuses, resume, summary files, the
 CLI, the same batch on a Dask LocalCluster, and the two studies.
 
-Crashes and hangs come from the test hook POLYFOLD_BATCH_FAULT (see polyfold/batch.py): the task
+Crashes and hangs come from the test hook POLYFOLD_BATCH_FAULT (see polyfold/apps/isolation.py): the task
 of crash-me.obj calls os._exit(1), segv-me.obj segfaults, hang-me.obj sleeps until killed."""
 
 from __future__ import annotations
 
 import csv
+import importlib
 import json
 import os
 import shutil
@@ -20,7 +21,9 @@ import pytest
 
 from test_cli import one_line, run_cli
 
-from polyfold.apps.batch import BatchRow, expand, FAULT_ENV, out_names, run_batch, run_study
+from polyfold.apps.batch import BatchRow, expand, out_names, run_batch
+from polyfold.apps.isolation import FAULT_ENV, PRELOAD
+from polyfold.apps.study import run_study
 from polyfold.errors import PolyfoldError
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions
@@ -152,6 +155,12 @@ def test_hard_limit_kills_a_real_make(models_dir, tmp_path) -> None:
     (row,) = res.rows
     assert row.status == "timeout" and row.faces is None
     assert not (tmp_path / "out" / "bunny-128" / "report.json").exists()
+
+
+def test_preload_modules_exist() -> None:
+    # the forkserver skips a preload name it cannot import without a word (a stale module path)
+    for name in PRELOAD:
+        importlib.import_module(name)
 
 
 def test_inputs_and_names(tmp_path, models_dir) -> None:

@@ -1,4 +1,4 @@
-"""`python -m polyfold`: the command line (`apps/cli.py`)."""
+"""`python -m polyfold`: the command line (`apps/cli/`)."""
 
 from .apps.cli.app import main
 

@@ -121,6 +121,14 @@ class _Debounced:
                 pass
 
 
+def _wait_until(done: Callable[[], bool], timeout: float) -> bool:
+    """Poll done() every 50 ms until it holds or `timeout` seconds have passed; -> done()."""
+    end = time.monotonic() + timeout
+    while not done() and time.monotonic() < end:
+        time.sleep(0.05)
+    return done()
+
+
 class Viewer:
     """A running viewer: the viser server, its scene and GUI. Create with `serve`."""
 
@@ -147,10 +155,23 @@ class Viewer:
         self._fold_nodes: list = []  # (piece, mesh handle)
         self._make_running = False
 
-        # A fixed view frame (camera and offsets stay put when a new make result is loaded): the
-        # model centred at the origin, longest side 2, z up. As the project's PNG previews
-        # (raster.render_mesh) do, the axis of middle extent is up and the longest one runs
-        # left to right.
+        self._set_view_frame(source)
+        server.gui.configure_theme(show_share_button=False, show_logo=False, control_width="medium")
+        self._set_camera()
+        self._add_panels()
+        self._add_inflated_nodes()
+        self._connect()
+        self._inflater = _Debounced(self._inflate, DEBOUNCE_S)
+        self.load(folder)
+        self._inflater.request()
+
+    # ---- set-up
+
+    def _set_view_frame(self, source: Mesh) -> None:
+        """A fixed view frame (camera and offsets stay put when a new make result is loaded): the
+        model centred at the origin, longest side 2, z up. As the project's PNG previews
+        (raster.render_mesh) do, the axis of middle extent is up and the longest one runs left
+        to right."""
         v = source.vertices[np.unique(source.faces)]
         lo, hi = v.min(axis=0), v.max(axis=0)
         ext = hi - lo
@@ -164,17 +185,20 @@ class Viewer:
         self._k = 2.0 / max(float(ext.max()), 1e-12)
         self._half = np.abs(rot @ ext) * self._k / 2  # half extents along view x, y, z
 
-        scene, gui = server.scene, server.gui
-        gui.configure_theme(show_share_button=False, show_logo=False, control_width="medium")
-        scene.set_up_direction("+z")
+    def _set_camera(self) -> None:
+        """z up; the camera takes in the inflated copy, the model and the row of nets."""
+        self.server.scene.set_up_direction("+z")
         hx, hz = float(self._half[0]), float(self._half[2])
         left, right = self._inflated_offset()[0] - hx, hx + NET_GAP + self._net_row_width()
         # look a little right of the middle: the control panel covers the right of the page
         mid = (left + right) / 2 + 0.12 * (right - left)
         dist = 0.5 * (right - left) + 0.8
-        server.initial_camera.look_at = (mid, 0.0, -0.3 * hz)
-        server.initial_camera.position = (mid, -dist, 0.55 * dist)
+        self.server.initial_camera.look_at = (mid, 0.0, -0.3 * hz)
+        self.server.initial_camera.position = (mid, -dist, 0.55 * dist)
 
+    def _add_panels(self) -> None:
+        """The title and the Folding, Inflation and Make panels."""
+        gui = self.server.gui
         self._title = gui.add_markdown("")
         with gui.add_folder("Folding"):
             self.part_dropdown = gui.add_dropdown("Part", [ALL_PARTS], initial_value=ALL_PARTS,
@@ -189,7 +213,7 @@ class Viewer:
                                                    hint="Stiff-edge multiplier (constrained mode).")
             self.steps_slider = gui.add_slider("Steps", 0, 20000, 100, 2000, hint="max_steps of the inflation run.")
             self.show_inflated = gui.add_checkbox("Show inflated", True)
-            self.hv_text = gui.add_markdown(f"input HV {int(source.hyperbolic.sum())}")
+            self.hv_text = gui.add_markdown(f"input HV {int(self.source.hyperbolic.sum())}")
         with gui.add_folder("Make"):
             self.output_text = gui.add_text("Output folder", ".", hint="Inside the viewed folder ('.' = the folder itself).")
             self.use_inflated = gui.add_checkbox("Use inflated mesh", True,
@@ -198,6 +222,9 @@ class Viewer:
             self.export_button = gui.add_button("Export inflated OBJ")
             self.make_status = gui.add_markdown("")
 
+    def _add_inflated_nodes(self) -> None:
+        """The inflated copy (left of the model) and its hyperbolic vertices, hidden until inflated."""
+        scene = self.server.scene
         self._inflated_mesh = scene.add_mesh_simple(
             "/inflated", np.zeros((3, 3), np.float32), np.array([[0, 1, 2]], np.uint32), color=INFLATED_COLOR,
             flat_shading=True, side="double", position=self._inflated_offset(), visible=False)
@@ -205,6 +232,8 @@ class Viewer:
             "/inflated/hv", np.zeros((0, 3), np.float32), HV_COLOR, point_size=0.04, point_shape="circle",
             visible=False)
 
+    def _connect(self) -> None:
+        """The callbacks of the controls."""
         self.part_dropdown.on_update(lambda _: self._show_part())
         self.fold_slider.on_update(lambda _: self._pose())
         self.play_button.on_click(lambda _: self.toggle_play())
@@ -213,10 +242,6 @@ class Viewer:
         self.show_inflated.on_update(lambda _: self._show_inflated_visibility())
         self.make_button.on_click(lambda _: self._start(self._run_make))
         self.export_button.on_click(lambda _: self._start(self._export))
-
-        self._inflater = _Debounced(self._inflate, DEBOUNCE_S)
-        self.load(folder)
-        self._inflater.request()
 
     # ---- geometry helpers
 
@@ -409,10 +434,7 @@ class Viewer:
 
     def wait_inflation(self, runs: int = 1, timeout: float = 30.0) -> bool:
         """Wait until at least `runs` inflation runs finished (for tests and scripts)."""
-        end = time.monotonic() + timeout
-        while self.inflation_runs < runs and time.monotonic() < end:
-            time.sleep(0.05)
-        return self.inflation_runs >= runs
+        return _wait_until(lambda: self.inflation_runs >= runs, timeout)
 
     # ---- make / export
 
@@ -489,10 +511,7 @@ class Viewer:
 
     def wait_make(self, runs: int = 1, timeout: float = 120.0) -> bool:
         """Wait until at least `runs` make runs finished (for tests and scripts)."""
-        end = time.monotonic() + timeout
-        while self.make_runs < runs and time.monotonic() < end:
-            time.sleep(0.05)
-        return self.make_runs >= runs
+        return _wait_until(lambda: self.make_runs >= runs, timeout)
 
     # ---- life cycle
 

@@ -158,7 +158,8 @@ def batch(
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol)
     if study is not None and study not in ("cspace", "unfold"):
         fail(f"--study must be 'cspace' or 'unfold', not {study!r}", 2)
-    from ..batch import run_batch, run_study
+    from ..batch import run_batch
+    from ..study import run_study
 
     t0 = time.perf_counter()
     progress, close = _batch_progress(quiet)
