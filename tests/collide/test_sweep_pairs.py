@@ -10,12 +10,11 @@ import pytest
 from numba import njit
 
 from polyfold.collide.self_intersect import crossing_pairs, face_triangles, self_intersections
-from polyfold.collide.sweep import all_collisions, first_collision, sweep_pairs
+from polyfold.collide.sweep import NO_LIMIT, all_collisions, first_collision, sweep_pairs
 from polyfold.collide.triangles import triangles_collide
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
 
-ALL_PAIRS = np.iinfo(np.int64).max
 # self-crossing inputs, and closed / open ones that do not cross themselves
 MESHES = ["fish-472.obj", "bad/intersecting-cubes.obj", "bad/two-cubes.obj", "bunny-348.obj", "torus-12x6-144.obj",
           "spiky-icosahedron-60.obj", "open/tube-132.obj"]
@@ -62,10 +61,10 @@ def reference(tris, tol, piece=None, parent=None, faces=None, keys=None) -> list
                                          NONE_I if keys is None else keys).tolist()]
 
 
-def swept(tris, tol, piece=None, parent=None, faces=None, keys=None, stop_after=ALL_PAIRS, room=None):
+def swept(tris, tol, piece=None, parent=None, faces=None, keys=None, stop_after=NO_LIMIT, room=None):
     """(count, pairs in sweep order) of sweep_pairs, room rows for the pairs (default: all)."""
     if room is None:
-        room = sweep_pairs(tris, tol, piece, parent, faces, keys, ALL_PAIRS, np.empty((0, 2), np.int64))
+        room = sweep_pairs(tris, tol, piece, parent, faces, keys, NO_LIMIT, np.empty((0, 2), np.int64))
     pairs = np.empty((room, 2), dtype=np.int64)
     count = sweep_pairs(tris, tol, piece, parent, faces, keys, stop_after, pairs)
     return count, [tuple(p) for p in pairs[: min(count, room)].tolist()]

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from ..mesh.mesh import Mesh
-from .sweep import sweep_pairs
+from .sweep import NO_LIMIT, sweep_pairs
 from .tolerance import CONTACT_TOL
 
 
@@ -37,10 +37,15 @@ def crossing_pairs(vertices: np.ndarray, faces: np.ndarray, tol: float, max_pair
     (i < j, in sweep order). tol: absolute contact tolerance. skip_keys: sorted int64 keys
     i * m + j (i < j) of pairs not to test (None or empty: none)."""
     pairs = np.empty((max_pairs, 2), dtype=np.int64)
-    tris = face_triangles(vertices, faces)
     keys = skip_keys if skip_keys is not None and len(skip_keys) else None
-    count = sweep_pairs(tris, float(tol), None, None, faces, keys, np.iinfo(np.int64).max, pairs)
+    count = _crossings(vertices, faces, float(tol), keys, pairs)
     return int(count), pairs[: min(count, max_pairs)]
+
+
+@njit(cache=True)
+def _crossings(vertices, faces, tol, keys, pairs):
+    """`crossing_pairs` in one numba call (the guard of inflation runs it every few steps)."""
+    return sweep_pairs(face_triangles(vertices, faces), tol, None, None, faces, keys, NO_LIMIT, pairs)
 
 
 def self_intersections(mesh: Mesh, tol: float = CONTACT_TOL) -> np.ndarray:

@@ -24,6 +24,8 @@ from numba import njit
 
 from .triangles import GEO_LO, face_geometry, faces_cross, load_face, store_face, tri_corners, triangles_collide
 
+NO_LIMIT = np.iinfo(np.int64).max  # `sweep_pairs`' stop_after that never stops early
+
 
 @njit(cache=True)
 def face_boxes(tris):
@@ -268,5 +270,5 @@ def all_collisions(tris, parent, piece, tol, max_pairs):
     """(count, pairs): all colliding pairs (count) of `sweep_pairs` with the skip rule of
     `first_collision`, the first min(count, max_pairs) of them."""
     pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
-    count = sweep_pairs(tris, tol, piece, parent, None, None, np.iinfo(np.int64).max, pairs[:max_pairs])
+    count = sweep_pairs(tris, tol, piece, parent, None, None, NO_LIMIT, pairs[:max_pairs])
     return count, pairs[: min(count, max_pairs)]
