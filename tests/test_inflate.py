@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from polyfold.errors import PolyfoldError
-from polyfold.inflate.inflate import inflate, self_intersections
+from polyfold.collide.self_intersect import self_intersections
+from polyfold.inflate.inflate import inflate
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.repair import describe
 from polyfold.mesh.mesh import Mesh

@@ -1,14 +1,20 @@
 """Broad phase of the 3D collision test: sort-and-sweep over face boxes.
 
-`sweep_collides` is the planners' hot loop (see `fold/checker.py`): faces in an order kept from
-one configuration to the next (`sort_by_lo_x`, nearly sorted between close configurations),
-their boxes gathered into contiguous rows (`gather_boxes`), and candidate pairs tested with
-`triangles.faces_cross` until the first crossing. `first_collision` / `all_collisions` report
-the colliding pairs of one folded state (for messages and tests) in the order this module always
-reported them.
+`sweep_pairs` is the one plain sort-and-sweep: the crossing face pairs of a set of triangles in
+sweep order (`triangles.triangles_collide` on the candidates), with the skip rule as data. The
+reports of one folded state, `first_collision` / `all_collisions` (for messages and tests: the
+colliding pairs in the order this module always reported them), and a mesh's self-intersections
+(`self_intersect.py`) both call it.
 
-Skipped pairs (never tested): faces of different pieces, a crease pair (parent, child), faces of
-one rigid group (rigid >= 0: their relative pose is fixed), degenerate faces.
+`sweep_collides` is the planners' hot loop (see `fold/checker.py`), a sweep of its own tuned for
+speed: faces in an order kept from one configuration to the next (`sort_by_lo_x`, nearly sorted
+between close configurations), their boxes gathered into contiguous rows (`gather_boxes`), and
+candidate pairs tested with `triangles.faces_cross` until the first crossing. It gives the same
+verdict as `first_collision` (tests/test_kinematics.py).
+
+Skipped pairs (never tested) of a folded net: faces of different pieces, a crease pair (parent,
+child); in `sweep_collides` also faces of one rigid group (rigid >= 0: their relative pose is
+fixed) and degenerate faces (which `triangles_collide` finds never collide).
 """
 
 from __future__ import annotations
@@ -18,9 +24,12 @@ from numba import njit
 
 from .triangles import GEO_LO, face_geometry, faces_cross, load_face, store_face, tri_corners, triangles_collide
 
+NO_LIMIT = np.iinfo(np.int64).max  # `sweep_pairs`' stop_after that never stops early
+
 
 @njit(cache=True)
 def face_boxes(tris):
+    """(lo, hi), both (F, 3): the axis-aligned box of each triangle of tris (F, 3, 3)."""
     n = tris.shape[0]
     lo = np.empty((n, 3))
     hi = np.empty((n, 3))
@@ -180,12 +189,21 @@ def sweep_collides(tris, geo, sb, si, tol, big):
 
 
 @njit(cache=True)
-def _collisions(tris, parent, piece, tol, max_pairs, pairs):
-    """Colliding pairs for reports (first_collision, all_collisions): sort-and-sweep on x in the
-    order of np.argsort of the boxes' lo x, `triangles_collide` on each candidate (the face
-    earlier in the order as a), as this module always did, so the pairs reported and their order
-    are the ones it always reported (the planners' test is `segment_collides`). Stops after
-    max_pairs hits, the first ones (i < j) written to pairs; returns the number of hits."""
+def sweep_pairs(tris, tol, piece, parent, faces, skip_keys, stop_after, pairs):
+    """Crossing face pairs of tris (F, 3, 3) by the plain sort-and-sweep on x: returns their
+    number, the first pairs.shape[0] of them written to pairs (i < j, in sweep order).
+
+    Faces in the order of np.argsort of their boxes' lo x; for each face, the later faces whose
+    boxes are within tol of its box on x, y and z are the candidates, tested by
+    `triangles_collide` (the face earlier in the order as a) unless the skip rule skips them.
+    The rule is data, each part off when None (numba then compiles it out): piece (F,) labels:
+    faces of different pieces; parent (F,) (f's parent face or -1): crease pairs; faces (F, 3)
+    corner ids: faces sharing an edge (two ids); skip_keys, sorted int64 keys i * F + j (i < j):
+    those pairs. Stops after stop_after hits. The one sweep of the fold reports
+    (`first_collision`, `all_collisions`) and of a mesh's self-intersections
+    (`self_intersect.crossing_pairs`): the pairs each reports, and their order, are the ones it
+    always reported.
+    """
     n = tris.shape[0]
     lo, hi = face_boxes(tris)
     xs = np.argsort(lo[:, 0])
@@ -200,30 +218,57 @@ def _collisions(tris, parent, piece, tol, max_pairs, pairs):
                 continue
             if lo[j, 2] - hi[i, 2] > tol or lo[i, 2] - hi[j, 2] > tol:
                 continue
-            if piece[i] != piece[j] or parent[i] == j or parent[j] == i:
+            if piece is not None and piece[i] != piece[j]:
+                continue
+            if parent is not None and (parent[i] == j or parent[j] == i):
+                continue
+            if faces is not None and _share_edge(faces, i, j):
+                continue
+            if skip_keys is not None and _listed(skip_keys, i, j, n):
                 continue
             if triangles_collide(tris[i], tris[j], tol):
                 if count < pairs.shape[0]:
                     pairs[count, 0] = min(i, j)
                     pairs[count, 1] = max(i, j)
                 count += 1
-                if count >= max_pairs:
+                if count >= stop_after:
                     return count
     return count
 
 
+@njit(cache=True, inline="always")
+def _share_edge(faces, i, j):
+    """True when faces i and j (rows of faces (F, 3)) have two corner ids in common."""
+    shared = 0
+    for a in range(3):
+        for b in range(3):
+            if faces[i, a] == faces[j, b]:
+                shared += 1
+    return shared >= 2
+
+
+@njit(cache=True, inline="always")
+def _listed(keys, i, j, n):
+    """True when the key min(i, j) * n + max(i, j) is in the sorted keys."""
+    key = min(i, j) * n + max(i, j)
+    k = np.searchsorted(keys, key)
+    return k < keys.shape[0] and keys[k] == key
+
+
 @njit(cache=True)
 def first_collision(tris, parent, piece, tol):
-    """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1)."""
+    """First colliding face pair (i, j), i < j, of folded faces tris (F, 3, 3), or (-1, -1):
+    the first hit of `sweep_pairs`, skipping pairs of different pieces and crease pairs."""
     pairs = np.empty((1, 2), dtype=np.int64)
-    if _collisions(tris, parent, piece, tol, np.int64(1), pairs) > 0:
+    if sweep_pairs(tris, tol, piece, parent, None, None, 1, pairs) > 0:
         return pairs[0, 0], pairs[0, 1]
     return -1, -1
 
 
 @njit(cache=True)
 def all_collisions(tris, parent, piece, tol, max_pairs):
-    """(count, pairs): all colliding pairs (count), the first min(count, max_pairs) of them."""
+    """(count, pairs): all colliding pairs (count) of `sweep_pairs` with the skip rule of
+    `first_collision`, the first min(count, max_pairs) of them."""
     pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
-    count = _collisions(tris, parent, piece, tol, np.iinfo(np.int64).max, pairs[:max_pairs])
+    count = sweep_pairs(tris, tol, piece, parent, None, None, NO_LIMIT, pairs[:max_pairs])
     return count, pairs[: min(count, max_pairs)]

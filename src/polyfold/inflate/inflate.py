@@ -61,12 +61,13 @@ over ``stall_window`` steps); ``max_steps`` ("max-steps"); a guard ("guard: ..."
 Guards. A step is rejected, and the state before it returned, when a face normal turns by more
 than 90 degrees in one step ("face N would flip"), a face area drops below 1e-8 of the initial
 mean ("would collapse"), or an edge's fold angle passes through +-180 degrees ("faces i and j
-would fold through each other"). Self-intersection (two faces sharing no edge cross, by
-`collide.triangles.triangles_collide` with its touching semantics, so faces meeting at a shared vertex
-count only if they really cross; tolerance 1e-7 of the bounding-box diagonal) is checked by a
-sort-and-sweep over face boxes at the start, every ``log_every`` steps and at the end; when it
-trips, the state of the last passed check is returned ("faces i and j would intersect"). Pairs that
-already cross in the input (and their one-ring neighbours) are reported in ``notes`` and exempt.
+would fold through each other"); these run in the step kernel (`kernels.run_steps`).
+Self-intersection (two faces sharing no edge cross, `collide.self_intersect.crossing_pairs` with the
+touching semantics of `collide.triangles.triangles_collide`, so faces meeting at a shared vertex
+count only if they really cross; tolerance 1e-7 of the bounding-box diagonal) is checked at the
+start, every ``log_every`` steps and at the end; when it trips, the state of the last passed check
+is returned ("faces i and j would intersect"). Pairs that already cross in the input (and their
+one-ring neighbours) are reported in ``notes`` and exempt.
 
 Open meshes: boundary vertices move under the same forces (pressure over their partial fan,
 springs, rest spring) but are not counted as hyperbolic (their angle sum is not a curvature, as in
@@ -86,23 +87,16 @@ from dataclasses import dataclass, field
 from typing import Callable, Iterable, Optional
 
 import numpy as np
-from numba import njit
 
-from ..collide.sweep import face_boxes
+from ..collide.self_intersect import crossing_pairs
 from ..collide.tolerance import CONTACT_TOL
-from ..collide.triangles import triangles_collide
 from ..errors import PolyfoldError
-from ..mesh.geometry import HYPERBOLIC_EPS
 from ..mesh.mesh import Mesh
+from .kernels import AT_TARGET, COLLAPSED, FLIPPED, FOLDED_THROUGH, STALLED, run_steps, surface_geometry
 
-TWO_PI = 2.0 * math.pi
-HV_EPS = HYPERBOLIC_EPS  # hyperbolic: S_v > 2 pi + HV_EPS
-STALL_DISP = 1e-3  # stop when the summed step displacement falls below this
 COLLAPSE = 1e-8  # a face collapses when its area drops below this * the initial mean area
 CONTACT = CONTACT_TOL  # self-intersection tolerance, fraction of the bounding-box diagonal
-
-# chunk status codes
-_RUNNING, _TARGET, _STALL, _FLIP, _COLLAPSE, _FOLD = 0, 1, 2, 3, 4, 5
+STALL_IF = 1e-4  # stall window: IF moving less than this since the window opened
 
 
 @dataclass(frozen=True)
@@ -126,326 +120,6 @@ class InflateResult:
     snapshots: dict = field(default_factory=dict)
     hyperbolic_start: int = 0
     notes: tuple = ()
-
-
-# --------------------------------------------------------------------------------------------------
-# numba kernels
-# --------------------------------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _geometry(X, F, edges, efaces, counted, normals, area2, phi, S, rho):
-    """Unit normals, doubled areas, corner angles, angle sums and fold angles of X; returns HV."""
-    m = F.shape[0]
-    n = X.shape[0]
-    for v in range(n):
-        S[v] = 0.0
-    for f in range(m):
-        a = F[f, 0]
-        b = F[f, 1]
-        c = F[f, 2]
-        ux = X[b, 0] - X[a, 0]
-        uy = X[b, 1] - X[a, 1]
-        uz = X[b, 2] - X[a, 2]
-        wx = X[c, 0] - X[a, 0]
-        wy = X[c, 1] - X[a, 1]
-        wz = X[c, 2] - X[a, 2]
-        nx = uy * wz - uz * wy
-        ny = uz * wx - ux * wz
-        nz = ux * wy - uy * wx
-        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-        area2[f] = nn
-        if nn > 0.0:
-            normals[f, 0] = nx / nn
-            normals[f, 1] = ny / nn
-            normals[f, 2] = nz / nn
-        else:
-            normals[f, 0] = 0.0
-            normals[f, 1] = 0.0
-            normals[f, 2] = 0.0
-        for k in range(3):
-            p = F[f, k]
-            q = F[f, (k + 1) % 3]
-            r = F[f, (k + 2) % 3]
-            ax = X[q, 0] - X[p, 0]
-            ay = X[q, 1] - X[p, 1]
-            az = X[q, 2] - X[p, 2]
-            bx = X[r, 0] - X[p, 0]
-            by = X[r, 1] - X[p, 1]
-            bz = X[r, 2] - X[p, 2]
-            cx = ay * bz - az * by
-            cy = az * bx - ax * bz
-            cz = ax * by - ay * bx
-            ang = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz)
-            phi[f, k] = ang
-            S[p] += ang
-    for e in range(edges.shape[0]):
-        f0 = efaces[e, 0]
-        f1 = efaces[e, 1]
-        if f0 < 0 or f1 < 0:
-            rho[e] = 0.0
-            continue
-        a = edges[e, 0]
-        b = edges[e, 1]
-        ux = X[b, 0] - X[a, 0]
-        uy = X[b, 1] - X[a, 1]
-        uz = X[b, 2] - X[a, 2]
-        n0x = normals[f0, 0]
-        n0y = normals[f0, 1]
-        n0z = normals[f0, 2]
-        n1x = normals[f1, 0]
-        n1y = normals[f1, 1]
-        n1z = normals[f1, 2]
-        cx = n0y * n1z - n0z * n1y
-        cy = n0z * n1x - n0x * n1z
-        cz = n0x * n1y - n0y * n1x
-        lu = math.sqrt(ux * ux + uy * uy + uz * uz)
-        s = (cx * ux + cy * uy + cz * uz) / lu if lu > 0.0 else 0.0
-        rho[e] = math.atan2(s, n0x * n1x + n0y * n1y + n0z * n1z)
-    hv = 0
-    for v in range(n):
-        if counted[v] and S[v] > TWO_PI + HV_EPS:
-            hv += 1
-    return hv
-
-
-@njit(cache=True)
-def _forces(X, P, F, L0, fedge, edges, phi, S, rho, normals, pv, E, stiff, thr, vbase, vrule, counted, lam, force):
-    """Total force per vertex (pressure + stretch-only edge springs + rest springs) into `force`.
-
-    pv: per-vertex pressure; stiff: k_e of stiff edges (1 in uniform mode); thr: deep-concave
-    threshold (radians); vbase: vertex_stiffness (0 disables the rest springs); vrule 0 = js, 1 = paper;
-    lam: (n,) scratch buffer.
-    """
-    n = X.shape[0]
-    m = F.shape[0]
-    for v in range(n):
-        force[v, 0] = 0.0
-        force[v, 1] = 0.0
-        force[v, 2] = 0.0
-    for f in range(m):
-        for k in range(3):
-            v = F[f, k]
-            if S[v] > 0.0:
-                w = pv[v] * phi[f, k] / S[v]
-                force[v, 0] += w * normals[f, 0]
-                force[v, 1] += w * normals[f, 1]
-                force[v, 2] += w * normals[f, 2]
-    for f in range(m):
-        for k in range(3):
-            a = F[f, k]
-            b = F[f, (k + 1) % 3]
-            dx = X[b, 0] - X[a, 0]
-            dy = X[b, 1] - X[a, 1]
-            dz = X[b, 2] - X[a, 2]
-            length = math.sqrt(dx * dx + dy * dy + dz * dz)
-            dl = length - L0[f, k]
-            if dl <= 0.0 or length == 0.0:
-                continue
-            r = rho[fedge[f, k]]
-            ke = stiff if (r > 0.0 or -r > thr) else 1.0
-            g = E * ke * dl / length
-            force[a, 0] += g * dx
-            force[a, 1] += g * dy
-            force[a, 2] += g * dz
-            force[b, 0] -= g * dx
-            force[b, 1] -= g * dy
-            force[b, 2] -= g * dz
-    if vbase > 0.0:
-        if vrule == 0:
-            for v in range(n):
-                lam[v] = stiff
-            for e in range(edges.shape[0]):
-                if rho[e] < 0.0:
-                    lam[edges[e, 0]] = 1.0
-                    lam[edges[e, 1]] = 1.0
-        else:
-            for v in range(n):
-                lam[v] = 1.0 if (counted[v] and S[v] > TWO_PI + HV_EPS) else stiff
-        for v in range(n):
-            k = E * vbase * lam[v]
-            force[v, 0] -= k * (X[v, 0] - P[v, 0])
-            force[v, 1] -= k * (X[v, 1] - P[v, 1])
-            force[v, 2] -= k * (X[v, 2] - P[v, 2])
-
-
-@njit(cache=True)
-def _run(X, P, F, L0, fedge, edges, efaces, counted, pv, boost, pcap, p, E, stiff, thr, vbase, vrule, dt,
-         until_hv, n_steps, min_area2, normals, area2, phi, S, rho, Xn, normals_n, area2_n, phi_n, S_n, rho_n,
-         lam, force, out):
-    """Run up to n_steps steps from X (whose geometry is in normals..rho). Updates X, the geometry
-    buffers and the per-vertex pressures pv (raised by p * boost per step on hyperbolic vertices, up
-    to pcap) in place. out[0] = steps done, out[1] = HV of X, out[2], out[3] = detail
-    (face / faces / edge). Returns the status code."""
-    n = X.shape[0]
-    m = F.shape[0]
-    hv = 0
-    for v in range(n):
-        if counted[v] and S[v] > TWO_PI + HV_EPS:
-            hv += 1
-    done = 0
-    status = _RUNNING
-    while True:
-        out[1] = hv
-        if hv <= until_hv:
-            status = _TARGET
-            break
-        if done >= n_steps:
-            break
-        _forces(X, P, F, L0, fedge, edges, phi, S, rho, normals, pv, E, stiff, thr, vbase, vrule, counted, lam, force)
-        total = 0.0
-        for v in range(n):
-            dx = dt * force[v, 0]
-            dy = dt * force[v, 1]
-            dz = dt * force[v, 2]
-            total += math.sqrt(dx * dx + dy * dy + dz * dz)
-            Xn[v, 0] = X[v, 0] + dx
-            Xn[v, 1] = X[v, 1] + dy
-            Xn[v, 2] = X[v, 2] + dz
-        if total < STALL_DISP:
-            rising = False  # a still-hyperbolic vertex whose pressure is still being raised
-            if boost > 0.0:
-                for v in range(n):
-                    if counted[v] and S[v] > TWO_PI + HV_EPS and pv[v] < pcap:
-                        rising = True
-                        break
-            if not rising:
-                status = _STALL
-                break
-        hv_n = _geometry(Xn, F, edges, efaces, counted, normals_n, area2_n, phi_n, S_n, rho_n)
-        for f in range(m):
-            if area2_n[f] < min_area2:
-                status = _COLLAPSE
-                out[2] = f
-                break
-            if (normals[f, 0] * normals_n[f, 0] + normals[f, 1] * normals_n[f, 1]
-                    + normals[f, 2] * normals_n[f, 2]) < 0.0:
-                status = _FLIP
-                out[2] = f
-                break
-        if status != _RUNNING:
-            break
-        for e in range(edges.shape[0]):
-            a = rho[e]
-            b = rho_n[e]
-            if (a > 0.5 * math.pi and b < -0.5 * math.pi) or (a < -0.5 * math.pi and b > 0.5 * math.pi):
-                status = _FOLD
-                out[2] = efaces[e, 0]
-                out[3] = efaces[e, 1]
-                break
-        if status != _RUNNING:
-            break
-        X[:] = Xn
-        normals[:] = normals_n
-        area2[:] = area2_n
-        phi[:] = phi_n
-        S[:] = S_n
-        rho[:] = rho_n
-        hv = hv_n
-        done += 1
-        if boost > 0.0:
-            for v in range(n):
-                if counted[v] and S[v] > TWO_PI + HV_EPS:
-                    pv[v] = min(pv[v] + p * boost, pcap)
-    out[0] = done
-    return status
-
-
-@njit(cache=True)
-def _intersections(X, F, tol, skip_keys, max_pairs, pairs):
-    """Sort-and-sweep over face AABBs; exact test (triangles_collide) on pairs sharing no edge and
-    not listed in skip_keys (sorted i * m + j, i < j). Returns the number of crossing pairs
-    (the first max_pairs written to pairs)."""
-    m = F.shape[0]
-    tris = np.empty((m, 3, 3))
-    for f in range(m):
-        for k in range(3):
-            for i in range(3):
-                tris[f, k, i] = X[F[f, k], i]
-    lo, hi = face_boxes(tris)
-    xs = np.argsort(lo[:, 0])
-    count = 0
-    for ii in range(m):
-        i = xs[ii]
-        for jj in range(ii + 1, m):
-            j = xs[jj]
-            if lo[j, 0] - hi[i, 0] > tol:
-                break
-            if lo[j, 1] - hi[i, 1] > tol or lo[i, 1] - hi[j, 1] > tol:
-                continue
-            if lo[j, 2] - hi[i, 2] > tol or lo[i, 2] - hi[j, 2] > tol:
-                continue
-            shared = 0
-            for a in range(3):
-                for b in range(3):
-                    if F[i, a] == F[j, b]:
-                        shared += 1
-            if shared >= 2:
-                continue  # edge neighbours: handled by the fold-through guard
-            lo_ij = min(i, j)
-            hi_ij = max(i, j)
-            if skip_keys.shape[0] > 0:
-                key = lo_ij * m + hi_ij
-                k = np.searchsorted(skip_keys, key)
-                if k < skip_keys.shape[0] and skip_keys[k] == key:
-                    continue
-            if triangles_collide(tris[i], tris[j], tol):
-                if count < max_pairs:
-                    pairs[count, 0] = lo_ij
-                    pairs[count, 1] = hi_ij
-                count += 1
-    return count
-
-
-# --------------------------------------------------------------------------------------------------
-# driver
-# --------------------------------------------------------------------------------------------------
-
-
-def _signed_volume(X: np.ndarray, F: np.ndarray) -> float:
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
-
-
-def _crossing_pairs(X: np.ndarray, F: np.ndarray, tol: float, skip: np.ndarray, max_pairs: int = 64) -> tuple[int, np.ndarray]:
-    pairs = np.empty((max(max_pairs, 1), 2), dtype=np.int64)
-    count = _intersections(X, F, tol, skip, max_pairs, pairs)
-    return int(count), pairs[: min(count, max_pairs)]
-
-
-def _near_pairs(F: np.ndarray, pairs: np.ndarray, n: int) -> np.ndarray:
-    """Sorted keys i * m + j (i < j) of the face pairs exempt from the intersection guard because the
-    input already crosses there: both faces within one vertex ring of the two faces of an input
-    crossing pair (the crossing line slides onto neighbouring faces as the surfaces move)."""
-    m = len(F)
-    vert_faces = [[] for _ in range(n)]
-    for f, tri in enumerate(F.tolist()):
-        for v in tri:
-            vert_faces[v].append(f)
-    keys = set()
-    for i, j in pairs.tolist():
-        near_i = sorted({g for v in F[i] for g in vert_faces[v]})
-        near_j = sorted({g for v in F[j] for g in vert_faces[v]})
-        for a in near_i:
-            for b in near_j:
-                if a != b:
-                    keys.add(min(a, b) * m + max(a, b))
-    return np.array(sorted(keys), dtype=np.int64)
-
-
-def self_intersections(mesh: Mesh, tol: float = CONTACT) -> np.ndarray:
-    """Pairs (k, 2), i < j, of faces that cross each other (faces sharing an edge are not tested;
-    faces touching at a shared vertex or resting on each other do not count). tol: fraction of the
-    bounding-box diagonal."""
-    X, F = mesh.vertices, mesh.faces
-    if len(F) == 0:
-        return np.empty((0, 2), dtype=np.int64)
-    diag = float(np.linalg.norm(X.max(0) - X.min(0))) if len(X) else 0.0
-    empty = np.empty(0, dtype=np.int64)
-    count, _ = _crossing_pairs(X, F, tol * diag, empty, 0)
-    if count == 0:
-        return np.empty((0, 2), dtype=np.int64)
-    return _crossing_pairs(X, F, tol * diag, empty, count)[1]
 
 
 def inflate(
@@ -478,14 +152,37 @@ def inflate(
     reported in notes); the flip, collapse and fold-through guards always run.
     progress(step, IF, HV) is called every log_every steps. Raises PolyfoldError on bad arguments.
     """
+    _check_arguments(mesh, mode, vertex_rule, step, max_steps, log_every, stall_window, {
+        "pressure": pressure, "modulus": modulus, "stiffness_ratio": stiffness_ratio,
+        "vertex_stiffness": vertex_stiffness, "hv_boost": hv_boost, "max_boost": max_boost,
+        "concave_threshold_deg": concave_threshold_deg})
+    if mode == "uniform":
+        stiffness_ratio, vertex_stiffness, hv_boost = 1.0, 0.0, 0.0
+    surface = _normalised_surface(mesh)
+    model = _Model(
+        pressures=np.full(surface.n_vertices, float(pressure)), boost=float(hv_boost),
+        cap=float(pressure) * (1.0 + max_boost), pressure=float(pressure), modulus=float(modulus),
+        stiffness=float(stiffness_ratio), threshold=math.radians(concave_threshold_deg),
+        vertex_stiffness=float(vertex_stiffness), rule=0 if vertex_rule == "js" else 1,
+        dt=math.log(step + 0.1) / 1000.0, until_hv=int(until_hv),
+        min_area2=COLLAPSE * float(surface.area2.mean()))
+    guard = _IntersectionGuard(surface, check_intersections)
+    log = _Log(surface, snapshot_steps, max_steps, progress)
+    log.snap(0, surface.X)
+    log.record(0, surface.X, surface.hv_start)
+    reason, done, hv = _step_loop(surface, model, guard, log, max_steps, log_every, stall_window)
+    return _result(mesh, surface, log, guard.notes, reason, done, hv)
+
+
+def _check_arguments(mesh: Mesh, mode: str, vertex_rule: str, step: float, max_steps: int, log_every: int,
+                     stall_window: int, nonnegative: dict[str, float]) -> None:
+    """Raise PolyfoldError on an argument `inflate` cannot run with (nonnegative: name -> value of
+    the parameters that must be finite and >= 0)."""
     if mode not in ("constrained", "uniform"):
         raise PolyfoldError(f"unknown inflation mode {mode!r} (use 'constrained' or 'uniform')")
     if vertex_rule not in ("js", "paper"):
         raise PolyfoldError(f"unknown vertex rule {vertex_rule!r} (use 'js' or 'paper')")
-    checks = {"pressure": pressure, "modulus": modulus, "stiffness_ratio": stiffness_ratio,
-              "vertex_stiffness": vertex_stiffness, "hv_boost": hv_boost, "max_boost": max_boost,
-              "concave_threshold_deg": concave_threshold_deg}
-    for name, value in checks.items():
+    for name, value in nonnegative.items():
         if not (math.isfinite(value) and value >= 0):
             raise PolyfoldError(f"{name} must be a finite number >= 0, not {value!r}")
     if not (math.isfinite(step) and step > 0.9):
@@ -494,15 +191,54 @@ def inflate(
         raise PolyfoldError("max_steps and stall_window must be >= 0 and log_every >= 1")
     if mesh.n_faces == 0:
         raise PolyfoldError("cannot inflate a mesh without faces")
-    if mode == "uniform":
-        stiffness_ratio, vertex_stiffness, hv_boost = 1.0, 0.0, 0.0
-    dt = math.log(step + 0.1) / 1000.0
 
+
+@dataclass(frozen=True)
+class _Surface:
+    """The mesh being inflated, normalised (bounding-box centre of the used vertices at the
+    origin, largest distance 1), with the arrays of `run_steps`. P: rest positions; X: current
+    positions (updated in place); used: vertices of some face; counted: used and not on the
+    boundary (their angle sum is a curvature); L0 (m, 3): rest length of edge k -> k+1 of each
+    face; geometry: normals, area2, phi, S, rho of X; scratch: the buffers of a step's state
+    (Xn, normals, area2, phi, S, rho), lam, force; out: what `run_steps` reports (steps done, HV,
+    the face / faces of a guard's stop)."""
+
+    F: np.ndarray
+    edges: np.ndarray
+    efaces: np.ndarray
+    fedge: np.ndarray
+    used: np.ndarray
+    counted: np.ndarray
+    center: np.ndarray
+    scale: float
+    P: np.ndarray
+    X: np.ndarray
+    L0: np.ndarray
+    geometry: tuple
+    scratch: tuple
+    out: np.ndarray
+    hv_start: int
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.P)
+
+    @property
+    def area2(self) -> np.ndarray:
+        """Doubled face areas of X as of the last `surface_geometry` (set-up or step)."""
+        return self.geometry[1]
+
+    def inflation_rate(self, state: np.ndarray) -> float:
+        """IF: mean |state_v - P_v| over the used vertices."""
+        return float(np.linalg.norm(state[self.used] - self.P[self.used], axis=1).mean())
+
+
+def _normalised_surface(mesh: Mesh) -> _Surface:
+    """`_Surface` of mesh, its geometry computed; PolyfoldError if its used vertices coincide."""
     F = mesh.faces
     topo = mesh.topology
     edges = np.ascontiguousarray(topo.edges)
     efaces = np.ascontiguousarray(topo.edge_faces)
-    fedge = np.ascontiguousarray(topo.face_edges)
     V = mesh.vertices
     used = np.zeros(len(V), dtype=bool)
     used[F.reshape(-1)] = True
@@ -515,117 +251,226 @@ def inflate(
     counted = used.copy()
     counted[edges[topo.boundary].reshape(-1)] = False  # boundary vertices: not curvature
     L0 = np.linalg.norm(P[np.roll(F, -1, axis=1)] - P[F], axis=2)
-
     m, n = len(F), len(V)
-    normals, area2, phi, S, rho = np.empty((m, 3)), np.empty(m), np.empty((m, 3)), np.empty(n), np.empty(len(edges))
-    bufs_n = (np.empty((n, 3)), np.empty((m, 3)), np.empty(m), np.empty((m, 3)), np.empty(n), np.empty(len(edges)))
-    force, lam = np.empty((n, 3)), np.empty(n)
-    out = np.zeros(4, dtype=np.int64)
-    hv = int(_geometry(X, F, edges, efaces, counted, normals, area2, phi, S, rho))
-    hv_start = hv
-    min_area2 = COLLAPSE * float(area2.mean())
-    pv = np.full(n, float(pressure))
-    pcap = float(pressure) * (1.0 + max_boost)
-    rule = 0 if vertex_rule == "js" else 1
-    v0 = _signed_volume(P, F)
-    tol = CONTACT * float(np.linalg.norm(P[used].max(0) - P[used].min(0)))
+    geometry = (np.empty((m, 3)), np.empty(m), np.empty((m, 3)), np.empty(n), np.empty(len(edges)))
+    scratch = (np.empty((n, 3)), np.empty((m, 3)), np.empty(m), np.empty((m, 3)), np.empty(n), np.empty(len(edges)),
+               np.empty(n), np.empty((n, 3)))
+    hv = int(surface_geometry(X, F, edges, efaces, counted, *geometry))
+    return _Surface(F, edges, efaces, np.ascontiguousarray(topo.face_edges), used, counted, center, scale, P, X, L0,
+                    geometry, scratch, np.zeros(4, dtype=np.int64), hv)
 
-    notes: list[str] = []
-    count, pairs = _crossing_pairs(X, F, tol, np.empty(0, dtype=np.int64), 0)
-    if count:
-        count, pairs = _crossing_pairs(X, F, tol, np.empty(0, dtype=np.int64), count)
-        notes.append(f"the input already self-intersects ({count} crossing face pair{'s' if count != 1 else ''}, "
-                     f"e.g. faces {pairs[0, 0]} and {pairs[0, 1]}); those pairs and their neighbours are not checked")
-    skip = _near_pairs(F, pairs, n) if count else np.empty(0, dtype=np.int64)
 
-    snaps_wanted = sorted({int(s) for s in snapshot_steps if 0 <= int(s) <= max_steps})
-    snapshots: dict[int, np.ndarray] = {}
-    history: list[tuple[float, float, float, float]] = []
+@dataclass(frozen=True)
+class _Model:
+    """The force model's parameters as `run_steps` takes them (after the uniform-mode
+    overrides). pressures (n,): p_v, raised in place on hyperbolic vertices by boost * pressure
+    per step up to cap; threshold: deep-concave threshold (radians); rule: 0 js, 1 paper."""
 
-    def mean_disp(state: np.ndarray) -> float:
-        return float(np.linalg.norm(state[used] - P[used], axis=1).mean())
+    pressures: np.ndarray
+    boost: float
+    cap: float
+    pressure: float
+    modulus: float
+    stiffness: float
+    threshold: float
+    vertex_stiffness: float
+    rule: int
+    dt: float
+    until_hv: int
+    min_area2: float
 
-    def record(k: int, state: np.ndarray, hv_k: int) -> None:
-        IF = mean_disp(state)
-        vol = _signed_volume(state, F)
-        dv = vol / v0 - 1.0 if v0 != 0 else float("nan")
-        if history and history[-1][0] == k:
-            history[-1] = (k, IF, hv_k, dv)
+    def run(self, s: _Surface, n_steps: int) -> int:
+        """Up to n_steps steps of s.X (`run_steps`); returns its status, s.out its counts."""
+        return run_steps(s.X, s.P, s.F, s.L0, s.fedge, s.edges, s.efaces, s.counted, self.pressures, self.boost,
+                         self.cap, self.pressure, self.modulus, self.stiffness, self.threshold,
+                         self.vertex_stiffness, self.rule, self.dt, self.until_hv, n_steps, self.min_area2,
+                         *s.geometry, *s.scratch, s.out)
+
+
+def _signed_volume(X: np.ndarray, F: np.ndarray) -> float:
+    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+class _Log:
+    """What a run records: history rows (step, IF, HV, volume_change), snapshots in the input's
+    frame at the wanted steps, the progress callback."""
+
+    def __init__(self, surface: _Surface, snapshot_steps: Iterable[int], max_steps: int,
+                 progress: Optional[Callable[[int, float, int], None]]) -> None:
+        self.surface = surface
+        self.snaps_wanted = sorted({int(s) for s in snapshot_steps if 0 <= int(s) <= max_steps})
+        self.snapshots: dict[int, np.ndarray] = {}
+        self.history: list[tuple[float, float, float, float]] = []
+        self.progress = progress
+        self.v0 = _signed_volume(surface.P, surface.F)
+
+    def record(self, k: int, state: np.ndarray, hv: int) -> float:
+        """Log (or replace) the row of step k; returns its IF."""
+        IF = self.surface.inflation_rate(state)
+        vol = _signed_volume(state, self.surface.F)
+        dv = vol / self.v0 - 1.0 if self.v0 != 0 else float("nan")
+        if self.history and self.history[-1][0] == k:
+            self.history[-1] = (k, IF, hv, dv)
         else:
-            history.append((k, IF, hv_k, dv))
-        if progress is not None:
-            progress(k, IF, hv_k)
+            self.history.append((k, IF, hv, dv))
+        if self.progress is not None:
+            self.progress(k, IF, hv)
+        return IF
 
-    def snap(k: int, state: np.ndarray) -> None:
-        if k in snaps_wanted:
-            snapshots[k] = state * scale + center
+    def snap(self, k: int, state: np.ndarray) -> None:
+        if k in self.snaps_wanted:
+            self.snapshots[k] = state * self.surface.scale + self.surface.center
 
-    snap(0, X)
-    record(0, X, hv)
-    good = (0, X.copy(), hv)  # last state that passed the intersection check
-    done = 0
-    reason = ""
-    best_hv, best_at, if_at_best = hv, 0, 0.0
-    while not reason:
-        target = min(max_steps, (done // log_every + 1) * log_every)
-        later = [s for s in snaps_wanted if s > done]
-        if later:
-            target = min(target, later[0])
-        status = _run(X, P, F, L0, fedge, edges, efaces, counted, pv, float(hv_boost), pcap, float(pressure),
-                      float(modulus), float(stiffness_ratio), math.radians(concave_threshold_deg),
-                      float(vertex_stiffness), rule, dt, int(until_hv), target - done, min_area2,
-                      normals, area2, phi, S, rho, *bufs_n, lam, force, out)
-        done += int(out[0])
-        hv = int(out[1])
-        if status == _TARGET:
-            reason = "target-hv"
-        elif status == _STALL:
-            reason = "stalled"
-        elif status == _FLIP:
-            reason = f"guard: face {int(out[2])} would flip"
-        elif status == _COLLAPSE:
-            reason = f"guard: face {int(out[2])} would collapse"
-        elif status == _FOLD:
-            reason = f"guard: faces {int(out[2])} and {int(out[3])} would fold through each other"
-        elif done >= max_steps:
-            reason = "max-steps"
-        snap(done, X)
-        if done % log_every == 0 or reason:
-            c, pr = _crossing_pairs(X, F, tol, skip, 1) if check_intersections else (0, None)
-            if c:
-                k, Xg, hv_g = good
-                X[:] = Xg
-                hv = hv_g
-                done = k
-                for s in [s for s in snapshots if s > k]:
-                    del snapshots[s]
-                while history and history[-1][0] > k:
-                    history.pop()
-                reason = f"guard: faces {int(pr[0, 0])} and {int(pr[0, 1])} would intersect"
-                break
-            good = (done, X.copy(), hv)
-            record(done, X, hv)
-            if not reason and stall_window:
-                IF = history[-1][1]
-                if hv < best_hv:
-                    best_hv, best_at, if_at_best = hv, done, IF
-                elif done - best_at >= stall_window:
-                    if abs(IF - if_at_best) < 1e-4:
-                        reason = "stalled"
-                    else:
-                        best_at, if_at_best = done, IF
-    IF = mean_disp(X)
-    out_mesh = Mesh(X * scale + center, F.copy(), mesh.face_source.copy())
-    if not history or history[-1][0] != done:
-        record(done, X, hv)
+    def rewind(self, k: int) -> None:
+        """Forget the rows and snapshots after step k."""
+        for s in [s for s in self.snapshots if s > k]:
+            del self.snapshots[s]
+        while self.history and self.history[-1][0] > k:
+            self.history.pop()
+
+
+def _result(mesh: Mesh, surface: _Surface, log: _Log, notes: tuple, reason: str, done: int, hv: int) -> InflateResult:
+    """The InflateResult of a run that stopped for `reason` after `done` steps at HV hv (the state
+    in surface.X); logs that state if it is not the last row yet."""
+    IF = surface.inflation_rate(surface.X)
+    out_mesh = Mesh(surface.X * surface.scale + surface.center, surface.F.copy(), mesh.face_source.copy())
+    if not log.history or log.history[-1][0] != done:
+        log.record(done, surface.X, hv)
     return InflateResult(
         mesh=out_mesh,
         stop_reason=reason,
         steps=done,
         inflation_rate=IF,
         hyperbolic=hv,
-        history=np.array(history, dtype=np.float64).reshape(-1, 4),
-        snapshots=snapshots,
-        hyperbolic_start=hv_start,
-        notes=tuple(notes),
+        history=np.array(log.history, dtype=np.float64).reshape(-1, 4),
+        snapshots=log.snapshots,
+        hyperbolic_start=surface.hv_start,
+        notes=notes,
     )
+
+
+def _near_pairs(F: np.ndarray, pairs: np.ndarray, n: int) -> np.ndarray:
+    """Sorted keys i * m + j (i < j) of the face pairs exempt from the intersection guard because the
+    input already crosses there: both faces within one vertex ring of the two faces of an input
+    crossing pair (the crossing line slides onto neighbouring faces as the surfaces move)."""
+    m = len(F)
+    vert_faces = [[] for _ in range(n)]
+    for f, tri in enumerate(F.tolist()):
+        for v in tri:
+            vert_faces[v].append(f)
+    keys = set()
+    for i, j in pairs.tolist():
+        near_i = sorted({g for v in F[i] for g in vert_faces[v]})
+        near_j = sorted({g for v in F[j] for g in vert_faces[v]})
+        for a in near_i:
+            for b in near_j:
+                if a != b:
+                    keys.add(min(a, b) * m + max(a, b))
+    return np.array(sorted(keys), dtype=np.int64)
+
+
+class _IntersectionGuard:
+    """The self-intersection guard: the input's crossing pairs (a note; they and their neighbours
+    are exempt, `_near_pairs`) and the last state that passed a check (step, X, HV)."""
+
+    def __init__(self, surface: _Surface, enabled: bool) -> None:
+        X, F, used = surface.X, surface.F, surface.used
+        self.surface = surface
+        self.enabled = enabled
+        self.tol = CONTACT * float(np.linalg.norm(surface.P[used].max(0) - surface.P[used].min(0)))
+        count, pairs = crossing_pairs(X, F, self.tol, 0)
+        notes = []
+        if count:
+            count, pairs = crossing_pairs(X, F, self.tol, count)
+            notes.append(f"the input already self-intersects ({count} crossing face pair{'s' if count != 1 else ''}, "
+                         f"e.g. faces {pairs[0, 0]} and {pairs[0, 1]}); those pairs and their neighbours are not checked")
+        self.notes = tuple(notes)
+        self.skip = _near_pairs(F, pairs, surface.n_vertices) if count else None
+        self.good = (0, X.copy(), surface.hv_start)
+
+    def crossing(self) -> Optional[tuple[int, int]]:
+        """A face pair of the current state that crosses (not exempt), or None (also when off)."""
+        if not self.enabled:
+            return None
+        count, pairs = crossing_pairs(self.surface.X, self.surface.F, self.tol, 1, self.skip)
+        return (int(pairs[0, 0]), int(pairs[0, 1])) if count else None
+
+    def passed(self, k: int, hv: int) -> None:
+        """The current state (step k, HV hv) passed a check."""
+        if self.enabled:
+            self.good = (k, self.surface.X.copy(), hv)
+
+    def restore(self) -> tuple[int, int]:
+        """Put the last state that passed back into the surface; returns its (step, HV)."""
+        k, X, hv = self.good
+        self.surface.X[:] = X
+        return k, hv
+
+
+class _StallWindow:
+    """The stall rule for the limit cycle (module docstring): no new lowest HV and IF moving
+    less than STALL_IF over `window` steps (window 0: never)."""
+
+    def __init__(self, window: int, hv: int) -> None:
+        self.window = window
+        self.best_hv, self.best_at, self.if_at_best = hv, 0, 0.0
+
+    def stalled(self, k: int, hv: int, IF: float) -> bool:
+        """Update with the logged state of step k; True when the run has stalled."""
+        if not self.window:
+            return False
+        if hv < self.best_hv:
+            self.best_hv, self.best_at, self.if_at_best = hv, k, IF
+        elif k - self.best_at >= self.window:
+            if abs(IF - self.if_at_best) < STALL_IF:
+                return True
+            self.best_at, self.if_at_best = k, IF
+        return False
+
+
+def _stop_reason(status: int, out: np.ndarray, at_max_steps: bool) -> str:
+    """The stop reason for a `run_steps` status ("" to go on)."""
+    if status == AT_TARGET:
+        return "target-hv"
+    if status == STALLED:
+        return "stalled"
+    if status == FLIPPED:
+        return f"guard: face {int(out[2])} would flip"
+    if status == COLLAPSED:
+        return f"guard: face {int(out[2])} would collapse"
+    if status == FOLDED_THROUGH:
+        return f"guard: faces {int(out[2])} and {int(out[3])} would fold through each other"
+    return "max-steps" if at_max_steps else ""
+
+
+def _step_loop(surface: _Surface, model: _Model, guard: _IntersectionGuard, log: _Log, max_steps: int,
+               log_every: int, stall_window: int) -> tuple[str, int, int]:
+    """Run the steps in chunks up to the next log step or snapshot, until a stop rule fires; the
+    intersection guard and the log at every log step and at the end. Returns (stop reason, steps
+    done, HV) of the state left in surface.X."""
+    done = 0
+    hv = surface.hv_start
+    reason = ""
+    stall = _StallWindow(stall_window, hv)
+    while not reason:
+        target = min(max_steps, (done // log_every + 1) * log_every)
+        later = [s for s in log.snaps_wanted if s > done]
+        if later:
+            target = min(target, later[0])
+        status = model.run(surface, target - done)
+        done += int(surface.out[0])
+        hv = int(surface.out[1])
+        reason = _stop_reason(status, surface.out, done >= max_steps)
+        log.snap(done, surface.X)
+        if done % log_every == 0 or reason:
+            hit = guard.crossing()
+            if hit is not None:
+                done, hv = guard.restore()
+                log.rewind(done)
+                return f"guard: faces {hit[0]} and {hit[1]} would intersect", done, hv
+            guard.passed(done, hv)
+            IF = log.record(done, surface.X, hv)
+            if not reason and stall.stalled(done, hv, IF):
+                reason = "stalled"
+    return reason, done, hv
