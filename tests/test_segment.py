@@ -22,8 +22,7 @@ from test_cli import one_line, run_cli
 
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
-from polyfold.mesh.geometry import FLAT_EPS
-from polyfold.segment.kernels import convex_hull
+from polyfold.segment.hull_kernels import HULL_FLAT_EPS, convex_hull
 from polyfold.segment.segment import DEFAULT_TAU, rand_index, segment, surface_samples
 
 # ----------------------------------------------------------------------------------------------
@@ -193,7 +192,7 @@ def test_hull_kernel_matches_qhull(models_dir):
     vertices, and the same depth below the hull for interior points; flat sets have no hull."""
     checked = 0
     for pts in _hull_sets(models_dir):
-        verts, eq = convex_hull(pts, FLAT_EPS)
+        verts, eq = convex_hull(pts, HULL_FLAT_EPS)
         try:
             qh = ConvexHull(pts)
         except QhullError:
@@ -210,7 +209,7 @@ def test_hull_kernel_matches_qhull(models_dir):
                                                        .min(axis=1).max())) <= 1e-9 * scale
     assert checked > 400
     flat = np.c_[np.random.default_rng(1).random((12, 2)), np.full(12, 2.0)]
-    assert len(convex_hull(flat, FLAT_EPS)[1]) == 0
+    assert len(convex_hull(flat, HULL_FLAT_EPS)[1]) == 0
 
 
 def test_merging_arrays_match_their_numpy_definitions(models_dir):

@@ -19,12 +19,13 @@ Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 3. Clean up: parts smaller than MIN_FACES faces join the neighbour with the cheapest admissible
    merge (concavity still <= tau).
 
-A merging run is one numba kernel (`_segment_kernels.merge_run`). The union concavity uses cached
+A merging run is one numba kernel (`merge_kernels.merge_run`). The union concavity uses cached
 hulls (the hull of A u B is the hull of the two hulls' vertices) and a depth kernel with early
 exit; evaluations are memoized across runs, so `parts=K` (a bisection on tau) re-uses most of
-them. Merging adjacent connected clusters keeps every part edge-connected. The per-mesh arrays,
-the candidate initial clusters and the parts' tables and concavities are numba kernels as well,
-one call each per segment() (per-face or per-part numpy calls cost more than the merging).
+them; a Deadline stops that bisection between runs (`Segmentation.timed_out`). Merging adjacent
+connected clusters keeps every part edge-connected. The per-mesh arrays, the candidate initial
+clusters and the parts' tables and concavities are numba kernels as well (table_kernels), one
+call each per segment() (per-face or per-part numpy calls cost more than the merging).
 
 Concavity (`part_concavity`): max over the part's vertices plus SAMPLES_PER_FACE seeded surface
 samples per face of the depth below the part's own convex hull (hull of its vertices), divided by
@@ -37,11 +38,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from .kernels import (FLAT_EPS, convex_hull, denoise, face_groups, face_keys, face_lengths, first_face_order, inner_edges,
-                               make_units, max_depth, merge_run, new_memo, part_concavities, part_tables, sample_points, unit_groups)
+from .hull_kernels import HULL_FLAT_EPS, convex_hull, denoise, max_depth
+from .memo_kernels import make_units, new_memo
+from .merge_kernels import merge_run
+from .table_kernels import (face_groups, face_keys, face_lengths, first_face_order, inner_edges, part_concavities, part_tables,
+                            sample_points, unit_groups)
+from ..deadline import Deadline
 from ..mesh.mesh import Mesh
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
@@ -63,7 +69,9 @@ class Segmentation:
     tau: the concavity tolerance the parts satisfy (relative to the whole mesh's bbox diagonal);
     concavity (P,): each part's concavity (same scale); parts: each part as `mesh.submesh(face_ids)`
     (its face_source maps to the input file's faces); face_ids: the mesh faces of each part, in
-    the part's face order; vertex_ids: the mesh vertex of each of the part's vertices.
+    the part's face order; vertex_ids: the mesh vertex of each of the part's vertices;
+    timed_out: the deadline passed during the `parts=K` search, so this is the closest part count
+    found until then (still every part's concavity <= tau).
     """
 
     labels: np.ndarray
@@ -72,6 +80,7 @@ class Segmentation:
     parts: tuple[Mesh, ...]
     face_ids: tuple[np.ndarray, ...]
     vertex_ids: tuple[np.ndarray, ...]
+    timed_out: bool = False
 
     @property
     def n_parts(self) -> int:
@@ -98,7 +107,7 @@ def _hull(points: np.ndarray):
     if len(points) < 4:
         return points, None
     if len(points) <= SMALL_HULL:
-        verts, eq = convex_hull(np.ascontiguousarray(points, dtype=np.float64), FLAT_EPS)
+        verts, eq = convex_hull(np.ascontiguousarray(points, dtype=np.float64), HULL_FLAT_EPS)
         return (points, None) if len(eq) == 0 else (points[verts], eq)
     try:
         h = ConvexHull(points)
@@ -185,7 +194,7 @@ class _Merger:
         # Perimeter of each face counted over all its edges; shared edges are subtracted on merges.
         self.areas, self.face_perim, edge_len = face_lengths(mesh.vertices, mesh.faces, topo.edges, topo.face_edges)
         self.ef0, self.ef1, self.inner_len, self.inner_conc = inner_edges(topo.edge_faces, edge_len, mesh.fold_angles)
-        # random 64-bit face keys: a cluster's key is their sum (see _segment_kernels.new_memo)
+        # random 64-bit face keys: a cluster's key is their sum (see memo_kernels.new_memo)
         self.face_key = face_keys(mesh.n_faces)
         self.memo = new_memo(mesh.n_faces)
         # seeds: faces joined across edges with rho >= -SEED_ANGLE_DEG (locally convex regions) and
@@ -215,7 +224,7 @@ class _Merger:
 def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
          w_compact: float = W_COMPACT, w_seam: float = W_SEAM, min_faces: int = MIN_FACES) -> tuple[np.ndarray, int]:
     """One merging run: (a cluster label per face, the number of clusters) (tau absolute; stop at
-    `target` clusters). The merging itself is `_segment_kernels.merge_run`."""
+    `target` clusters). The merging itself is `merge_kernels.merge_run`."""
     limit = tau * m.diag * (1 - 1e-9)  # margin: the final re-measure may differ by rounding
     scale = limit if limit > 0 and math.isfinite(limit) else m.diag
     label, n, m.memo = merge_run(limit, scale, -1 if target is None else int(target), float(w_compact), float(w_seam),
@@ -223,7 +232,8 @@ def _run(m: _Merger, tau: float, target: int | None, seed_labels: np.ndarray,
     return label, n
 
 
-def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed: int = 0) -> Segmentation:
+def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed: int = 0,
+            deadline: Deadline | None = None) -> Segmentation:
     """Decompose `mesh` into edge-connected parts whose concavity is <= tau (relative to the bbox
     diagonal of the whole mesh).
 
@@ -232,46 +242,76 @@ def segment(mesh: Mesh, tau: float = DEFAULT_TAU, parts: int | None = None, seed
     cost order until K parts remain, and the reported tau is the largest part concavity. The count
     is bounded below by the number of edge-connected components and above by the count at tau 0
     (already-convex pieces are not split further), so the result may have fewer or more than K.
-    seed: seeds the surface samples of the concavity metric.
+    seed: seeds the surface samples of the concavity metric. deadline (None: no limit): when it
+    passes during the parts=K search, the search stops after the merging run under way and the
+    result is the run whose part count came closest to K (ties: the smaller tau), with
+    `timed_out` set; one run is always made. A single tau is one run and never times out.
     """
     if mesh.n_faces == 0:
         raise ValueError("empty mesh")
     if not (tau >= 0 and math.isfinite(tau)):
         raise ValueError(f"tau must be a non-negative number, not {tau!r}")
     m = _Merger(mesh, seed)
+    timed_out = False
     if parts is None:
         label, _ = _run(m, tau, None, m.seeds)
     else:
-        label, tau = _fit_parts(m, m.seeds, int(parts))
-    return _finish(m, label, tau)
+        label, tau, timed_out = _fit_parts(m, m.seeds, int(parts), deadline or Deadline.never())
+    return _finish(m, label, tau, timed_out)
 
 
-def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[np.ndarray, float]:
+class _TimeUp(Exception):
+    """The deadline of a `parts=K` search passed before a merging run."""
+
+
+def _fit_parts(m: _Merger, seeds: np.ndarray, k: int, deadline: Deadline) -> tuple[np.ndarray, float, bool]:
+    """(cluster labels, tau, timed out) for `parts=k` (see `_search_parts`); when the deadline
+    passes, the run so far whose count is closest to k (ties: the smaller tau)."""
+    n_comp = int(m.components.max()) + 1
+    k = int(min(max(k, n_comp), m.mesh.n_faces))
+    runs: list[tuple[np.ndarray, int, float]] = []
+
+    def run(tau: float, target: int | None = None) -> tuple[np.ndarray, int]:
+        if runs and deadline.expired():
+            raise _TimeUp
+        g, n = _run(m, tau, target, seeds)
+        runs.append((g, n, tau))
+        return g, n
+
+    try:
+        g, tau = _search_parts(m, k, run)
+    except _TimeUp:
+        g, _, tau = min(runs, key=lambda r: (abs(r[1] - k), r[2]))
+        return g, tau, True
+    return g, tau, False
+
+
+def _search_parts(m: _Merger, k: int, run: Callable[..., tuple[np.ndarray, int]]) -> tuple[np.ndarray, float]:
     """Cluster labels and tau for `parts=k`: the default tau when it already gives k parts (so
-    `segment()` and `segment(parts=k)` agree), else a bisection on tau from the default towards k."""
+    `segment()` and `segment(parts=k)` agree), else a bisection on tau from the default towards k.
+    run(tau, target=None): one merging run (`_run` on the seeds)."""
     mesh = m.mesh
     n_comp = int(m.components.max()) + 1
-    k = int(min(max(k, n_comp), mesh.n_faces))
-    g, n = _run(m, DEFAULT_TAU, None, seeds)
+    g, n = run(DEFAULT_TAU)
     if n == k:
         return g, DEFAULT_TAU
     if n > k:
         lo, hi = DEFAULT_TAU, None
     else:
         lo, hi = 0.0, DEFAULT_TAU
-        g0, n0 = _run(m, 0.0, None, seeds)
+        g0, n0 = run(0.0)
         if n0 <= k:  # even tau 0 gives no more parts: already-convex pieces stay whole
             return g0, 0.0
     if hi is None:
         # every component as one part is admissible at its own concavity
         hi = float(_parts_concavity(m, part_tables(m.components, n_comp, mesh.faces, mesh.n_vertices)).max()) * 1.001
         hi = max(hi, lo * 1.001)
-        g, n = _run(m, hi, None, seeds)
+        g, n = run(hi)
         if n == k:
             return g, hi
     for _ in range(40):
         mid = 0.5 * (lo + hi)
-        g, n = _run(m, mid, None, seeds)
+        g, n = run(mid)
         if n == k:
             return g, mid
         if n > k:
@@ -281,13 +321,13 @@ def _fit_parts(m: _Merger, seeds: np.ndarray, k: int) -> tuple[np.ndarray, float
         if hi - lo < 1e-6:
             break
     # No tau gives exactly k: merge on past tau (hi) until k parts, report the largest concavity.
-    g, n = _run(m, hi, k, seeds)
+    g, n = run(hi, k)
     label, n = first_face_order(g)
     conc = float(_parts_concavity(m, part_tables(label, n, mesh.faces, mesh.n_vertices)).max())
     return g, max(conc, lo)
 
 
-def _finish(m: _Merger, label: np.ndarray, tau: float) -> Segmentation:
+def _finish(m: _Merger, label: np.ndarray, tau: float, timed_out: bool = False) -> Segmentation:
     """The Segmentation of a run's cluster labels: parts ordered by their first face so labels are
     stable and readable, faces and vertices ascending within each part."""
     mesh = m.mesh
@@ -300,4 +340,5 @@ def _finish(m: _Merger, label: np.ndarray, tau: float) -> Segmentation:
     # each part as mesh.submesh(face_ids[p]) builds it
     subs = tuple(Mesh(mesh.vertices[v], local[fstart[p]:fstart[p + 1]], mesh.face_source[f])
                  for p, (f, v) in enumerate(zip(face_ids, vids)))
-    return Segmentation(labels=labels, tau=float(tau), concavity=conc, parts=subs, face_ids=face_ids, vertex_ids=vids)
+    return Segmentation(labels=labels, tau=float(tau), concavity=conc, parts=subs, face_ids=face_ids, vertex_ids=vids,
+                        timed_out=timed_out)

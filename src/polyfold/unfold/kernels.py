@@ -12,8 +12,23 @@ from numba import njit
 from ..collide.flat import overlapping_pairs
 
 
+# Prim's heap: parallel arrays (weight, push counter, face, parent, edge) ordered by (weight,
+# counter); the counter breaks ties in push order. The order test is written out at each use: as
+# a helper (even inlined) it made prim_tree twice as slow.
+
+
+@njit(cache=True, inline="always")
+def _swap(hw, hc, hf, hp, he, a, b):
+    hw[a], hw[b] = hw[b], hw[a]
+    hc[a], hc[b] = hc[b], hc[a]
+    hf[a], hf[b] = hf[b], hf[a]
+    hp[a], hp[b] = hp[b], hp[a]
+    he[a], he[b] = he[b], he[a]
+
+
 @njit(cache=True)
 def _heap_push(hw, hc, hf, hp, he, size, w, c, f, p, e):
+    """Add the entry (w, c, f, p, e) to the heap of `size` entries: the new size."""
     i = size
     hw[i] = w
     hc[i] = c
@@ -24,17 +39,14 @@ def _heap_push(hw, hc, hf, hp, he, size, w, c, f, p, e):
         par = (i - 1) >> 1
         if hw[par] < hw[i] or (hw[par] == hw[i] and hc[par] < hc[i]):
             break
-        hw[par], hw[i] = hw[i], hw[par]
-        hc[par], hc[i] = hc[i], hc[par]
-        hf[par], hf[i] = hf[i], hf[par]
-        hp[par], hp[i] = hp[i], hp[par]
-        he[par], he[i] = he[i], he[par]
+        _swap(hw, hc, hf, hp, he, par, i)
         i = par
     return size + 1
 
 
 @njit(cache=True)
 def _heap_pop(hw, hc, hf, hp, he, size):
+    """Remove the first entry: its (face, parent, edge) and the new size."""
     f, p, e = hf[0], hp[0], he[0]
     size -= 1
     hw[0], hc[0], hf[0], hp[0], he[0] = hw[size], hc[size], hf[size], hp[size], he[size]
@@ -49,11 +61,7 @@ def _heap_pop(hw, hc, hf, hp, he, size):
             m = right
         if hw[i] < hw[m] or (hw[i] == hw[m] and hc[i] < hc[m]):
             break
-        hw[m], hw[i] = hw[i], hw[m]
-        hc[m], hc[i] = hc[i], hc[m]
-        hf[m], hf[i] = hf[i], hf[m]
-        hp[m], hp[i] = hp[i], hp[m]
-        he[m], he[i] = he[i], he[m]
+        _swap(hw, hc, hf, hp, he, m, i)
         i = m
     return f, p, e, size
 
@@ -179,16 +187,20 @@ def local_overlaps(pairs, face_edges, edges, hyperbolic):
 
 
 @njit(cache=True)
+def tree_arrays(n):
+    """Room for one spanning tree of n faces and its layout: (parent, parent_edge, order (n,),
+    coords (n, 3, 2)), uninitialised."""
+    return np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64), np.empty((n, 3, 2))
+
+
+@njit(cache=True)
 def evaluate_batch(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges, edges, hyperbolic, local, tol, max_pairs):
     """Decode and score a batch of genomes (B, E): returns global overlaps G (B,) and local L (B,)."""
     nb = weights.shape[0]
     nf = faces.shape[0]
     G = np.zeros(nb, dtype=np.int64)
     L = np.zeros(nb, dtype=np.int64)
-    parent = np.empty(nf, dtype=np.int64)
-    parent_edge = np.empty(nf, dtype=np.int64)
-    order = np.empty(nf, dtype=np.int64)
-    tris = np.empty((nf, 3, 2))
+    parent, parent_edge, order, tris = tree_arrays(nf)
     for b in range(nb):
         prim_tree(weights[b], base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
         layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
@@ -241,12 +253,9 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
     np.random.seed(seed)
     n = faces.shape[0]
     n_e = edges.shape[0]
-    parent = np.empty(n, dtype=np.int64)
-    parent_edge = np.empty(n, dtype=np.int64)
-    order = np.empty(n, dtype=np.int64)
+    parent, parent_edge, order, tris = tree_arrays(n)
     depth = np.empty(n, dtype=np.int64)
     in_sub = np.empty(n, dtype=np.bool_)
-    tris = np.empty((n, 3, 2))
     best_crease = crease.copy()
     tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
     layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
@@ -263,22 +272,8 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
         r = np.random.randint(npairs)
         f = pairs[r, 0]
         g = pairs[r, 1]
-        # tree path between f and g (creases named by their child face)
-        depth[base] = 0
-        for idx in range(1, n):
-            x = order[idx]
-            depth[x] = depth[parent[x]] + 1
-        plen = 0
-        a = f
-        b = g
-        while a != b:
-            if depth[a] >= depth[b]:
-                path[plen] = a
-                a = parent[a]
-            else:
-                path[plen] = b
-                b = parent[b]
-            plen += 1
+        tree_depths(parent, order, depth)
+        plen = tree_path(f, g, parent, depth, path, 0)
         x = path[np.random.randint(plen)]
         c = parent_edge[x]
         # faces of the subtree under x
@@ -327,40 +322,43 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
 
 
 @njit(cache=True)
+def tree_depths(parent, order, depth):
+    """Fill depth (F,): each face's number of creases below its root (roots 0). Parents must
+    precede children in `order`."""
+    for idx in range(order.shape[0]):
+        f = order[idx]
+        depth[f] = depth[parent[f]] + 1 if parent[f] >= 0 else 0
+
+
+@njit(cache=True)
+def tree_path(a, b, parent, depth, out, k):
+    """Write the creases of the tree path between faces a and b (same tree) to out[k:], each
+    named by its child face, climbing from the deeper end: the index after the last one written."""
+    while a != b:
+        if depth[a] >= depth[b]:
+            out[k] = a
+            a = parent[a]
+        else:
+            out[k] = b
+            b = parent[b]
+        k += 1
+    return k
+
+
+@njit(cache=True)
 def tree_paths(parent, order, pairs):
     """Tree paths between the faces of each pair, as CSR (ptr, members); a crease is named by its
     child face. Parents must precede children in `order`."""
     n = parent.shape[0]
-    depth = np.zeros(n, dtype=np.int64)
-    for idx in range(1, n):
-        f = order[idx]
-        if parent[f] >= 0:
-            depth[f] = depth[parent[f]] + 1
+    depth = np.empty(n, dtype=np.int64)
+    tree_depths(parent, order, depth)
+    scratch = np.empty(n, dtype=np.int64)  # a path has fewer creases than the tree has faces
     ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
-    total = 0
     for r in range(pairs.shape[0]):
-        a = pairs[r, 0]
-        b = pairs[r, 1]
-        while a != b:
-            if depth[a] >= depth[b]:
-                a = parent[a]
-            else:
-                b = parent[b]
-            total += 1
-        ptr[r + 1] = total
-    members = np.empty(total, dtype=np.int64)
-    k = 0
+        ptr[r + 1] = ptr[r] + tree_path(pairs[r, 0], pairs[r, 1], parent, depth, scratch, 0)
+    members = np.empty(ptr[-1], dtype=np.int64)
     for r in range(pairs.shape[0]):
-        a = pairs[r, 0]
-        b = pairs[r, 1]
-        while a != b:
-            if depth[a] >= depth[b]:
-                members[k] = a
-                a = parent[a]
-            else:
-                members[k] = b
-                b = parent[b]
-            k += 1
+        tree_path(pairs[r, 0], pairs[r, 1], parent, depth, members, ptr[r])
     return ptr, members
 
 
@@ -408,10 +406,7 @@ def decode_tree(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges, l
     """Genome (E,) -> (reached, parent, parent_edge, order, coords (F, 3, 2)): Prim's tree and its
     layout. coords is only laid out when every face is reached (reached == F)."""
     n = faces.shape[0]
-    parent = np.empty(n, np.int64)
-    parent_edge = np.empty(n, np.int64)
-    order = np.empty(n, np.int64)
-    coords = np.empty((n, 3, 2))
+    parent, parent_edge, order, coords = tree_arrays(n)
     reached = prim_tree(weights, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
     if reached == n:
         layout_tree(order, parent, parent_edge, faces, face_edges, local, coords)

@@ -2,13 +2,13 @@
 
 In: a manifold, consistently oriented `Mesh` (one edge-connected component, closed or open).
 Out: a `Net` — a spanning forest of the dual graph with its planar layout, one tree per piece,
-overlap-free (checked with the exact test of `overlap.py`).
+overlap-free (checked with the exact test of `collide.flat`).
 
 Genome (ALGORITHMS.md 5.1, 5.5): one weight in [0, 1] per mesh edge; Prim's algorithm from the base
 face keeps light edges as creases. Fitness = -(G + 100 L), G = overlapping face pairs, L = overlaps
-at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time or
-generation budget runs out, the best tree is split into the fewest overlap-free pieces found by a
-set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
+at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time (a
+`Deadline`) or the generation budget runs out, the best tree is split into the fewest overlap-free
+pieces found by a set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..deadline import Deadline
 from ..errors import NoNetFound
 from ..mesh.mesh import Mesh
 from . import kernels as K
@@ -48,27 +49,18 @@ FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local
 GA_CREATORS = ("steepest-edge", "flat-tree", "unflat-tree", "random-edge")
 
 
-@dataclass
-class _Budget:
-    deadline: float
-    max_generations: int
-
-    def exhausted(self, generation: int) -> bool:
-        return generation >= self.max_generations or time.perf_counter() >= self.deadline
-
-
 def _fitness(G: np.ndarray, L: np.ndarray) -> np.ndarray:
     return -(G + 100 * L).astype(np.float64)
 
 
-def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _Budget, population: int,
+def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, deadline: Deadline, population: int,
                      finished: Callable[[np.ndarray], bool]) -> tuple[np.ndarray, np.ndarray, list[str], int, int]:
     """The GA's initial population: each individual from a creator drawn from GA_CREATORS.
 
     Evaluated in small batches so a valid heuristic net (one `finished` accepts) stops the search
     at once; valid but unaccepted ones get fitness -0.5 (good parents, not answers). Returns
     (pop, fit, origin, evaluations, index of the accepted individual or -1); pop is cut short
-    when the budget runs out.
+    when the deadline passes.
     """
     mesh = problem.mesh
     pop = np.empty((population, mesh.topology.n_edges))
@@ -92,7 +84,7 @@ def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _
                 return pop, fit, origin, evaluations, int(i)
             fit[i] = -0.5
         start = stop
-        if time.perf_counter() >= budget.deadline:
+        if deadline.expired():
             break
     return pop[:filled], fit[:filled], origin[:filled], evaluations, -1
 
@@ -100,7 +92,8 @@ def _seed_population(problem: UnfoldProblem, rng: np.random.Generator, budget: _
 def run_ga(
     problem: UnfoldProblem,
     rng: np.random.Generator,
-    budget: _Budget,
+    deadline: Deadline,
+    max_generations: int,
     population: int = 400,
     children: int = 50,
     tournament: int = 7,
@@ -112,11 +105,11 @@ def run_ga(
     """Genetic algorithm of ALGORITHMS.md 5.5, seeded with the heuristics.
 
     Returns (best genome, best fitness, generations, evaluations, creator of the best). Stops at
-    the first valid net (fitness 0) or when the budget runs out.
+    the first valid net (fitness 0), after max_generations or when the deadline passes.
     """
     mesh = problem.mesh
     n_e = mesh.topology.n_edges
-    pop, fit, origin_list, evaluations, hit = _seed_population(problem, rng, budget, population, lambda g: True)
+    pop, fit, origin_list, evaluations, hit = _seed_population(problem, rng, deadline, population, lambda g: True)
     if hit >= 0:
         return pop[hit].copy(), 0.0, 0, evaluations, origin_list[hit]
     population = len(pop)
@@ -124,7 +117,7 @@ def run_ga(
     best = float(fit.max())
     stall = 0
     generation = 0
-    while not budget.exhausted(generation):
+    while generation < max_generations and not deadline.expired():
         generation += 1
         pm = p_mut if stall <= 100 else min(1.0, p_mut * 1.25 ** (stall / 100))
         pc = p_cross if stall <= 100 else min(1.0, p_cross * 1.1 ** (stall / 100))
@@ -170,10 +163,55 @@ def _genome_of_tree(crease: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return np.where(crease, 0.0, 0.5) + 0.5 * rng.random(len(crease)) * np.where(crease, 0.0, 1.0)
 
 
+class _AcceptFirst:
+    """The memetic search's test of a valid genome: an answer when `accept` (None: any) passes it;
+    the first valid genome it turns down is kept as the fallback answer."""
+
+    def __init__(self, accept: Callable[[np.ndarray], bool] | None):
+        self.accept = accept
+        self.fallback: np.ndarray | None = None
+
+    def __call__(self, genome: np.ndarray) -> bool:
+        if self.accept is None or self.accept(genome):
+            return True
+        if self.fallback is None:
+            self.fallback = genome.copy()
+        return False
+
+
+def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.Generator, deadline: Deadline,
+                      temperature: float) -> tuple[np.ndarray, int, int]:
+    """Edge-swap local search from the tree of a child genome (ALGORITHMS.md 5.5): (improved
+    genome, overlap score, iterations). Runs up to max(1000, 4 F) iterations, in kernel calls short
+    enough to check the deadline often; stops at a valid tree (score 0) or when the deadline passes."""
+    mesh = problem.mesh
+    topo = mesh.topology
+    # Effort per generation: enough to finish most nets, small enough to restart from a fresh
+    # child when the search is stuck in a local minimum.
+    chunk_iters = max(1000, 4 * mesh.n_faces)
+    step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
+    max_pairs = 4 * mesh.n_faces
+    parent, parent_edge, _, _ = problem.decode(child)
+    crease = np.zeros(topo.n_edges, dtype=np.bool_)
+    crease[parent_edge[parent_edge >= 0]] = True
+    done_iters, score = 0, 0
+    while done_iters < chunk_iters:
+        score, it = K.local_search(
+            crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
+            mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, max_pairs,
+            step, int(rng.integers(2**31)), temperature,
+        )
+        done_iters += max(it, 1)
+        if score == 0 or deadline.expired():
+            break
+    return _genome_of_tree(crease, rng), int(score), done_iters
+
+
 def run_memetic(
     problem: UnfoldProblem,
     rng: np.random.Generator,
-    budget: _Budget,
+    deadline: Deadline,
+    max_generations: int,
     population: int = 400,
     tournament: int = 7,
     p_cross: float = 0.4,
@@ -184,76 +222,40 @@ def run_memetic(
     """GA of ALGORITHMS.md 5.5 with a Lamarckian tree local search ("auto").
 
     Same heuristic-seeded population, tournament selection and uniform crossover as `run_ga`; each
-    generation breeds one child, improves it with edge-swap local search (a crease on the tree path
+    generation breeds one child, improves it with `tree_local_search` (a crease on the tree path
     between two overlapping faces is swapped for a cut edge that reconnects the halves), and writes
     the improved tree back into the population in place of the worst individual. Returns the same
-    tuple as `run_ga`.
+    tuple as `run_ga`; stops like it.
 
     accept: optional extra test of a valid (overlap-free) genome; the search goes on, within the
     budget, until a valid genome passes it, and falls back to the first valid one otherwise.
     """
-    fallback: list[np.ndarray] = []
-
-    def finished(genome: np.ndarray) -> bool:
-        if accept is None or accept(genome):
-            return True
-        if not fallback:
-            fallback.append(genome.copy())
-        return False
-
-    mesh = problem.mesh
-    topo = mesh.topology
-    n_e = topo.n_edges
+    finished = _AcceptFirst(accept)
+    n_e = problem.mesh.topology.n_edges
     # The first batch of the population only, then one local search from its best: most nets
     # are finished by that search, and building the whole population (hundreds of heuristic
     # trees) first would cost ten times more. The rest of the population is built only if not.
-    first = min(FIRST_BATCH, population)
-    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, budget, first, finished)
+    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population), finished)
     if hit >= 0:
         return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
-    # Local-search effort per generation: enough to finish most nets, small enough to restart
-    # from a fresh child when the search is stuck in a local minimum.
-    chunk_iters = max(1000, 4 * mesh.n_faces)
-    step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
-    cap = 4 * mesh.n_faces
-    crease = np.zeros(n_e, dtype=np.bool_)
-
-    def improve(child: np.ndarray) -> tuple[np.ndarray, int, int]:
-        """Local search from a child genome: (improved genome, overlap score, iterations)."""
-        parent, parent_edge, _, _ = problem.decode(child)
-        crease[:] = False
-        crease[parent_edge[parent_edge >= 0]] = True
-        done_iters, score = 0, 0
-        while done_iters < chunk_iters:
-            score, it = K.local_search(
-                crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
-                mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, cap,
-                step, int(rng.integers(2**31)), temperature,
-            )
-            done_iters += max(it, 1)
-            if score == 0 or time.perf_counter() >= budget.deadline:
-                break
-        return _genome_of_tree(crease, rng), int(score), done_iters
-
     generation = 0
-    while not budget.exhausted(generation):
+    while generation < max_generations and not deadline.expired():
         generation += 1
         if generation == 1:
             child = pop[int(np.argmax(fit))].copy()
         else:
             if generation == 2 and len(pop) < population:
                 more, more_fit, more_origin, more_ev, hit = _seed_population(
-                    problem, rng, budget, population - len(pop), finished)
+                    problem, rng, deadline, population - len(pop), finished)
                 evaluations += more_ev
                 if hit >= 0:
                     return more[hit].copy(), 0.0, generation, evaluations, more_origin[hit]
                 pop, fit = np.concatenate([pop, more]), np.concatenate([fit, more_fit])
-            n_pop = len(pop)
-            draws = rng.integers(0, n_pop, size=(2, tournament))
+            draws = rng.integers(0, len(pop), size=(2, tournament))
             winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
             swap = rng.random(n_e) < p_cross
             child = np.where(swap, pop[winners[1]], pop[winners[0]])
-        genome, score, done_iters = improve(child)
+        genome, score, done_iters = tree_local_search(problem, child, rng, deadline, temperature)
         evaluations += done_iters
         worst = int(np.argmin(fit))
         pop[worst] = genome
@@ -264,17 +266,18 @@ def run_memetic(
             if finished(genome):
                 return genome, 0.0, generation, evaluations, "ga+local-search"
             fit[worst] = -0.5
-    if fallback:
-        return fallback[0], 0.0, generation, evaluations, "ga+local-search"
+    if finished.fallback is not None:
+        return finished.fallback, 0.0, generation, evaluations, "ga+local-search"
     i = int(np.argmax(fit))
     return pop[i].copy(), float(fit[i]), generation, evaluations, "ga+local-search"
 
 
-def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator, budget: _Budget) -> tuple[np.ndarray, float, int]:
+def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator,
+                  deadline: Deadline) -> tuple[np.ndarray, float, int]:
     """Plain heuristic mode: fresh random direction per try, keep the best (fewest overlaps)."""
     best_w, best_fit, tries = None, -np.inf, 0
     make = HEURISTICS[name]
-    while tries < 100 and (tries == 0 or time.perf_counter() < budget.deadline):
+    while tries < 100 and (tries == 0 or not deadline.expired()):
         w = make(problem, rng)[None, :]
         G, L = problem.evaluate(w)
         tries += 1
@@ -345,6 +348,7 @@ def unfold(
     max_generations: int = 15000,
     progress: Callable[[int, float], None] | None = None,
     accept: Callable[[Net], bool] | None = None,
+    deadline: Deadline | None = None,
 ) -> tuple[Net, UnfoldStats]:
     """Unfold one edge-connected component into a net (one piece when one is found in time).
 
@@ -352,13 +356,17 @@ def unfold(
     raises `NoNetFound` instead of falling back to several pieces. Deterministic for a given seed
     (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
     within the time limit, for a valid net that also passes this test (e.g. linear foldability);
-    `UnfoldStats.accepted` says whether one did.
+    `UnfoldStats.accepted` says whether one did. deadline: when given, the search stops there
+    instead of `time_limit` seconds from now (the generation cap stays max_generations).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     t0 = time.perf_counter()
+    if deadline is None:
+        deadline = Deadline(t0 + time_limit)
+    else:
+        time_limit = deadline.left()
     rng = np.random.default_rng(seed)
-    budget = _Budget(deadline=t0 + time_limit, max_generations=max_generations)
     problem = UnfoldProblem.from_mesh(mesh)
     if mesh.n_faces == 1:
         weights = np.zeros(mesh.topology.n_edges)
@@ -371,11 +379,11 @@ def unfold(
         # Large meshes: a smaller seed population, so the local search gets the time budget.
         population = min(max(200_000 // mesh.n_faces, 50), 400)
         weights, fitness, generations, evaluations, winner = run_memetic(
-            problem, rng, budget, population=population, progress=progress, accept=accept_genome)
+            problem, rng, deadline, max_generations, population=population, progress=progress, accept=accept_genome)
     elif method == "ga":
-        weights, fitness, generations, evaluations, winner = run_ga(problem, rng, budget, progress=progress)
+        weights, fitness, generations, evaluations, winner = run_ga(problem, rng, deadline, max_generations, progress=progress)
     else:
-        weights, fitness, evaluations = run_heuristic(problem, method, rng, budget)
+        weights, fitness, evaluations = run_heuristic(problem, method, rng, deadline)
         generations, winner = 0, method
     parent, parent_edge, order, coords = problem.decode(weights)
     pairs = problem.overlaps(coords, parent)
