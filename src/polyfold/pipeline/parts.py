@@ -43,15 +43,17 @@ def component_faces(mesh: Mesh) -> tuple[np.ndarray, list[np.ndarray]]:
 class _Segmenter:
     """Segmentations of sets of faces of one mesh, and what they add up to for the report."""
 
-    def __init__(self, mesh: Mesh) -> None:
+    def __init__(self, mesh: Mesh, deadline: Deadline) -> None:
         self.mesh = mesh
+        self.deadline = deadline  # a --parts search stops here with the closest count so far
         self.seconds = 0.0
         self.tau: float | None = None
         self.concavity: list[float] = []
 
     def __call__(self, faces: np.ndarray, tau: float | None, parts: int | None) -> list[np.ndarray]:
         ts = time.perf_counter()
-        seg = segment(self.mesh.submesh(faces), tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=0)
+        seg = segment(self.mesh.submesh(faces), tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=0,
+                      deadline=self.deadline)
         self.seconds += time.perf_counter() - ts
         self.tau = seg.tau
         self.concavity += [float(c) for c in seg.concavity]
@@ -64,7 +66,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline,
     comp, components = component_faces(mesh)
     explicit = opts.tau is not None or opts.parts is not None
     mode = "tau" if opts.tau is not None else "parts" if opts.parts is not None else opts.segment
-    segmenter = _Segmenter(mesh)
+    segmenter = _Segmenter(mesh, deadline)
     segmented: list[int] = []
     nets: list[NetReport] = []
     unfold_s = 0.0

@@ -90,21 +90,25 @@ def segment(
     tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Concavity bound per part, fraction of the bounding-box diagonal (default 0.05)."),
     parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Pick tau so that there are this many parts (instead of --tau)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the surface samples of the concavity measure."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="With --parts: seconds for the search of tau (then the closest count found)."),
     png: bool = typer.Option(True, "--png/--no-png", help="Also draw segments.png."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or table, only errors."),
 ) -> None:
     """Split a mesh into few connected, nearly convex parts (concavity <= tau each), ready to unfold."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
+    from ...deadline import Deadline
     from ...formats.segmentation import write_segmentation
     from ...segment.segment import DEFAULT_TAU, segment as segment_mesh
 
     t0 = time.perf_counter()
+    deadline = Deadline(t0 + time_limit)
     loaded = load(mesh, quiet)
-    seg = segment_mesh(loaded.mesh, tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=seed)
+    seg = segment_mesh(loaded.mesh, tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=seed, deadline=deadline)
     seconds = time.perf_counter() - t0
     if parts is not None and seg.n_parts != parts and not quiet:
-        why = ("even tau 0 gives fewer: the parts are already convex" if seg.n_parts < parts
+        why = (f"the search of tau ran out of time after {time_limit:g} s: the closest count found" if seg.timed_out
+               else "even tau 0 gives fewer: the parts are already convex" if seg.n_parts < parts
                else "the mesh has that many separate components")
         say(f"warning: {mesh.name}: {seg.n_parts} parts instead of {parts} ({why})")
     write_segmentation(seg, loaded.mesh, output, n_input_faces=loaded.n_input_faces, source_name=mesh.name, png=png)
