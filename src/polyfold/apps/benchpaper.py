@@ -382,7 +382,7 @@ def _preamble(st: BenchSettings, seconds: float, compiled: list[str]) -> list[st
     """Markdown lines: the title and how the numbers were measured."""
     late = (f"kernels compiled while the clock ran: {len(compiled)} ({', '.join(compiled)})" if compiled
             else "no kernel compiled while the clock ran")
-    return [f"# polyfold vs the paper (Xi & Lien 2017)", "",
+    return ["# polyfold vs the paper (Xi & Lien 2017)", "",
             f"{st.runs} runs (seeds 1–{st.runs}) per row{' (--quick)' if st.quick else ''}; time limit "
             f"{st.time_limit:g} s per search (one unfold, one path); mean ± standard deviation of wall-clock "
             f"seconds; a run without a path counts the time limit as its path time. Every stage runs once "

@@ -331,8 +331,8 @@ class Viewer:
         x = y = shelf = 0.0
         gap = 0.15
         for i, piece in enumerate(pieces):
-            xy = np.asarray(piece.fold["vertices_coords"], dtype=np.float64)[:, :2] * self._k
-            faces = np.asarray(piece.fold["faces_vertices"], dtype=np.int64)
+            xy = piece.net.coords * self._k
+            faces = piece.net.faces
             lo, hi = xy.min(axis=0), xy.max(axis=0)
             w, d = hi - lo
             if x > 0 and x + w > row_width:
@@ -344,8 +344,8 @@ class Viewer:
             self._net_nodes.append(self.server.scene.add_mesh_simple(
                 f"/net/piece-{i}", pts, faces.astype(np.uint32), color=self._colors[piece.part],
                 flat_shading=True, side="double", opacity=0.9))
-            edges = np.asarray(piece.fold["edges_vertices"], dtype=np.int64)
-            assign = [str(a).upper() for a in piece.fold["edges_assignment"]]
+            edges = piece.net.edges
+            assign = piece.net.assignments
             lifted = pts + np.array([0.0, 0.0, 0.002], np.float32)
             colors = np.array([LINE_COLORS.get(a, CUT_COLOR if a in ("B", "C") else (120, 120, 120)) for a in assign],
                               dtype=np.uint8)

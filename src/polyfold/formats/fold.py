@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
@@ -21,6 +22,7 @@ import numpy as np
 from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
 from ..fold.tree import ASSIGNMENT_KIND, FoldTree, bbox_diagonal, build_tree, malformed_net
+from ..mesh.geometry import rho_to_fold_deg
 from ..unfold.net import Net
 from ..unfold.pattern import CreasePattern, crease_pattern
 from .files import atomic_write
@@ -254,3 +256,50 @@ def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: fl
     out["polyfold:path_resolutionDeg"] = float(resolution_deg)
     out["polyfold:path_contactTol"] = float(contact_tol)
     return out
+
+
+def piece_fold(pattern: CreasePattern, *, title: str, file_title: str, whole_mesh_faces: Sequence[int],
+               path: FoldPath | None = None, resolution_deg: float = 1.0, contact_tol: float = CONTACT_TOL) -> dict:
+    """The FOLD document of one piece of a make folder: its crease pattern (frame_title `title`),
+    its folding path when it has one (`with_path`), file_title, and `polyfold:faces_wholeMeshFace`
+    (the piece's faces as faces of the whole model)."""
+    fold = pattern_fold(pattern, title=title)
+    if path is not None:
+        fold = with_path(fold, path, resolution_deg, contact_tol)
+    fold["file_title"] = file_title
+    fold["polyfold:faces_wholeMeshFace"] = [int(x) for x in whole_mesh_faces]
+    return fold
+
+
+@dataclass(frozen=True, eq=False)
+class FoldNet:
+    """A FOLD net read back: its crease tree; the flat net (coords (V, 2), faces (F, 3), edges
+    (E, 2), assignments upper-case); path (K, E) the `polyfold:path` frames in FOLD degrees, or
+    None; goal (E,) the folded angles in FOLD degrees (the path's last frame, else
+    edges_foldAngle, else the tree's own goal)."""
+
+    tree: FoldTree
+    coords: np.ndarray
+    faces: np.ndarray
+    edges: np.ndarray
+    assignments: tuple[str, ...]
+    path: np.ndarray | None
+    goal: np.ndarray
+
+
+def fold_net(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldNet:
+    """The FoldNet of a FOLD dict; PolyfoldError (one line) when the net or its path is malformed."""
+    tree = fold_tree(fold, contact_tol)
+    path = None
+    if fold.get("polyfold:path"):
+        path = np.asarray(fold["polyfold:path"], dtype=np.float64)
+        if path.ndim != 2 or path.shape[1] != tree.n_edges:
+            raise PolyfoldError(f"polyfold:path frames must have one angle per edge ({tree.n_edges})")
+        goal = path[-1]
+    elif fold.get("edges_foldAngle") is not None:
+        goal = np.asarray(fold["edges_foldAngle"], dtype=np.float64)
+    else:  # no angles in the file: the tree's own goal
+        goal = rho_to_fold_deg(tree.goal)
+    coords = np.asarray(fold["vertices_coords"], dtype=np.float64)[:, :2]
+    return FoldNet(tree=tree, coords=coords, faces=tree.faces, edges=np.asarray(fold["edges_vertices"], dtype=np.int64),
+                   assignments=tuple(str(a).upper() for a in fold["edges_assignment"]), path=path, goal=goal)

@@ -15,7 +15,7 @@ from typing import Callable
 from ..fabricate.page import Page, page_of
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
-from ..formats.fold import dumps, pattern_fold, with_path
+from ..formats.fold import dumps, piece_fold
 from ..formats.meshes import obj_text
 from ..formats.pdf import pdf_bytes
 from ..formats.svg import svg_page_string
@@ -40,14 +40,6 @@ def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
             for k in range(n_pages)]
 
 
-def piece_fold(fp: FoldedPiece, piece_name: str, model: str, opts: MakeOptions) -> dict:
-    """The FOLD document of one piece: its net, its folding path (when verified), its source faces."""
-    fold = pattern_fold(fp.pattern, title=f"part {fp.part} piece")
-    if fp.path is not None:
-        fold = with_path(fold, fp.path, opts.resolution_deg, opts.contact_tol)
-    fold["file_title"] = f"{model} piece {piece_name} (part {fp.part})"
-    fold["polyfold:faces_wholeMeshFace"] = [int(x) for x in fp.mesh_faces]
-    return fold
 
 
 def piece_reports(folded: list[FoldedPiece], sheets: Sheets) -> tuple[PieceReport, ...]:
@@ -94,7 +86,10 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
         rows = piece_reports(folded, sheets)
         for fp, piece, row in zip(folded, sheets.pieces, rows):
-            stage.write(row.fold_file, dumps(piece_fold(fp, piece.name, model, opts)))
+            stage.write(row.fold_file, dumps(piece_fold(
+                fp.pattern, title=f"part {fp.part} piece", file_title=f"{model} piece {piece.name} (part {fp.part})",
+                whole_mesh_faces=fp.mesh_faces, path=fp.path, resolution_deg=opts.resolution_deg,
+                contact_tol=opts.contact_tol)))
         stage.write("assembly.json", assembly(model, opts, parts, sheets, rows).to_json())
         stage.write("instructions.html", instructions_html(
             model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),

@@ -19,8 +19,8 @@ import numpy as np
 
 from ..errors import PolyfoldError
 from ..fold.tree import FoldTree, fold_positions
-from ..formats.fold import fold_tree, read_fold
-from ..mesh.geometry import fold_deg_to_rho, rho_to_fold_deg
+from ..formats.fold import FoldNet, fold_net, read_fold
+from ..mesh.geometry import fold_deg_to_rho
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
 from .options import MakeOptions
@@ -31,8 +31,9 @@ from .report import Assembly, MakeReport
 class ViewPiece:
     """One piece of a make folder, ready to animate.
 
-    fold: its FOLD dict; tree: `fold_tree(fold)`; frames (K, E): `polyfold:path` (FOLD degrees,
-    valley positive), None when the piece has no verified path (it is then shown folded only);
+    fold: its FOLD dict; net: the net read from it (`formats.fold.fold_net`: tree, flat net, path);
+    frames (K, E): the folding path in FOLD degrees (valley positive), None when the piece has no
+    verified path (it is then shown folded only);
     rotation (P, 3, 3) / translation (P, 3): per FOLD piece, the rigid motion (Kabsch fit of the
     goal pose onto the foldedForm) that puts the folded net onto the model; fit_error: largest
     corner distance between the aligned goal pose and the foldedForm, in model units (nan
@@ -42,7 +43,7 @@ class ViewPiece:
     name: str
     part: int
     fold: dict
-    tree: FoldTree
+    net: FoldNet
     frames: np.ndarray | None
     rotation: np.ndarray
     translation: np.ndarray
@@ -52,10 +53,14 @@ class ViewPiece:
     def verified(self) -> bool:
         return self.frames is not None
 
+    @property
+    def tree(self) -> FoldTree:
+        return self.net.tree
+
     def pose(self, t: float) -> np.ndarray:
         """Face corners (F, 3, 3) in the model frame at fraction t in [0, 1] of the folding path
         (0 flat, 1 folded onto the model). Without a path the piece stays folded."""
-        deg = _goal_degrees(self.fold, self.tree) if self.frames is None else path_degrees(self.frames, t)
+        deg = self.net.goal if self.frames is None else path_degrees(self.frames, t)
         corners = fold_positions(self.tree, fold_deg_to_rho(deg))
         piece = self.tree.piece
         return np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
@@ -88,16 +93,6 @@ def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
     return (1.0 - u) * frames[i] + u * frames[i + 1]
 
 
-def _goal_degrees(fold: dict, tree: FoldTree) -> np.ndarray:
-    path = fold.get("polyfold:path")
-    if path:
-        return np.asarray(path[-1], dtype=np.float64)
-    angles = fold.get("edges_foldAngle")
-    if angles is None:  # no angles in the file: the tree's own goal (rho radians)
-        return rho_to_fold_deg(tree.goal)
-    return np.asarray(angles, dtype=np.float64)
-
-
 def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rotation R and translation t minimising |R p + t - q| over the rows (a proper rotation)."""
     cp, cq = p.mean(axis=0), q.mean(axis=0)
@@ -110,15 +105,12 @@ def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
     """A ViewPiece of a FOLD dict: builds the fold tree, checks the path and fits the rigid motion
     that lands the goal pose on the foldedForm (fold_positions keeps each root face flat)."""
-    tree = fold_tree(fold)
-    frames = None
-    if fold.get("polyfold:path"):
-        frames = np.asarray(fold["polyfold:path"], dtype=np.float64)
-        if frames.ndim != 2 or frames.shape[1] != tree.n_edges:
-            raise PolyfoldError(f"piece {name}: polyfold:path frames must have one angle per edge ({tree.n_edges})")
-    elif tree.n_faces == 1:
+    net = fold_net(fold)
+    tree = net.tree
+    frames = net.path
+    if frames is None and tree.n_faces == 1:
         frames = np.zeros((2, tree.n_edges))  # a single face is trivially foldable
-    goal = fold_positions(tree, fold_deg_to_rho(_goal_degrees(fold, tree)))
+    goal = fold_positions(tree, fold_deg_to_rho(net.goal))
     n_p = int(tree.piece.max()) + 1
     rotation = np.repeat(np.eye(3)[None], n_p, axis=0)
     translation = np.zeros((n_p, 3))
@@ -134,7 +126,7 @@ def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
             rotation[k], translation[k] = r, t
             moved = goal[on] @ r.T + t
             fit_error = max(fit_error, float(np.abs(moved - target[on]).max()))
-    return ViewPiece(name=name, part=part, fold=fold, tree=tree, frames=frames, rotation=rotation,
+    return ViewPiece(name=name, part=part, fold=fold, net=net, frames=frames, rotation=rotation,
                      translation=translation, fit_error=fit_error)
 
 
