@@ -31,7 +31,8 @@ from polyfold.fold.plan import plan_fold
 from polyfold.formats.meshes import load_mesh
 from polyfold.fold.tree import FoldTree, collides
 from polyfold.mesh.mesh import Mesh
-from polyfold.formats.raster import part_colors, write_mesh_png
+from polyfold.formats.png import write_mesh_png
+from polyfold.formats.raster import part_colors
 from polyfold.unfold.search import unfold
 
 ROOT = Path(__file__).resolve().parents[1]
