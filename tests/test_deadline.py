@@ -1,4 +1,4 @@
-"""Deadline: the one "time is up" type."""
+"""deadline.py: Deadline, the one "time is up" type."""
 
 from __future__ import annotations
 

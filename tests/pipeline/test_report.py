@@ -1,4 +1,4 @@
-"""report.json and assembly.json as types: exact round trips, clear errors on other layouts."""
+"""pipeline/report.py: report.json and assembly.json as types: exact round trips, clear errors on other layouts."""
 
 from __future__ import annotations
 

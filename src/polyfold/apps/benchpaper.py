@@ -7,7 +7,7 @@ paper / ours), report.json (every run), fig3.png and fig5.png. Needs matplotlib 
 (the `bench` extra); the tables do not.
 
 Every time is wall-clock seconds in this process with the numba kernels already compiled. A
-"path" is a collision-free folding path found by `fold.plan_fold` ("auto": straight line first =
+"path" is a collision-free folding path found by `fold.plan.plan_fold` ("auto": straight line first =
 LC, then the sequential planner, then Lazy PRM); whole meshes are also run with the paper's own
 planner (straight line, then Lazy PRM) on a few seeds. A run without a path within the time limit
 counts the time limit as its path time and is marked.

@@ -9,7 +9,7 @@ Isolation: a task runs in its own process -- a forkserver child locally, a subpr
 (segfault, os._exit) or a hang in one task becomes that task's status and never stops the others.
 A hard wall-clock limit per task kills a task that hangs.
 
-Test hook (tests/test_batch.py only): POLYFOLD_BATCH_FAULT="crash:NAME,segv:NAME,hang:NAME"
+Test hook (tests/apps/test_batch.py only): POLYFOLD_BATCH_FAULT="crash:NAME,segv:NAME,hang:NAME"
 makes the task of the mesh file named NAME call os._exit(1), segfault, or sleep forever. The
 parent reads it when a batch starts (`faults`) and puts it into the task spec, so it also reaches
 forkserver children (started with an older environment) and Dask workers.
@@ -37,7 +37,7 @@ from ..deadline import Deadline
 FAULT_ENV = "POLYFOLD_BATCH_FAULT"
 SCHEDULER_ENV = "POLYFOLD_SCHEDULER"
 # imported once by the forkserver, so each task process starts with them loaded (saves ~1 s each);
-# the forkserver skips a name it cannot import without a word, so tests/test_batch.py checks them
+# the forkserver skips a name it cannot import without a word, so tests/apps/test_batch.py checks them
 # imported once by the forkserver, so each task process starts with them loaded (saves ~1 s each):
 # the task modules and what make, unfold and the studies import lazily (make's own imports
 # bring in every stage)

@@ -10,7 +10,7 @@ colliding pairs in the order this module always reported them), and a mesh's sel
 speed: faces in an order kept from one configuration to the next (`sort_by_lo_x`, nearly sorted
 between close configurations), their boxes gathered into contiguous rows (`gather_boxes`), and
 candidate pairs tested with `triangles.faces_cross` until the first crossing. It gives the same
-verdict as `first_collision` (tests/test_kinematics.py).
+verdict as `first_collision` (tests/collide/test_sweep.py).
 
 Skipped pairs (never tested) of a folded net: faces of different pieces, a crease pair (parent,
 child); in `sweep_collides` also faces of one rigid group (rigid >= 0: their relative pose is

@@ -122,7 +122,7 @@ def _goal_from_folded(kind: np.ndarray, edges: np.ndarray, edge_faces: np.ndarra
     return goal
 
 
-_SIDE_ERRORS = {  # messages of the edge-table codes of _tree_kernels (info, then the edge's vertex pair)
+_SIDE_ERRORS = {  # messages of the edge-table codes of tree_kernels (info, then the edge's vertex pair)
     TK.BAD_EDGE: "edge {0} has invalid vertices {pair}",
     TK.DUPLICATE_EDGE: "edges {0} and {1} join the same vertices {uv}",
     TK.MISSING_SIDE: "side {0}-{1} of face {2} is not in 'edges_vertices'",
@@ -132,7 +132,7 @@ _SIDE_ERRORS = {  # messages of the edge-table codes of _tree_kernels (info, the
 
 
 def _tree_error(code: int, info: np.ndarray, parent: np.ndarray, piece: np.ndarray, kind: np.ndarray) -> PolyfoldError:
-    """The one-line message of a `_tree_kernels.crease_tree` error code."""
+    """The one-line message of a `tree_kernels.net_tree` error code."""
     a, b, c = info[:3].tolist()
     if code == TK.INVALID_PARENT:
         return malformed_net(f"face {a} has invalid parent {b}")

@@ -71,7 +71,7 @@ one-ring neighbours) are reported in ``notes`` and exempt.
 
 Open meshes: boundary vertices move under the same forces (pressure over their partial fan,
 springs, rest spring) but are not counted as hyperbolic (their angle sum is not a curvature, as in
-`io.describe`), are never boosted and count as elliptic for the paper rule; boundary edges have
+`mesh.repair.describe`), are never boosted and count as elliptic for the paper rule; boundary edges have
 rho = 0 (k_e = 1).
 
 IF (ALGORITHMS.md 3.5) = mean |X_v - P_v| over the vertices of the faces, in units of the

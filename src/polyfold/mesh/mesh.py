@@ -114,7 +114,7 @@ def edge_topology(faces: np.ndarray) -> Topology:
     Edges in lexicographic order of their sorted vertex pair; slot 0 of edge_faces takes a face
     that runs the edge low -> high, slot 1 the other; when orientation is inconsistent both may run
     the same way, then the second such face goes to the free slot (a third face is only counted).
-    One numba pass (`_mesh_kernels.edge_table`): this is set-up work of every mesh and part.
+    One numba pass (`kernels.edge_table`): this is set-up work of every mesh and part.
     """
     faces = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
     edges, edge_faces, face_edges, counts = MK.edge_table(faces)

@@ -3,7 +3,7 @@
 In: a `Mesh` (one or more edge-connected components, closed or open). Out: a `Segmentation` — a
 part label per face such that every part is edge-connected and its concavity (ALGORITHMS.md 4.2,
 relative to the bounding-box diagonal of the WHOLE mesh) is at most `tau`. Each part is an open
-patch (`Mesh.submesh`) that `unfold.unfold` and the folding planner accept directly.
+patch (`Mesh.submesh`) that `unfold.search.unfold` and the folding planner accept directly.
 
 Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 

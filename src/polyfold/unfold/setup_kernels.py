@@ -4,7 +4,7 @@ Small meshes (segmentation parts of a few dozen faces) are unfolded in well unde
 so the per-mesh arrays are built in one pass and the weight rules that sort per vertex run here
 instead of as chains of small numpy calls. Results are bitwise those of the numpy formulas:
 ties and orders follow np.lexsort (stable), sums follow numpy's order, and dot products, matrix
-products and atan2 are left to numpy (see `_mesh_kernels`).
+products and atan2 are left to numpy (see `mesh.kernels`).
 """
 
 from __future__ import annotations

@@ -1,0 +1,120 @@
+"""apps/cli/app.py: the `polyfold` command line as a whole: startup cost, bad inputs
+(bad/expected.json) and unreadable files rejected with one line and exit code 2, nothing left
+behind. (The commands: test_mesh_commands.py, test_net_commands.py, test_make_commands.py.)"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import CLI, bad_cases, one_line, run_cli
+from fold_checker import check_fold
+
+
+# ----------------------------------------------------------------------------------------------
+# Startup
+
+
+def test_help() -> None:
+    script = Path(sys.executable).with_name("polyfold")
+    cmd = [str(script)] if script.exists() else CLI
+    proc = subprocess.run([*cmd, "--help"], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "unfold" in proc.stdout and "info" in proc.stdout
+
+
+def test_cli_import_is_light() -> None:
+    code = "import sys, polyfold.apps.cli.app; print(any(m in sys.modules for m in ('numba', 'trimesh', 'scipy')))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "False"
+
+
+# ----------------------------------------------------------------------------------------------
+# Bad inputs, as bad/expected.json says
+
+
+def test_bad_cases_found(models_dir: Path) -> None:
+    names = {name for name, _ in bad_cases()}
+    assert len(names) >= 15
+    for name in names:
+        assert (models_dir / "bad" / name).is_file(), name
+
+
+@pytest.mark.parametrize("name,spec", bad_cases(), ids=[n for n, _ in bad_cases()])
+def test_bad_input(models_dir: Path, tmp_path: Path, name: str, spec: dict) -> None:
+    mesh = models_dir / "bad" / name
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    out = out_dir / "net.fold"
+    proc = run_cli("unfold", mesh, "-o", out, "--seed", 1, "--time-limit", 20)
+    assert "Traceback" not in proc.stderr, proc.stderr
+    expect = spec["expect"]
+
+    def assert_rejected():
+        assert proc.returncode == 2, f"exit {proc.returncode}\n{proc.stderr}"
+        assert name in one_line(proc.stderr)
+        assert list(out_dir.iterdir()) == [], "output or temp files left behind"
+
+    def assert_net(orientation: str):
+        assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stderr}"
+        assert list(out_dir.iterdir()) == [out], "temp files left behind"
+        report = check_fold(out, mesh, orientation=orientation)
+        assert report.ok, str(report)
+        assert report.overlaps == []
+        if "pieces" in spec:
+            assert report.pieces == spec["pieces"], f"{report.pieces} pieces\n{proc.stderr}"
+
+    if expect == "reject":
+        assert_rejected()
+    elif expect == "repair":
+        warnings = [line for line in proc.stderr.splitlines() if "warning" in line]
+        assert warnings, proc.stderr
+        # A repair may flip faces, so the net follows the repaired orientation, not the file's.
+        assert_net("outward")
+    elif expect == "accept":
+        assert_net("source")
+    elif expect == "either":
+        if proc.returncode == 0:
+            assert_net("source")
+        else:
+            assert_rejected()
+    else:
+        pytest.fail(f"unknown expectation {expect!r}")
+
+
+# ----------------------------------------------------------------------------------------------
+# Unreadable files
+
+
+def _unreadable(kind: str, tmp_path: Path) -> Path:
+    if kind == "directory":
+        path = tmp_path / "folder.obj"
+        path.mkdir()
+    elif kind == "garbage":
+        path = tmp_path / "garbage.obj"
+        path.write_bytes(bytes(range(256)) * 8 + b"\x00\xff\xfe v 1 2\x00 f 1 2 3\n")
+    elif kind == "missing":
+        path = tmp_path / "missing.obj"
+    elif kind == "unknown-extension":
+        path = tmp_path / "mesh.xyz"
+        path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    else:
+        raise AssertionError(kind)
+    return path
+
+
+@pytest.mark.parametrize("command", ["unfold", "info"])
+@pytest.mark.parametrize("kind", ["directory", "garbage", "missing", "unknown-extension"])
+def test_unreadable(tmp_path: Path, kind: str, command: str) -> None:
+    path = _unreadable(kind, tmp_path)
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    args = ["unfold", path, "-o", out_dir / "net.fold", "--time-limit", 5] if command == "unfold" else ["info", path]
+    proc = run_cli(*args)
+    assert proc.returncode == 2, f"exit {proc.returncode}\n{proc.stderr}"
+    assert path.name in one_line(proc.stderr)
+    assert list(out_dir.iterdir()) == []

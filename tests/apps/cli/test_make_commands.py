@@ -1,0 +1,96 @@
+"""apps/cli/make_commands.py: `polyfold make` with its defaults (every output, every sheet checked
+independently, every piece a verified net and folding path), and its errors (a model too large for
+the paper, bad options). (`polyfold view`, `batch`, `bench paper`: tests/apps/test_view.py,
+test_batch.py, test_benchpaper.py.)"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections import Counter
+from pathlib import Path
+
+from conftest import check_sheet, one_line, read_sheet, run_cli
+from fold_checker import check_fold, read_mesh
+from path_checker import check_path
+
+
+REPORT_KEYS = {"polyfold_report", "input", "options", "stages", "pieces", "checks", "outputs", "seconds"}
+
+
+STAGES = {"load", "inflate", "segment", "unfold", "fold", "layout", "export"}
+
+
+def piece_files(fold_path: Path, mesh_path: Path, tmp_path: Path) -> tuple[str, str]:
+    """A piece covers some of the mesh's faces: write those faces as their own OBJ (file order
+    kept) and the FOLD with faces_meshFace renumbered into it, for the whole-net checker."""
+    verts, polys = read_mesh(str(mesh_path))
+    fold = json.loads(fold_path.read_text())
+    src = sorted(set(fold["polyfold:faces_meshFace"]))
+    new = {f: k for k, f in enumerate(src)}
+    obj = tmp_path / f"{fold_path.stem}.obj"
+    obj.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in verts.tolist())
+                   + "".join("f " + " ".join(str(v + 1) for v in polys[f]) + "\n" for f in src))
+    fold["polyfold:faces_meshFace"] = [new[f] for f in fold["polyfold:faces_meshFace"]]
+    out = tmp_path / fold_path.name
+    out.write_text(json.dumps(fold))
+    return str(out), str(obj)
+
+
+def test_make_bunny_default_cli(models_dir, tmp_path):
+    src = models_dir / "bunny-128.obj"
+    out = tmp_path / "bunny"
+    (out).mkdir()
+    (out / "sheet-09.svg").write_text("stale")
+    proc = run_cli("make", src, "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert REPORT_KEYS <= set(report) and STAGES <= set(report["stages"])
+    n_pages = report["stages"]["layout"]["pages"]
+    pieces = report["pieces"]
+    assert set(report["outputs"]) == {p.name for p in out.iterdir()}
+    assert not (out / "sheet-09.svg").exists()
+    assert not list(out.glob(".polyfold-*"))
+    # sheets in every format, one per page
+    svgs = sorted(out.glob("sheet-*.svg"))
+    assert len(svgs) == n_pages == len(list(out.glob("sheet-*.dxf")))
+    pdf = (out / "sheets.pdf").read_bytes()
+    assert pdf.startswith(b"%PDF") and len(re.findall(rb"/Type /Page\b", pdf)) == n_pages
+    labels = Counter()
+    for svg in svgs:
+        sheet = read_sheet(svg)
+        assert {"cut", "mountain", "valley", "labels"} <= sheet["layers"]
+        assert (sheet["width"], sheet["height"]) == (210.0, 297.0)
+        assert check_sheet(sheet, 10.0) == []
+        labels.update(text for kind, text in sheet["labels"] if kind == "edge-label")
+    # every glue label printed exactly twice; every glue pair of the assembly is labelled
+    assembly = json.loads((out / "assembly.json").read_text())
+    assert set(labels.values()) == {2}
+    assert set(labels) == {g["label"] for g in assembly["glue"]}
+    assert sum(g["tab_on"] is None for g in assembly["glue"]) == len(report["stages"]["layout"]["untabbed_edges"])
+    # every piece: a verified net and a verified folding path, checked independently
+    assert report["checks"]["paths_verified"] == len(pieces)
+    for row in pieces:
+        fold = out / row["fold_file"]
+        net = check_fold(*piece_files(fold, src, tmp_path))
+        assert net.ok and net.pieces == 1, f"{row['piece']}:\n{net}"
+        path = check_path(fold)
+        assert path.ok, f"{row['piece']}:\n{path}"
+    assert sum(r["faces"] for r in pieces) == 128
+    html = (out / "instructions.html").read_text()
+    assert all(f"<b>{r['piece']}</b>" in html for r in pieces) and "data:image/png;base64," in html
+    assert all(f"src='{s.name}'" in html for s in svgs)
+
+
+def test_too_large_and_bad_options(models_dir, tmp_path):
+    out = tmp_path / "t"
+    proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--size", 150)
+    assert proc.returncode == 2
+    line = one_line(proc.stderr.strip().splitlines()[-1] + "\n")
+    assert "largest size that fits is 144.4 mm" in line
+    assert not out.exists() or not any(out.iterdir())
+    proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--paper", "b5", "-q")
+    assert proc.returncode == 2 and "unknown paper" in one_line(proc.stderr)
+    proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--tau", 0.1, "--parts", 2, "-q")
+    assert proc.returncode == 2 and "--tau or --parts" in one_line(proc.stderr)

@@ -1,0 +1,95 @@
+"""collide/flat.py: the numba 2D overlap test (`triangles_overlap`, `find_overlaps`) against an
+exact brute-force oracle (rational clipping)."""
+
+from fractions import Fraction
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from polyfold.collide.flat import find_overlaps, triangles_overlap
+
+
+def _clip(poly, a, b):
+    """Sutherland-Hodgman: keep the part of `poly` left of the directed line a->b (exact)."""
+    out = []
+    side = lambda p: (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+    for i, p in enumerate(poly):
+        q = poly[(i + 1) % len(poly)]
+        sp, sq = side(p), side(q)
+        if sp >= 0:
+            out.append(p)
+        if (sp > 0 > sq) or (sp < 0 < sq):
+            t = sp / (sp - sq)
+            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+    return out
+
+
+def _area(poly):
+    return sum(poly[i][0] * poly[(i + 1) % len(poly)][1] - poly[(i + 1) % len(poly)][0] * poly[i][1]
+               for i in range(len(poly))) / 2
+
+
+def oracle_overlap(t1, t2) -> bool:
+    """Interiors intersect <=> the exact intersection polygon has positive area."""
+    t1 = [tuple(map(Fraction, p)) for p in t1]
+    t2 = [tuple(map(Fraction, p)) for p in t2]
+    if _area(t1) == 0 or _area(t2) == 0:
+        return False  # a degenerate triangle has no interior
+    if _area(t1) < 0:
+        t1 = t1[::-1]
+    poly = t2 if _area(t2) > 0 else t2[::-1]
+    for i in range(3):
+        poly = _clip(poly, t1[i], t1[(i + 1) % 3])
+        if len(poly) < 3:
+            return False
+    return _area(poly) > 0
+
+
+grid_tri = st.lists(st.tuples(st.integers(0, 6), st.integers(0, 6)), min_size=3, max_size=3)
+
+
+@settings(max_examples=3000, deadline=None)
+@given(grid_tri, grid_tri)
+def test_matches_exact_oracle_on_small_grid(t1, t2):
+    # Small integer grids make touching (shared edges, vertices, collinear sides) very common, and
+    # all arithmetic of the kernel is exact there, so tol = 0 must agree with the oracle exactly.
+    a = np.array(t1, dtype=np.float64)
+    b = np.array(t2, dtype=np.float64)
+    assert triangles_overlap(a, b, 0.0) == oracle_overlap(t1, t2)
+
+
+def test_random_float_triangles_against_oracle():
+    rng = np.random.default_rng(7)
+    disagreements = 0
+    for _ in range(3000):
+        a = rng.random((3, 2))
+        b = rng.random((3, 2)) * 0.8 + 0.2
+        disagreements += triangles_overlap(a, b, 0.0) != oracle_overlap(a.tolist(), b.tolist())
+    assert disagreements == 0
+
+
+def test_touching_is_not_overlap():
+    a = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    assert not triangles_overlap(a, np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]), 1e-12)  # shared edge
+    assert not triangles_overlap(a, np.array([[1.0, 0.0], [2.0, 0.0], [2.0, 1.0]]), 1e-12)  # shared vertex
+    assert not triangles_overlap(a, np.array([[0.5, 0.0], [1.5, 0.0], [1.0, -1.0]]), 1e-12)  # collinear side
+    assert triangles_overlap(a, np.array([[0.2, 0.2], [2.0, 0.2], [0.2, 2.0]]), 1e-12)  # corner inside
+    assert triangles_overlap(a, a.copy(), 1e-12)  # identical
+
+
+def test_sweep_finds_all_pairs_of_brute_force():
+    rng = np.random.default_rng(3)
+    for n in (5, 40, 200):
+        tris = rng.random((n, 1, 2)) * 10 + rng.random((n, 3, 2)) - 0.5
+        parent = np.full(n, -1)
+        got = {tuple(p) for p in find_overlaps(tris, parent, 0.0)}
+        want = {(i, j) for i in range(n) for j in range(i + 1, n) if oracle_overlap(tris[i].tolist(), tris[j].tolist())}
+        assert got == want
+
+
+def test_crease_pairs_are_skipped():
+    a = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    tris = np.stack([a, a + 0.1])
+    assert len(find_overlaps(tris, np.array([-1, -1]))) == 1
+    assert len(find_overlaps(tris, np.array([-1, 0]))) == 0

@@ -1,0 +1,286 @@
+"""fabricate/pack.py: packing net pieces onto pages by their real outlines."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+import shapely
+from shapely import affinity
+from shapely.geometry import LineString, Polygon, box
+
+from polyfold.errors import PolyfoldError
+from polyfold.fabricate.pack import check_packing, fits_page, pack_outlines, Packing, placed_outline, Placement
+
+A4 = (210.0, 297.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# helpers
+
+
+def moved(outline, pl: Placement):
+    """The outline on its page, computed independently of Placement.apply (shapely.affinity)."""
+    return affinity.translate(affinity.rotate(outline, pl.angle, origin=(0, 0)), *pl.offset)
+
+
+def brute_force_problems(outlines, packing: Packing, gap: float) -> list[str]:
+    """Every pair on every page and every piece against the printable rectangle, no index."""
+    W, H = packing.page_size
+    m = packing.margin
+    placed = [moved(g, pl) for g, pl in zip(outlines, packing.placements)]
+    out = []
+    for i, q in enumerate(placed):
+        x0, y0, x1, y1 = q.bounds
+        if min(x0, y0) < m - 1e-9 or x1 > W - m + 1e-9 or y1 > H - m + 1e-9:
+            out.append(f"{i} out of the printable area")
+        if not 0 <= packing.placements[i].page < packing.n_pages:
+            out.append(f"{i} on page {packing.placements[i].page}")
+    for i in range(len(placed)):
+        for j in range(i + 1, len(placed)):
+            if packing.placements[i].page != packing.placements[j].page:
+                continue
+            if placed[i].intersection(placed[j]).area > 1e-9:
+                out.append(f"{i} overlaps {j}")
+            elif gap > 0 and placed[i].distance(placed[j]) < gap - 1e-9:
+                out.append(f"{i} is {placed[i].distance(placed[j]):.3f} mm from {j}")
+    return out
+
+
+def assert_valid(outlines, packing: Packing, gap: float) -> None:
+    assert len(packing.placements) == len(outlines)
+    assert check_packing(outlines, packing, gap) == []
+    assert brute_force_problems(outlines, packing, gap) == []
+    assert {pl.page for pl in packing.placements} == set(range(packing.n_pages))  # no empty page
+    pw, ph = packing.page_size[0] - 2 * packing.margin, packing.page_size[1] - 2 * packing.margin
+    area = sum(g.area for g in outlines)
+    assert packing.utilisation == pytest.approx(area / (packing.n_pages * pw * ph))
+
+
+def snake(rng: np.random.Generator, steps: int, width: float) -> Polygon:
+    """A wandering band (random walk with turns, buffered): long, non-convex, like a triangle strip."""
+    heading, p, pts = rng.uniform(0, 2 * np.pi), np.zeros(2), [np.zeros(2)]
+    for _ in range(steps):
+        heading += rng.uniform(-1.4, 1.4)
+        p = p + rng.uniform(8, 16) * np.array([np.cos(heading), np.sin(heading)])
+        pts.append(p)
+    g = LineString(pts).buffer(width / 2, cap_style="flat", join_style="mitre", mitre_limit=2.0)
+    if g.geom_type != "Polygon":
+        g = max(shapely.get_parts(g), key=lambda q: q.area)
+    return g
+
+
+def l_shape(a: float, b: float, t: float) -> Polygon:
+    return Polygon([(0, 0), (a, 0), (a, t), (t, t), (t, b), (0, b)])
+
+
+def comb(teeth: int, w: float, gapw: float, depth: float, spine: float) -> Polygon:
+    pts, x = [(0.0, 0.0)], 0.0
+    for k in range(teeth):
+        pts += [(x, spine + depth), (x + w, spine + depth), (x + w, spine)]
+        x += w
+        if k < teeth - 1:
+            pts.append((x + gapw, spine))
+            x += gapw
+    pts.append((x, 0.0))
+    return Polygon(pts)
+
+
+@pytest.fixture(scope="module")
+def snakes() -> list[Polygon]:
+    rng = np.random.default_rng(3)
+    out = [snake(rng, int(rng.integers(4, 14)), rng.uniform(8, 18)) for _ in range(14)]
+    # off-centre and rotated, so that the piece's own origin matters
+    return [affinity.translate(affinity.rotate(g, float(rng.uniform(0, 360))), *rng.uniform(-200, 200, 2)) for g in out]
+
+
+# ----------------------------------------------------------------------------------------------
+# placements
+
+
+def test_placement_apply_rotates_ccw_then_translates():
+    pl = Placement(0, 90.0, (10.0, 20.0))
+    np.testing.assert_allclose(pl.apply(np.array([[1.0, 0.0], [0.0, 2.0]])), [[10.0, 21.0], [8.0, 20.0]], atol=1e-12)
+    assert isinstance(pl.offset[0], float) and isinstance(pl.page, int)
+
+
+def test_placed_outline_is_the_rotated_translated_input(snakes):
+    packing = pack_outlines(snakes, A4, gap=2.0)
+    for g, pl in zip(snakes, packing.placements):
+        q = placed_outline(g, pl)
+        ref = moved(g, pl)
+        assert q.area == pytest.approx(g.area, rel=1e-9)
+        assert q.symmetric_difference(ref).area < 1e-6 * g.area
+        np.testing.assert_allclose(shapely.get_coordinates(q), shapely.get_coordinates(ref), atol=1e-9)
+        np.testing.assert_allclose(shapely.get_coordinates(q), pl.apply(shapely.get_coordinates(g)), atol=1e-12)
+
+
+# ----------------------------------------------------------------------------------------------
+# validity
+
+
+@pytest.mark.parametrize("gap", [0.0, 2.0, 5.0])
+def test_snakes_pack_validly(snakes, gap):
+    packing = pack_outlines(snakes, A4, margin=10.0, gap=gap)
+    assert_valid(snakes, packing, gap)
+    assert packing.page_size == A4 and packing.margin == 10.0
+
+
+def test_gap_is_respected_and_measured(snakes):
+    packing = pack_outlines(snakes, (297.0, 210.0), margin=5.0, gap=4.0, seed=2)
+    assert_valid(snakes, packing, 4.0)
+    placed = [placed_outline(g, pl) for g, pl in zip(snakes, packing.placements)]
+    dists = [
+        placed[i].distance(placed[j])
+        for i in range(len(placed))
+        for j in range(i + 1, len(placed))
+        if packing.placements[i].page == packing.placements[j].page
+    ]
+    assert dists and min(dists) >= 4.0 - 1e-9
+
+
+def test_many_mixed_pieces_on_letter():
+    rng = np.random.default_rng(11)
+    pieces = [snake(rng, int(rng.integers(3, 10)), rng.uniform(6, 14)) for _ in range(20)]
+    pieces += [l_shape(*rng.uniform([40, 30, 8], [90, 80, 20])) for _ in range(8)]
+    pieces += [comb(int(rng.integers(3, 6)), 6.0, 16.0, rng.uniform(15, 35), 8.0) for _ in range(6)]
+    packing = pack_outlines(pieces, (215.9, 279.4), margin=8.0, gap=1.5, angles=6, seed=5)
+    assert_valid(pieces, packing, 1.5)
+
+
+def test_first_fit_uses_one_page_for_small_pieces():
+    pieces = [box(0, 0, 20, 10 + k) for k in range(12)]
+    packing = pack_outlines(pieces, A4)
+    assert packing.n_pages == 1
+    assert_valid(pieces, packing, 2.0)
+
+
+def test_piece_in_a_hole_and_multipolygons():
+    frame = box(0, 0, 100, 100).difference(box(20, 20, 80, 80))  # a 60 mm hole
+    two = shapely.MultiPolygon([box(0, 0, 6, 6), box(20, 0, 26, 6)])
+    pieces = [frame, box(0, 0, 40, 40), two]
+    packing = pack_outlines(pieces, (130.0, 130.0), margin=10.0, gap=2.0)
+    # the 110 x 110 printable area has no room for the square beside the frame: it sits in the hole
+    assert packing.n_pages == 1
+    assert_valid(pieces, packing, 2.0)
+    hole = placed_outline(box(20, 20, 80, 80), packing.placements[0])
+    assert hole.contains(placed_outline(pieces[1], packing.placements[1]))
+
+
+def test_piece_that_just_fits_goes_alone_and_others_follow():
+    pieces = [box(0, 0, 190, 277), box(0, 0, 30, 30), affinity.rotate(box(0, 0, 277, 190), 90, origin=(0, 0))]
+    packing = pack_outlines(pieces, A4, margin=10.0, gap=2.0)
+    assert_valid(pieces, packing, 2.0)
+    assert packing.n_pages == 3
+
+
+# ----------------------------------------------------------------------------------------------
+# nesting beats bounding boxes
+
+
+def test_two_l_shapes_nest_on_one_page():
+    # printable 100 x 100; each L has a 75 x 75 bounding box: no two such squares fit side by side
+    # or stacked in any rotation (that needs 150 mm one way), but the Ls interlock corner to corner
+    ls = [l_shape(75, 75, 15), affinity.rotate(l_shape(75, 75, 15), 37, origin=(0, 0))]
+    packing = pack_outlines(ls, (120.0, 120.0), margin=10.0, gap=2.0)
+    assert packing.n_pages == 1
+    assert_valid(ls, packing, 2.0)
+
+
+def test_two_combs_interlock_on_one_page():
+    # bounding box 92 x 50 each on a 120 x 75 printable area: stacked needs 100+ mm of height,
+    # side by side 184 mm of width, and a comb on end is 92 mm tall; interlocked they need 106 x ~63
+    c = comb(4, 8.0, 20.0, 40.0, 10.0)
+    x0, y0, x1, y1 = c.bounds
+    assert (x1 - x0, y1 - y0) == (92.0, 50.0)
+    combs = [c, affinity.translate(c, 500, -300)]
+    packing = pack_outlines(combs, (140.0, 95.0), margin=10.0, gap=2.0)
+    assert packing.n_pages == 1
+    assert_valid(combs, packing, 2.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# errors, determinism, edge cases
+
+
+def test_too_large_piece_raises_with_the_largest_scale():
+    pieces = [box(0, 0, 50, 50), box(0, 0, 300, 100)]
+    s = fits_page(pieces[1], A4, 10.0)
+    assert s == pytest.approx(277 / 300)
+    with pytest.raises(PolyfoldError, match=r"piece 1 .*largest scale that fits is 0\.923") as err:
+        pack_outlines(pieces, A4)
+    assert "\n" not in str(err.value)
+
+
+def test_fits_page_scale_above_one_and_rotation():
+    assert fits_page(box(0, 0, 19, 27.7), A4, 10.0) == pytest.approx(10.0)
+    # a long thin diagonal bar fits only turned onto an axis (minimum-area rectangle rotation)
+    bar = affinity.rotate(box(0, 0, 250, 5), 33.0, origin=(0, 0))
+    assert fits_page(bar, A4, 10.0, angles=1) == pytest.approx(277 / 250)
+    assert fits_page(box(0, 0, 10, 10), (15.0, 15.0), 10.0) == 0.0
+
+
+def test_deterministic_for_a_seed(snakes):
+    a = pack_outlines(snakes, A4, seed=7)
+    b = pack_outlines(snakes, A4, seed=7)
+    assert a == b
+    c = pack_outlines(snakes, A4, seed=8)
+    assert_valid(snakes, c, 2.0)
+
+
+def test_empty_input_gives_no_pages():
+    packing = pack_outlines([], A4)
+    assert packing.n_pages == 0 and packing.placements == () and packing.utilisation == 0.0
+    assert check_packing([], packing) == []
+
+
+def test_time_limit_falls_back_to_valid_shelves(snakes):
+    t = time.perf_counter()
+    packing = pack_outlines(snakes, A4, gap=3.0, time_limit=0.0)
+    assert time.perf_counter() - t < 5.0
+    assert_valid(snakes, packing, 3.0)
+
+
+def test_check_packing_reports_problems():
+    pieces = [box(0, 0, 50, 50), box(0, 0, 50, 50)]
+    same = Packing((Placement(0, 0.0, (20, 20)), Placement(0, 0.0, (40, 40))), 1, A4, 10.0, 0.0)
+    assert any("overlap" in p for p in check_packing(pieces, same))
+    close = Packing((Placement(0, 0.0, (20, 20)), Placement(0, 0.0, (71, 20))), 1, A4, 10.0, 0.0)
+    assert check_packing(pieces, close) == []
+    assert any("closer than 2" in p for p in check_packing(pieces, close, gap=2.0))
+    out = Packing((Placement(0, 0.0, (5, 20)), Placement(1, 0.0, (20, 20))), 1, A4, 10.0, 0.0)
+    problems = check_packing(pieces, out)
+    assert any("piece 0 leaves" in p for p in problems) and any("piece 1: page 1" in p for p in problems)
+
+
+def test_final_check_repairs_a_broken_placement(snakes, monkeypatch):
+    # a grid that forgets every piece stacks them all in one spot: the exact check must catch it
+    # and move the offenders to pages of their own
+    from polyfold.fabricate import pack
+
+    monkeypatch.setattr(pack._Page, "stamp", lambda self, mask, y, x: None)
+    packing = pack_outlines(snakes[:6], A4, gap=2.0)
+    assert_valid(snakes[:6], packing, 2.0)
+
+
+def test_rejects_bad_input():
+    with pytest.raises(PolyfoldError, match="piece 0"):
+        pack_outlines([Polygon()], A4)
+    with pytest.raises(PolyfoldError, match="gap"):
+        pack_outlines([box(0, 0, 1, 1)], A4, gap=-1.0)
+
+
+def test_twenty_hundred_vertex_pieces_on_a4_fast():
+    rng = np.random.default_rng(9)
+    pieces = []
+    while len(pieces) < 20:
+        g = snake(rng, 30, rng.uniform(6, 10)).simplify(0.0)
+        s = fits_page(g, A4, 10.0)
+        pieces.append(affinity.scale(g, min(1.0, 0.7 * s), min(1.0, 0.7 * s)))
+    assert np.mean([len(shapely.get_coordinates(g)) for g in pieces]) > 60
+    pack_outlines(pieces[:2], A4)  # numba kernels compiled / loaded outside the timing
+    t = time.perf_counter()
+    packing = pack_outlines(pieces, A4)
+    assert time.perf_counter() - t < 1.0
+    assert_valid(pieces, packing, 2.0)

@@ -1,0 +1,117 @@
+"""The planners behind fold/plan.py's `plan_fold` (linear, sequential with its RRT-Connect
+unlocking, Lazy PRM), their paths judged by the independent path checker (tests/path_checker.py,
+which does not import polyfold): a net whose straight-line fold collides, whole meshes, a net
+without creases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import straight, whole_net
+from fold_checker import check_fold
+from path_checker import FoldNet, check_path
+from polyfold.fold.plan import is_linearly_foldable, plan_fold
+from polyfold.formats.fold import fold_tree, net_to_fold, with_path
+from polyfold.formats.meshes import load_mesh
+from polyfold.unfold.search import unfold
+
+
+# ----------------------------------------------------------------------------------------------
+# A net whose straight-line fold collides: the Lazy PRM for real
+
+
+def test_lazy_prm_path_where_the_straight_line_collides(lazy_case):
+    name, mesh, fold, net, path = lazy_case
+    assert name.startswith("l-prism-hand.obj"), name  # the hand-made mesh suffices
+    net_report = check_fold(net, mesh)
+    assert net_report.ok, str(net_report)
+    tree = fold_tree(fold)
+    assert plan_fold(tree, planner="linear") is None
+    assert not is_linearly_foldable(tree)
+    # the straight line really collides (the planner checks it at 1 deg and 0.5 deg)
+    hit = check_path(straight(fold), step_deg=0.5).first_collision
+    assert hit is not None and 0 < hit[1] <= 1, hit
+    # ... and the Lazy PRM path around it is accepted
+    assert path.planner == "lazy-prm" and not path.linear and len(path.frames) > 2
+    report = check_path(with_path(fold, path, 1.0, 1e-7))
+    assert report.ok, f"{name}:\n{report}"
+    finer = check_path(with_path(fold, path, 1.0, 1e-7), step_deg=0.25)
+    assert finer.ok, f"{name}:\n{finer}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Whole meshes: the sequential planner (crease-by-crease unfolding of the folded shape)
+
+
+def _assert_monotone_discrete(tree, path) -> None:
+    """Every frame is a discrete state of the paper's sampling domain (each crease flat or at its
+    goal), and the frames only fold creases, from all flat to all folded."""
+    goal = tree.goal[tree.creases]
+    cr = path.frames[:, tree.creases]
+    assert np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal))
+    folded = np.isclose(cr, goal).sum(axis=1)
+    assert folded[0] == 0 and folded[-1] == len(goal) and np.all(np.diff(folded) > 0)
+
+
+def test_sequential_planner_folds_the_whole_horse(models_dir):
+    """The paper found no path for the whole horse (301 DOF) in an hour, and the Lazy PRM alone
+    finds none here in seconds; crease-by-crease unfolding of the folded shape does. (The
+    independent checker re-checks a whole-mesh path below, on the smaller bunny: on the horse
+    it takes minutes.)"""
+    tree = fold_tree(whole_net(models_dir, "horse-302", 3, 302))
+    assert plan_fold(tree, planner="linear") is None
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=1)
+    assert path is not None, "no sequential path for the whole horse"
+    assert path.planner == "sequential" and not path.linear
+    _assert_monotone_discrete(tree, path)
+    assert plan_fold(tree, planner="lazy-prm", time_limit=3, seed=1) is None
+
+
+def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_dir):
+    """Horse net 13: nine creases of a curled strip carrying a 67-face flap can open neither alone,
+    nor first, nor together in the discrete domain (this seed had no path before). The
+    RRT-Connect search over those creases opens them; its frames (the path's first ones, off the
+    discrete domain) are re-checked by the independent checker, the rest is discrete."""
+    fold = whole_net(models_dir, "horse-302", 13, 302)
+    tree = fold_tree(fold)
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
+    assert path is not None and path.planner == "sequential-rrt"
+    goal = tree.goal[tree.creases]
+    cr = path.frames[:, tree.creases]
+    discrete = np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal), axis=1)
+    k = int(np.argmax(discrete[1:])) + 1  # the stuck state: where the discrete frames begin
+    assert k > 1 and not discrete[1:k].any() and discrete[k:].all()
+    folded = np.isclose(cr[k:], goal).sum(axis=1)
+    assert folded[-1] == len(goal) and np.all(np.diff(folded) > 0)
+    # only the stuck creases move in the continuous part, and they end where the discrete part starts
+    moving = np.flatnonzero(np.ptp(cr[:k + 1], axis=0) > 0)
+    assert 0 < len(moving) <= 32
+    net = FoldNet(fold, 1e-7)
+    deg = np.asarray(path.degrees_fold())
+    for s in range(k):
+        _, hit = net.segment_collision(deg[s], deg[s + 1], 0.5, skip_start=s > 0)
+        assert hit is None, f"segment {s} collides at {hit}"
+
+
+@pytest.mark.parametrize("planner", ["auto", "linear", "sequential", "lazy-prm"])
+def test_every_planner_handles_a_net_without_creases(models_dir, planner):
+    mesh = load_mesh(models_dir / "tetrahedron-4.obj").mesh.submesh(np.array([0]))
+    net, _ = unfold(mesh)
+    tree = fold_tree(net_to_fold([net]))
+    assert len(tree.creases) == 0
+    path = plan_fold(tree, planner=planner)
+    assert path is not None and path.linear and path.frames.shape == (2, tree.n_edges)
+    assert np.allclose(path.frames, 0.0)
+
+
+def test_sequential_path_of_a_whole_mesh_passes_the_independent_checker(whole_bunny):
+    fold, _ = whole_bunny
+    tree = fold_tree(fold)
+    assert plan_fold(tree, planner="linear") is None
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=1)
+    assert path is not None and path.planner == "sequential"
+    _assert_monotone_discrete(tree, path)
+    report = check_path(with_path(fold, path, 1.0, 1e-7), step_deg=0.5)
+    assert report.ok, str(report)
+    assert report.frames == len(path.frames) > 2

@@ -1,0 +1,109 @@
+"""formats/meshes.py: the readers (OBJ with negative indices and slashes, OFF, STL / PLY / GLB
+through trimesh), parse errors with line numbers, unreadable and unknown files, and the mesh
+writer table (every suffix writes a file the readers load back as the same mesh)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import assert_valid_component, signed_volume
+from polyfold.errors import MeshError, PolyfoldError
+from polyfold.formats.meshes import WRITERS, load_mesh, write_mesh
+from polyfold.mesh.repair import describe
+
+
+# ----------------------------------------------------------------------------------------------
+# Readers and parsing details (synthetic files)
+
+
+CUBE_V = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+
+
+CUBE_QUADS = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+
+
+def test_off_quads(tmp_path: Path) -> None:
+    lines = ["OFF", "# a cube", f"{len(CUBE_V)} {len(CUBE_QUADS)} 0"]
+    lines += [" ".join(map(str, v)) for v in CUBE_V]
+    lines += ["4 " + " ".join(map(str, q)) for q in CUBE_QUADS]
+    (tmp_path / "cube.off").write_text("\n".join(lines) + "\n")
+    loaded = load_mesh(tmp_path / "cube.off")
+    assert loaded.mesh.n_faces == 12 and len(loaded.components) == 1
+    assert loaded.warnings == ("triangulated 6 polygons with more than 3 corners",)
+    assert signed_volume(loaded.mesh) == pytest.approx(1.0)
+
+
+def test_obj_negative_indices_and_slashes(tmp_path: Path) -> None:
+    lines = ["o cube", "vt 0 0", "vn 0 0 1"]
+    lines += ["v " + " ".join(map(str, v)) for v in CUBE_V]
+    # relative indices: -8 is vertex 0 once all 8 vertices exist
+    lines += ["f " + " ".join(f"{i - 8}/1/1" for i in q) for q in CUBE_QUADS]
+    (tmp_path / "rel.obj").write_text("\n".join(lines) + "\n")
+    loaded = load_mesh(tmp_path / "rel.obj")
+    assert loaded.mesh.n_faces == 12 and describe(loaded)["closed"]
+    assert signed_volume(loaded.mesh) == pytest.approx(1.0)
+
+
+def test_obj_parse_errors_have_line_numbers(tmp_path: Path) -> None:
+    (tmp_path / "zero.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")
+    with pytest.raises(MeshError, match=r"^zero\.obj: line 4: face 0 uses vertex index 0"):
+        load_mesh(tmp_path / "zero.obj")
+    (tmp_path / "word.obj").write_text("v 0 0 0\nv 1 zero 0\n")
+    with pytest.raises(MeshError, match=r"^word\.obj: line 2: vertex 1"):
+        load_mesh(tmp_path / "word.obj")
+
+
+def test_unreadable_and_unknown(tmp_path: Path) -> None:
+    with pytest.raises(MeshError, match=r"^missing\.obj: cannot read"):
+        load_mesh(tmp_path / "missing.obj")
+    (tmp_path / "mesh.xyz").write_text("1 2 3\n")
+    with pytest.raises(MeshError, match=r"^mesh\.xyz: unknown format"):
+        load_mesh(tmp_path / "mesh.xyz")
+    (tmp_path / "junk.stl").write_bytes(b"\x00\x01junk")
+    with pytest.raises(MeshError, match=r"^junk\.stl: "):
+        load_mesh(tmp_path / "junk.stl")
+
+
+def test_trimesh_formats(tmp_path: Path) -> None:
+    import trimesh
+
+    trimesh.creation.icosahedron().export(tmp_path / "ico.stl")
+    trimesh.creation.icosahedron().export(tmp_path / "ico.ply")
+    a, b = trimesh.creation.box(), trimesh.creation.box()
+    b.apply_translation([3, 0, 0])
+    trimesh.Scene([a, b]).export(tmp_path / "boxes.glb")
+    stl = load_mesh(tmp_path / "ico.stl")  # STL is a triangle soup: welded
+    assert (stl.mesh.n_faces, stl.mesh.n_vertices, len(stl.components)) == (20, 12, 1)
+    assert stl.warnings[0].startswith("welded")
+    ply = load_mesh(tmp_path / "ico.ply")
+    assert ply.warnings == () and describe(ply)["closed"]
+    glb = load_mesh(tmp_path / "boxes.glb")  # a scene: concatenated, one component per box
+    assert len(glb.components) == 2 and glb.mesh.n_faces == 24
+    for comp in glb.components:
+        assert_valid_component(comp)
+
+
+# ----------------------------------------------------------------------------------------------
+# Writers
+
+
+@pytest.mark.parametrize("suffix", sorted(WRITERS))
+def test_written_mesh_loads_back(models_dir, tmp_path, suffix):
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    colors = np.tile(np.array([[200, 30, 30]], np.uint8), (mesh.n_faces, 1))
+    path = tmp_path / f"bunny{suffix}"
+    write_mesh(path, mesh.vertices, mesh.faces, face_colors=colors, header="a bunny")
+    back = load_mesh(path).mesh
+    assert back.n_faces == mesh.n_faces
+    # same surface: the same triangles as point triples (GLB stores its own vertex order)
+    key = lambda m: np.sort(np.round(m.vertices[m.faces], 5).reshape(len(m.faces), -1), axis=0)  # noqa: E731
+    assert np.allclose(np.sort(key(back), axis=0), np.sort(key(mesh), axis=0), atol=1e-5)
+
+
+def test_unknown_suffix_is_one_clear_error(tmp_path):
+    with pytest.raises(PolyfoldError, match="cannot write '.xyz' meshes"):
+        write_mesh(tmp_path / "m.xyz", np.zeros((3, 3)), np.array([[0, 1, 2]]))
+    assert not list(tmp_path.iterdir())

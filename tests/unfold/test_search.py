@@ -1,0 +1,153 @@
+"""unfold/search.py (`unfold`): verified single nets of closed, genus-one and open meshes, two cuts
+at hyperbolic vertices, every method, the same net for the same seed, the multi-piece fallback and
+the time budget (time_limit or a Deadline)."""
+
+import time
+
+import numpy as np
+import pytest
+
+from conftest import single_component, sorted_side_lengths
+from polyfold.collide.flat import find_overlaps
+from polyfold.deadline import Deadline
+from polyfold.errors import NoNetFound
+from polyfold.formats.meshes import load_mesh
+from polyfold.unfold.problem import HEURISTICS, UnfoldProblem
+from polyfold.unfold.search import split_into_pieces, unfold
+
+PLATONIC = ["tetrahedron-4", "cube-12", "octahedron-8", "dodecahedron-36", "icosahedron-20"]
+GENUS_ONE = ["torus-50", "torus-8x4-64", "torus-12x6-144", "torus-twisted-10x3-60"]
+
+
+def assert_valid_net(net, n_pieces=1):
+    mesh = net.mesh
+    # every face congruent to its 3D triangle, CCW seen from +z (outer side up)
+    np.testing.assert_allclose(sorted_side_lengths(net.coords), sorted_side_lengths(mesh.vertices[mesh.faces]),
+                               atol=1e-9 * mesh.bbox_diagonal)
+    c = net.coords
+    area2 = (c[:, 1, 0] - c[:, 0, 0]) * (c[:, 2, 1] - c[:, 0, 1]) - (c[:, 1, 1] - c[:, 0, 1]) * (c[:, 2, 0] - c[:, 0, 0])
+    assert (area2 > 0).all()
+    # a crease joins the two faces that share that mesh edge, and they share its two corners in 2D
+    for f in np.flatnonzero(net.parent >= 0):
+        p, e = net.parent[f], net.parent_edge[f]
+        assert e in mesh.topology.face_edges[f] and e in mesh.topology.face_edges[p]
+        for v in mesh.topology.edges[e]:
+            np.testing.assert_allclose(c[f][mesh.faces[f] == v], c[p][mesh.faces[p] == v], atol=1e-12 * mesh.bbox_diagonal)
+    # no two faces of one piece overlap (all pairs, crease pairs included)
+    for piece in range(net.n_pieces):
+        idx = np.flatnonzero(net.piece == piece)
+        assert len(find_overlaps(c[idx], None, 1e-9 * mesh.bbox_diagonal)) == 0
+    assert net.n_pieces == n_pieces
+
+
+@pytest.mark.parametrize("name", PLATONIC)
+def test_platonic_solids_single_net(models_dir, name):
+    net, stats = unfold(single_component(models_dir, name), seed=1)
+    assert_valid_net(net)
+    assert stats.pieces == 1 and not stats.timed_out
+    # closed genus 0: cut edges form a spanning tree of the vertex graph (|V| - 1 edges)
+    cuts = ~net.crease_mask
+    assert cuts.sum() == net.mesh.n_vertices - 1
+
+
+@pytest.mark.parametrize("name", GENUS_ONE)
+def test_genus_one_single_net(models_dir, name):
+    net, _ = unfold(single_component(models_dir, name), seed=2)
+    assert_valid_net(net)
+    # genus g: cuts = |V| - 1 + 2g (the cut graph carries the 2g handle loops)
+    assert (~net.crease_mask).sum() == net.mesh.n_vertices - 1 + 2
+
+
+@pytest.mark.parametrize("name", ["open/hemisphere-152", "open/tube-132", "open/cube-no-bottom-40",
+                                  "paper-parts/horse/part-6", "paper-parts/bunny-128/part-0"])
+def test_open_patches_single_net(models_dir, name):
+    net, _ = unfold(single_component(models_dir, name), seed=1)
+    assert_valid_net(net)
+
+
+@pytest.mark.parametrize("name", ["bunny-128", "star-prism-36", "spiky-icosahedron-60"])
+def test_hyperbolic_vertices_get_two_cuts(models_dir, name):
+    # ALGORITHMS.md 2: a vertex with angle sum > 2 pi and only one cut would overlap itself.
+    net, _ = unfold(single_component(models_dir, name), seed=3)
+    assert_valid_net(net)
+    topo = net.mesh.topology
+    cut_edges = topo.edges[~net.crease_mask]
+    cuts_per_vertex = np.bincount(cut_edges.ravel(), minlength=net.mesh.n_vertices)
+    hyper = np.flatnonzero(net.mesh.hyperbolic)
+    assert len(hyper) > 0 and (cuts_per_vertex[hyper] >= 2).all()
+
+
+def test_same_seed_same_net(models_dir):
+    mesh = single_component(models_dir, "bunny-128")
+    a, _ = unfold(mesh, seed=5)
+    b, _ = unfold(mesh, seed=5)
+    assert np.array_equal(a.parent, b.parent) and np.array_equal(a.coords, b.coords)
+
+
+@pytest.mark.parametrize("method", sorted(set(HEURISTICS) - {"unsteepest-edge", "random-edge"}) + ["ga"])
+def test_every_method_gives_a_verified_net(models_dir, method):
+    mesh = single_component(models_dir, "icosahedron-20")
+    net, stats = unfold(mesh, method=method, seed=1, time_limit=20)
+    assert_valid_net(net, n_pieces=stats.pieces)
+
+
+def test_fallback_splits_into_overlap_free_pieces(models_dir):
+    mesh = single_component(models_dir, "bumpy-528")
+    problem = UnfoldProblem.from_mesh(mesh)
+    rng = np.random.default_rng(0)
+    parent, parent_edge, order, coords = problem.decode(HEURISTICS["flat-tree"](problem, rng))
+    pairs = problem.overlaps(coords, parent)
+    assert len(pairs) > 0  # a plain flat tree of this bumpy mesh overlaps
+    cut = split_into_pieces(parent, parent_edge, order, pairs)
+    # every overlapping pair is separated: some crease on its tree path is cut
+    depth = np.zeros(len(parent), int)
+    for f in order[1:]:
+        depth[f] = depth[parent[f]] + 1
+    for f, g in pairs:
+        on_path = []
+        while f != g:
+            if depth[f] >= depth[g]:
+                on_path.append(f); f = parent[f]
+            else:
+                on_path.append(g); g = parent[g]
+        assert cut[on_path].any()
+
+
+def test_time_limit_fallback_and_max_pieces(models_dir):
+    mesh = single_component(models_dir, "bumpy-528")
+    net, stats = unfold(mesh, method="flat-tree", seed=0, time_limit=0.0)
+    if stats.timed_out:
+        assert stats.pieces > 1
+        assert_valid_net(net, n_pieces=stats.pieces)
+        with pytest.raises(NoNetFound):
+            unfold(mesh, method="flat-tree", seed=0, time_limit=0.0, max_pieces=1)
+
+
+# ----------------------------------------------------------------------------------------------
+# unfold()'s optional Deadline: used instead of time_limit when given, same nets for the same seed
+# while it is not reached, and a spent one stops the search at once (with a net all the same)
+
+
+def _same_net(a, b) -> bool:
+    return all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("parent", "parent_edge", "order", "coords", "piece"))
+
+
+def test_a_deadline_not_reached_gives_the_time_limits_nets(models_dir):
+    mesh = load_mesh(models_dir / "bunny-128.obj").components[0]
+    for method in ("auto", "ga", "steepest-edge"):
+        for seed in (0, 3):
+            net, st = unfold(mesh, method=method, seed=seed, time_limit=600, max_generations=50)
+            net_d, st_d = unfold(mesh, method=method, seed=seed, deadline=Deadline.after(600), max_generations=50)
+            assert _same_net(net, net_d)
+            assert (st.generations, st.evaluations, st.method, st.pieces) == (st_d.generations, st_d.evaluations,
+                                                                              st_d.method, st_d.pieces)
+
+
+def test_a_spent_deadline_stops_the_search(models_dir):
+    mesh = load_mesh(models_dir / "bumpy-528.obj").components[0]
+    unfold(mesh, seed=0, time_limit=0.0)  # compile / load the kernels first
+    t0 = time.perf_counter()
+    net, st = unfold(mesh, method="ga", seed=0, time_limit=600, deadline=Deadline.after(0.0))
+    assert st.generations == 0  # the deadline wins over time_limit
+    assert time.perf_counter() - t0 < 30
+    assert net.n_pieces == st.pieces >= 1
