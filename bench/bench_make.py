@@ -42,11 +42,11 @@ def main() -> None:
                 print(f"{path.stem:<34} {str(exc)[:100]}")
                 continue
             dt = time.perf_counter() - t0
-            lay = rep["stages"]["layout"]
-            n = len(rep["pieces"])
-            print(f"{path.stem:<34} {rep['input']['faces']:>5} {rep['stages']['segment']['parts']:>5} {n:>6} "
-                  f"{lay['pages']:>5} {lay['utilisation']:>5.2f} {lay['tabs']:>4}/{lay['glue_edges']:<4} "
-                  f"{len(lay['untabbed_edges']):>6} {rep['checks']['paths_verified']:>3}/{n:<3} {dt:>7.2f}", flush=True)
+            lay = rep.stages.layout
+            n = len(rep.pieces)
+            print(f"{path.stem:<34} {rep.input.faces:>5} {rep.stages.segment.parts:>5} {n:>6} "
+                  f"{lay.pages:>5} {lay.utilisation:>5.2f} {lay.tabs:>4}/{lay.glue_edges:<4} "
+                  f"{len(lay.untabbed_edges):>6} {rep.checks.paths_verified:>3}/{n:<3} {dt:>7.2f}", flush=True)
 
 
 if __name__ == "__main__":

@@ -6,5 +6,6 @@
     study.py      a study over many meshes (`batch --study unfold | cspace`): its tasks, CSV and SVG plot
     isolation.py  one process per task, locally (forkserver pool) or on Dask; outcomes of crashed /
                   killed tasks; the `python -m polyfold.apps.isolation` entry of a Dask task
-    benchpaper.py `polyfold bench paper`: the paper's tables and figures, regenerated
+    benchpaper.py `polyfold bench paper`: the paper's experiments, measured
+    benchpaper_report.py  its report.md and figures, beside the paper's numbers
 """

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+from ..collide.tolerance import CONTACT_TOL
 from .batch import BatchResult, Progress, Row, expand, outcome_row, row_collector, rows_csv
 from .isolation import faults, hard_limit_for, run_tasks, task_spec
 
@@ -121,7 +122,7 @@ def cspace_task(spec: dict) -> dict:
 
 
 def run_study(study: str, patterns: str | os.PathLike | Sequence[str | os.PathLike], out_dir: str | os.PathLike, *,
-              runs: int = 5, samples: int = 1000, seed: int = 1, time_limit: float = 60.0, contact_tol: float = 1e-7,
+              runs: int = 5, samples: int = 1000, seed: int = 1, time_limit: float = 60.0, contact_tol: float = CONTACT_TOL,
               workers: int | None = None, scheduler: str | None = None, hard_limit: float | None = None,
               progress: Progress | None = None) -> BatchResult:
     """A study over the meshes, each mesh an isolated task as in `run_batch`.

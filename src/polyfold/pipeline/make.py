@@ -82,7 +82,7 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     """The independent page checks; PolyfoldError (nothing written) when one fails."""
     say("check", "checking every page")
     tc = time.perf_counter()
-    _, pack_height = printable(opts, sheets.width, sheets.height)
+    _, pack_height = printable(sheets.width, sheets.height)
     checks = check_pages(list(sheets.pieces), sheets.page_of_piece(), sheets.packing.n_pages, sheets.width,
                          pack_height, opts.margin, GAP_MM)
     problems = checks.pop("problems")
@@ -120,7 +120,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     scale = model_scale(mesh, opts.size, name)
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
-    fitted, page_splits = fit_parts(parts, scale, opts, printable(opts, width, height), name)
+    fitted, page_splits = fit_parts(parts, scale, opts, printable(width, height), name)
     fit_seconds = time.perf_counter() - ts
     folded, fold_report = fold_pieces(fitted, opts, deadline, say)
     sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say)

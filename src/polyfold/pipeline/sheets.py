@@ -34,7 +34,7 @@ def model_scale(mesh: Mesh, size_mm: float, name: str) -> float:
     return size_mm / extent
 
 
-def printable(opts: MakeOptions, width: float, height: float) -> tuple[float, float]:
+def printable(width: float, height: float) -> tuple[float, float]:
     """The page area pieces are packed into (the footer strip excluded), mm."""
     return width, height - FOOTER_MM
 
@@ -88,7 +88,7 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     say("layout", f"tabs and labels for {len(folded)} pieces")
     pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
-    packing = pack_outlines([p.outline for p in pieces], printable(opts, width, height), margin=opts.margin,
+    packing = pack_outlines([p.outline for p in pieces], printable(width, height), margin=opts.margin,
                             gap=GAP_MM, seed=opts.seed, time_limit=max(2.0, min(10.0, deadline.left())))
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
     return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl)
