@@ -17,3 +17,12 @@ class NoNetFound(PolyfoldError):
     """No net satisfying the request (e.g. --max-pieces 1) was found within the budget."""
 
     exit_code = 1
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception as the one line a user sees: a PolyfoldError's message (its first line), any
+    other exception as 'internal error (Type): first line'."""
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    if isinstance(exc, PolyfoldError):
+        return text or type(exc).__name__
+    return f"internal error ({type(exc).__name__}): {text}".rstrip(": ")

@@ -17,7 +17,8 @@ from shapely.geometry import Point, Polygon, box
 
 from conftest import H3, by_class, make_net, square_net, tetra_net
 from polyfold.fabricate.check import check_pages
-from polyfold.fabricate.sheet import FOOTER_MM, GAP_MM, MARGIN_MM, NetSheet, net_sheet
+from polyfold.fabricate.paper import FOOTER_MM, GAP_MM
+from polyfold.fabricate.sheet import MARGIN_MM, NetSheet, net_sheet
 from polyfold.formats.svg import write_svg_page
 from polyfold.unfold.net import Net
 

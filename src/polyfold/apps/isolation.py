@@ -14,8 +14,8 @@ makes the task of the mesh file named NAME call os._exit(1), segfault, or sleep 
 parent reads it when a batch starts (`faults`) and puts it into the task spec, so it also reaches
 forkserver children (started with an older environment) and Dask workers.
 
-Only the standard library (and polyfold.deadline, which imports only it) is imported at module
-level: Dask workers and the task processes import this module, and `polyfold --help` must stay fast.
+Only the standard library (and polyfold.deadline, errors and formats.files, which import only
+it) is imported at module level: Dask workers and the task processes import this module, and `polyfold --help` must stay fast.
 """
 
 from __future__ import annotations
@@ -33,14 +33,15 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from ..deadline import Deadline
+from ..errors import one_line
+from ..formats.files import atomic_write
 
 FAULT_ENV = "POLYFOLD_BATCH_FAULT"
 SCHEDULER_ENV = "POLYFOLD_SCHEDULER"
-# imported once by the forkserver, so each task process starts with them loaded (saves ~1 s each);
-# the forkserver skips a name it cannot import without a word, so tests/apps/test_batch.py checks them
 # imported once by the forkserver, so each task process starts with them loaded (saves ~1 s each):
-# the task modules and what make, unfold and the studies import lazily (make's own imports
-# bring in every stage)
+# the task modules and what make, unfold and the studies import lazily (make's own imports bring
+# in every stage). The forkserver skips a name it cannot import without a word, so
+# tests/apps/test_batch.py checks them.
 PRELOAD = ("polyfold.apps.isolation", "polyfold.apps.batch", "polyfold.apps.study", "polyfold.pipeline.make",
            "polyfold.formats.meshes", "polyfold.inflate.inflate", "polyfold.fold.cspace")
 
@@ -80,16 +81,6 @@ def hard_limit_for(budget: float, hard_limit: float | None) -> float:
 # Inside the task process
 
 
-def one_line(exc: BaseException) -> str:
-    """An exception as one line: a PolyfoldError's message, else 'internal error (Type): ...'."""
-    from ..errors import PolyfoldError
-
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-    if isinstance(exc, PolyfoldError):
-        return text or type(exc).__name__
-    return f"internal error ({type(exc).__name__}): {text}".rstrip(": ")
-
-
 def run_task(spec: dict) -> dict:
     """Run one task spec; -> {status: ok | error, error, values}."""
     fault = spec.get("fault")
@@ -121,11 +112,7 @@ def child_main(spec: dict, result_path: str, log_path: str) -> None:
     os.dup2(log, 1)
     os.dup2(log, 2)
     faulthandler.enable()
-    outcome = run_task(spec)
-    tmp = result_path + ".tmp"
-    with open(tmp, "w") as fh:
-        json.dump(outcome, fh)
-    os.replace(tmp, result_path)  # the parent never reads half a result
+    atomic_write(result_path, json.dumps(run_task(spec)))  # the parent never reads half a result
 
 
 # ----------------------------------------------------------------------------------------------

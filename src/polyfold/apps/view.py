@@ -27,7 +27,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import PolyfoldError
+from ..errors import PolyfoldError, one_line
 from ..formats.meshes import obj_text
 from ..mesh.mesh import Mesh
 from ..pipeline.folder import MakeFolder, ViewPiece, load_folder, make_folder
@@ -412,8 +412,7 @@ class Viewer:
         try:
             res = inflate(self.source, mode=mode, pressure=p, stiffness_ratio=r, max_steps=n)
         except Exception as exc:  # shown in the page; the next slider change tries again
-            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            self.hv_text.content = f"input HV {hv0}  \ninflation failed: {why}"
+            self.hv_text.content = f"input HV {hv0}  \ninflation failed: {one_line(exc)}"
             return
         mesh = res.mesh
         hv = mesh.hyperbolic
@@ -449,10 +448,8 @@ class Viewer:
         def run() -> None:
             try:
                 job()
-            except PolyfoldError as exc:
-                self.make_status.content = f"failed: {str(exc).splitlines()[0]}"
             except Exception as exc:  # report in the page; the server keeps running
-                self.make_status.content = f"failed ({type(exc).__name__}): {str(exc).splitlines()[0] if str(exc) else ''}"
+                self.make_status.content = f"failed: {one_line(exc)}"
             finally:
                 with self._lock:
                     self._make_running = False

@@ -5,9 +5,13 @@ Cutting creases never moves a face, so the pieces stay overlap-free.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..errors import PolyfoldError
+from ..mesh.mesh import Mesh
 from ..unfold.net import Net, cut_creases, subtree_areas
 from .pack import fits_page
 from .tabs import TAB_MAX_MM
@@ -81,3 +85,13 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
         net = cut_creases(net, np.array([chosen]))
         cuts += 1
     return net, cuts
+
+
+def model_scale(meshes: Sequence[Mesh], size_mm: float) -> float:
+    """mm per model unit: the longest bounding-box side of the meshes' used vertices (a model's
+    components together) becomes size_mm. PolyfoldError when the model has zero size."""
+    pts = np.concatenate([m.vertices[np.unique(m.faces)] for m in meshes])
+    extent = float(np.ptp(pts, axis=0).max())
+    if not (extent > 0 and math.isfinite(extent)):
+        raise PolyfoldError("the model has zero size")
+    return size_mm / extent

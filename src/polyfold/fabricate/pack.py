@@ -15,7 +15,7 @@ shapely (`check_packing`) before it is returned. The scan over positions is a nu
 checks a piece row by row as runs of cells against a "last occupied column" table and jumps past
 the obstacle it hits, so no loop visits every cell.
 
-`shelf_offsets` puts bounding boxes on plain shelves: the fallback when the time budget runs out,
+`shelves.shelf_offsets` puts bounding boxes on plain shelves: the fallback when the time budget runs out,
 and the layout of the one sheet of `polyfold unfold --svg` (`sheet.py`).
 """
 
@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,8 +31,8 @@ from numba import njit
 from shapely import MultiPolygon, Polygon
 
 from ..errors import PolyfoldError
+from ..shelves import shelf_offsets
 
-GAP_MM = 3.0  # minimum distance between pieces on a page, tabs included (room for scissors)
 _CELLS = 600  # grid cells along the long printable side: ~0.46 mm on A4
 _QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
 _TOL = 1e-9  # mm: float noise allowed by check_packing
@@ -345,26 +344,6 @@ def _best_on_page(page: _Page, piece: _Piece, res: float) -> tuple[_Shape, int, 
 
 # ----------------------------------------------------------------------------------------------
 # shelves (the fallback, and sheets that grow to fit)
-
-
-def shelf_offsets(sizes: Sequence[Sequence[float]], width: float, height: float,
-                  gap: float) -> list[tuple[int, float, float]]:
-    """Boxes `sizes` (n, 2) = (width, height) mm on shelves: tallest first (ties in input order),
-    left to right in rows no wider than `width` (a box wider than that gets a row of its own),
-    boxes and rows `gap` apart, a new page when a row would pass `height`. Returns (page, x, y) of
-    each box's min corner, relative to the printable area, in input order."""
-    order = sorted(range(len(sizes)), key=lambda j: (-sizes[j][1], j))
-    out: list[tuple[int, float, float]] = [(0, 0.0, 0.0)] * len(sizes)
-    page, x, y, shelf_h = 0, 0.0, 0.0, 0.0
-    for j in order:
-        bw, bh = sizes[j]
-        if x > 0 and x + bw > width:
-            x, y, shelf_h = 0.0, y + shelf_h + gap, 0.0
-        if y > 0 and y + bh > height:
-            page, x, y, shelf_h = page + 1, 0.0, 0.0, 0.0
-        out[j] = (page, x, y)
-        x, shelf_h = x + bw + gap, max(shelf_h, bh)
-    return out
 
 
 def _shelf(items: list[tuple[int, _Piece]], pw: float, ph: float, margin: float, gap: float, first_page: int) -> dict[int, Placement]:

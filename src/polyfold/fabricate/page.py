@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .paper import FOOTER_FONT_MM
+
 if TYPE_CHECKING:
     from .pack import Placement
     from .pieces import SheetPiece
@@ -135,7 +137,7 @@ def page_of(pieces: list[SheetPiece], width: float, height: float, footer: str |
     """A `Page` with the (already placed) pieces; an optional footer line of text."""
     texts = [t for p in pieces for t in p.texts]
     if footer:
-        texts.append(TextItem(footer, width / 2, footer_y if footer_y is not None else height - 12, 0.0, 2.5, "title"))
+        texts.append(TextItem(footer, width / 2, footer_y if footer_y is not None else height - 12, 0.0, FOOTER_FONT_MM, "title"))
     cat = lambda name: np.concatenate([getattr(p, name).reshape(-1, 2, 2) for p in pieces]) if pieces else np.zeros((0, 2, 2))
     return Page(width=width, height=height, cut=tuple(r for p in pieces for r in p.cut_rings()),
                 mountain=cat("mountain"), valley=cat("valley"), tab_folds=cat("tab_folds"), texts=tuple(texts),

@@ -16,15 +16,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import PolyfoldError
+from ..shelves import shelf_offsets
 from ..unfold.net import Net, piece_net
 from .labels import CHAR_EM
-from .pack import GAP_MM, Placement, shelf_offsets
+from .fit import model_scale
+from .pack import Placement
+from .paper import FOOTER_FONT_MM, FOOTER_MM, GAP_MM
 from .page import Page, page_of, place
 from .pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
 
 MARGIN_MM = 10.0
-FOOTER_MM = 6.0  # strip below the pieces for the footer line
-FOOTER_FONT_MM = 2.5  # the footer's font size in `page.page_of`
 MAX_SHEET_MM = 300.0  # larger sheets do not fit common printers and cutting machines
 
 
@@ -59,12 +60,6 @@ def net_pieces(nets: Sequence[Net]) -> list[PieceInput]:
     return inputs
 
 
-def model_extent(nets: Sequence[Net]) -> float:
-    """The longest bounding-box side of the model (all components' used vertices), model units."""
-    pts = np.concatenate([net.mesh.vertices[np.unique(net.mesh.faces)] for net in nets])
-    return float(np.ptp(pts, axis=0).max())
-
-
 def _shelves(pieces: list[SheetPiece]) -> tuple[list[Placement], float, float]:
     """Placements of the pieces on rows about as wide as the pieces' total area is deep (unturned,
     GAP_MM apart), and the (width, height) mm the rows take."""
@@ -86,10 +81,7 @@ def net_sheet(nets: Sequence[Net], size_mm: float, *, labels: bool = True, tabs:
     not a positive number or a model of zero size."""
     if not (size_mm > 0 and math.isfinite(size_mm)):
         raise PolyfoldError(f"sheet size must be a positive number of mm, got {size_mm}")
-    extent = model_extent(nets)
-    if not (extent > 0 and math.isfinite(extent)):
-        raise PolyfoldError("the model has zero size, cannot scale the sheet")
-    scale = size_mm / extent
+    scale = model_scale([net.mesh for net in nets], size_mm)
     pieces, glue, stats = build_sheet_pieces(net_pieces(nets), scale, tabs=tabs)
     if not labels:
         pieces = [replace(p, texts=()) for p in pieces]

@@ -170,7 +170,6 @@ def _check_ends(tree: FoldTree, check: ValidityChecker) -> None:
 def is_linearly_foldable(tree: FoldTree, resolution_deg: float = 1.0) -> bool:
     """True if the straight segment flat -> goal is collision-free at the resolution (and at half of it)."""
     check = ValidityChecker(tree, math.radians(resolution_deg))
-    zero = np.zeros(len(tree.goal))
-    if not check.valid(zero) or not check.valid(tree.goal):
+    if not check.valid(np.zeros(len(tree.goal))) or not check.valid(tree.goal):
         return False
-    return check.segment(zero, tree.goal, check.step / 2)  # half the resolution covers the full one
+    return plan_linear(tree, check, Deadline.never(), PlannerSettings()) is not None

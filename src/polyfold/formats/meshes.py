@@ -12,7 +12,8 @@ import os
 import numpy as np
 
 from ..errors import PolyfoldError
-from ..mesh.repair import LoadedMesh, RawMesh, mesh_error, repair
+from ..mesh.mesh import Mesh
+from ..mesh.repair import LoadedMesh, RawMesh, check_input, mesh_error, repair
 from .files import atomic_write
 
 
@@ -235,6 +236,17 @@ def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray,
     """Write a mesh file, its format by the path's suffix (`mesh_bytes`), atomically."""
     atomic_write(path, mesh_bytes(os.path.splitext(os.fspath(path))[1], vertices, faces, face_colors=face_colors,
                                   header=header))
+
+
+def read_mesh_as_is(path: str | os.PathLike) -> Mesh:
+    """The mesh of a file exactly as written, without repairs (for files polyfold wrote itself,
+    e.g. a make folder's part-K.obj); MeshError (one line) when it has no faces, an index out of
+    range or a non-finite coordinate."""
+    path = os.fspath(path)
+    name = os.path.basename(path)
+    raw = _read(path, name)
+    check_input(raw, name)
+    return Mesh(raw.vertices, raw.tris)
 
 
 def load_mesh(path: str | os.PathLike) -> LoadedMesh:

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..fabricate.page import Page, page_of
+from ..fabricate.paper import FOOTER_MM
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
 from ..formats.fold import dumps, piece_fold
@@ -22,7 +23,7 @@ from ..formats.svg import svg_page_string
 from ..mesh.mesh import Mesh
 from .folding import FoldedPiece
 from .instructions import instructions_html
-from .options import FOOTER_MM, MakeOptions
+from .options import MakeOptions
 from .parts import Part
 from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, PieceReport
 from .sheets import Sheets

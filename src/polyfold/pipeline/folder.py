@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import PolyfoldError
 from ..fold.tree import FoldTree, fold_positions
 from ..formats.fold import FoldNet, fold_net, read_fold
+from ..formats.meshes import read_mesh_as_is
 from ..mesh.geometry import fold_deg_to_rho
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
@@ -150,23 +151,6 @@ def weld_parts(parts: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
     return welded
 
 
-def _read_obj(path: Path) -> Mesh:
-    """The OBJ files make writes (v / f lines, triangles): read them exactly, without repairs."""
-    verts, faces = [], []
-    for line in path.read_text(encoding="utf-8").splitlines():
-        tok = line.split()
-        if not tok:
-            continue
-        if tok[0] == "v":
-            verts.append([float(x) for x in tok[1:4]])
-        elif tok[0] == "f":
-            faces.append([int(x.split("/")[0]) - 1 for x in tok[1:4]])
-    v, f = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(faces, dtype=np.int64).reshape(-1, 3)
-    if len(f) == 0 or f.min() < 0 or f.max() >= len(v):
-        raise PolyfoldError(f"{path.name}: not a usable part mesh (no faces or bad vertex indices)")
-    return Mesh(v, f)
-
-
 def _inside(root: Path, name: str) -> Path:
     """root / name for a plain file name from assembly.json, refusing anything that leaves root."""
     if not isinstance(name, str) or not name or Path(name).name != name or name in (".", ".."):
@@ -206,7 +190,7 @@ def load_folder(path: str | Path) -> MakeFolder:
         f = _inside(root, row.obj)
         if not f.is_file():
             raise PolyfoldError(f"{root}: {row.obj} is missing")
-        parts.append(_read_obj(f))
+        parts.append(read_mesh_as_is(f))
     pieces = []
     for row in assembly.pieces:
         if not 0 <= row.part < len(parts):

@@ -18,7 +18,8 @@ from typing import Callable
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fabricate.check import check_pages
-from ..fabricate.pack import GAP_MM
+from ..fabricate.fit import model_scale
+from ..fabricate.paper import GAP_MM
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
 from .export import write_make_folder
@@ -27,7 +28,7 @@ from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
                      PieceReport, StageReports)
-from .sheets import Sheets, fit_parts, lay_out, model_scale, printable
+from .sheets import Sheets, fit_parts, lay_out, printable
 
 Progress = Callable[[str, str], None]  # (stage, message)
 
@@ -117,7 +118,10 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     mesh, input_report, load_report, name = _load(source, name, say)
     mesh, inflate_report = _inflate(mesh, opts, say)
     parts, segment_report, unfold_report = make_parts(mesh, opts, deadline, say)
-    scale = model_scale(mesh, opts.size, name)
+    try:
+        scale = model_scale([mesh], opts.size)
+    except PolyfoldError as exc:
+        raise PolyfoldError(f"{name}: {exc}") from None
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
     fitted, page_splits = fit_parts(parts, scale, opts, printable(width, height), name)

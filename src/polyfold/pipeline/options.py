@@ -10,11 +10,11 @@ from dataclasses import dataclass
 
 from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
+from ..fabricate.paper import FOOTER_MM
 
 PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
 INFLATE_MODES = ("none", "constrained", "uniform")
 SEGMENT_MODES = ("auto", "none")
-FOOTER_MM = 6.0  # strip at the bottom of the printable area for the page footer
 
 
 @dataclass(frozen=True)

@@ -12,26 +12,17 @@ import time
 from dataclasses import dataclass
 from typing import Callable
 
-import numpy as np
-
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fabricate.fit import PieceTooLarge, split_to_fit
-from ..fabricate.pack import GAP_MM, Packing, pack_outlines
+from ..fabricate.pack import Packing, pack_outlines
 from ..fabricate.page import place
+from ..fabricate.paper import FOOTER_MM, GAP_MM
 from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
 from ..mesh.mesh import Mesh
 from .folding import FoldedPiece
-from .options import FOOTER_MM, MakeOptions
+from .options import MakeOptions
 from .parts import Part
-
-
-def model_scale(mesh: Mesh, size_mm: float, name: str) -> float:
-    """mm per model unit: the model's longest bounding-box side becomes size_mm."""
-    extent = float(np.ptp(mesh.vertices[np.unique(mesh.faces)], axis=0).max())
-    if not extent > 0:
-        raise PolyfoldError(f"{name}: the model has zero size")
-    return size_mm / extent
 
 
 def printable(width: float, height: float) -> tuple[float, float]:

@@ -21,6 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from ..mesh.geometry import FLAT_EPS, vector_norm
+from ..shelves import shelf_offsets
 from . import pattern_kernels as PK
 from .net import Net
 
@@ -62,23 +63,13 @@ class CreasePattern:
 
 
 def _piece_offsets(lo: np.ndarray, hi: np.ndarray, gap: float) -> np.ndarray:
-    """Shelf-pack the pieces' bounding boxes (lo, hi (P, 2)): translation (P, 2) per piece."""
-    n_p = len(lo)
+    """Translations (P, 2) that put the pieces' bounding boxes (lo, hi (P, 2)) on shelves, rows
+    going down from y = 0 (`shelves.shelf_offsets`; rows about 1.5 times as wide as the pieces'
+    total area is deep)."""
     size = (hi - lo).tolist()
-    lo = lo.tolist()
-    # (the row width only matters once a shelf holds a piece: not for a single piece)
-    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5) if n_p > 1 else 0.0
-    offsets = [None] * n_p
-    x = y = shelf = 0.0
-    # a handful of pieces: plain Python over lists is cheaper than numpy here
-    for p in sorted(range(n_p), key=lambda i: -size[i][1]) if n_p > 1 else (0,):
-        w, h = size[p]
-        if x > 0 and x + w > row_width:
-            x, y, shelf = 0.0, y + shelf + gap, 0.0
-        offsets[p] = (x - lo[p][0], -(y + h) - lo[p][1])
-        x += w + gap
-        shelf = max(shelf, h)
-    return np.array(offsets)
+    row_width = max(max(w for w, _ in size), math.sqrt(sum(w * h for w, h in size)) * 1.5) if len(size) > 1 else 0.0
+    return np.array([(x - lo_p[0], -(y + h) - lo_p[1])
+                     for (_, x, y), (_, h), lo_p in zip(shelf_offsets(size, row_width, math.inf, gap), size, lo.tolist())])
 
 
 def _joined(parts: list[np.ndarray]) -> np.ndarray:

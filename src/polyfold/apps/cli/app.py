@@ -34,18 +34,18 @@ def guard(func):
 
     @wraps(func)
     def wrapper(*args, **kwargs):
-        from ...errors import PolyfoldError
+        from ...errors import PolyfoldError, one_line
 
         try:
             return func(*args, **kwargs)
         except PolyfoldError as exc:
-            fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__, exc.exit_code)
+            fail(one_line(exc), exc.exit_code)
         except KeyboardInterrupt:
             fail("interrupted", 130)
         except typer.Exit:
             raise
         except Exception as exc:  # last resort: still one line, no traceback
-            fail(f"internal error ({type(exc).__name__}): {str(exc).splitlines()[0] if str(exc) else ''}", 3)
+            fail(one_line(exc), 3)
 
     return wrapper
 
