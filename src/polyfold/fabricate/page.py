@@ -51,6 +51,8 @@ class Page:
 
     cut: closed polylines (k, 2), k >= 3, piece outlines incl. tabs, not repeating the first point
     (a repeated closing point is dropped); mountain / valley / tab_folds: (n, 2, 2) segments;
+    tab_mountain: (len(tab_folds),) bool, True where a tab folds as a mountain seen from the printed
+    side (its seam is convex), False for a valley (concave seam; default: all valleys);
     texts: labels; faces: optional (n, 3, 2) triangles per piece, filled light in previews only;
     slits: (n, 2, 2) cut segments inside an outline (two faces of one piece that touch along a cut
     edge: the outline alone would not separate them). Arrays are coerced to float64 and validated on construction.
@@ -66,6 +68,7 @@ class Page:
     faces: tuple[np.ndarray, ...] = ()
     slits: np.ndarray = ()  # type: ignore[assignment]
     tabs: tuple[np.ndarray, ...] = ()  # optional (4, 2) glue-tab polygons, shaded in previews only
+    tab_mountain: np.ndarray = ()  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.width) and math.isfinite(self.height) and self.width > 0 and self.height > 0):
@@ -85,6 +88,12 @@ class Page:
         object.__setattr__(self, "faces", faces)
         object.__setattr__(self, "tabs", tuple(_finite(t, f"tabs[{i}]", (-1, 2)) for i, t in enumerate(self.tabs)))
         object.__setattr__(self, "texts", tuple(self.texts))
+        tm = np.asarray(self.tab_mountain, dtype=bool).reshape(-1)
+        if tm.size == 0:
+            tm = np.zeros(len(self.tab_folds), dtype=bool)
+        if len(tm) != len(self.tab_folds):
+            raise ValueError(f"tab_mountain: expected {len(self.tab_folds)} flags, got {len(tm)}")
+        object.__setattr__(self, "tab_mountain", tm)
 
 
 def _finite(a, name: str, shape: tuple[int, ...]) -> np.ndarray:
@@ -142,4 +151,5 @@ def page_of(pieces: list[SheetPiece], width: float, height: float, footer: str |
     return Page(width=width, height=height, cut=tuple(r for p in pieces for r in p.cut_rings()),
                 mountain=cat("mountain"), valley=cat("valley"), tab_folds=cat("tab_folds"), texts=tuple(texts),
                 faces=tuple(p.faces_xy for p in pieces), slits=cat("slits"),
-                tabs=tuple(t for p in pieces for t in p.tabs))
+                tabs=tuple(t for p in pieces for t in p.tabs),
+                tab_mountain=np.concatenate([p.tab_mountain for p in pieces]) if pieces else np.zeros(0, bool))

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..mesh.geometry import FLAT_EPS  # flat creases are not scored, as in the FOLD files
+from ..mesh.mesh import Mesh
 from ..unfold.net import Net
 from .labels import edge_label, piece_label, piece_name
 from .page import TextItem
@@ -53,6 +54,7 @@ class SheetPiece:
     tabs: tuple[np.ndarray, ...]  # (4, 2) trapezoids
     tab_folds: np.ndarray  # (t, 2, 2)
     texts: tuple[TextItem, ...]
+    tab_mountain: np.ndarray  # (t,) bool: tab t folds as a mountain seen from the printed side (convex seam)
 
     def cut_rings(self) -> list[np.ndarray]:
         """The outline's boundary rings (exterior and holes), without the repeated last point."""
@@ -73,6 +75,7 @@ class GlueEdge:
     pieces: tuple[int, int]  # piece index of each side
     tab_piece: int | None  # the piece whose side carries the tab; None: no tab fits either side
     tab_height_mm: float
+    fold_angle: float = 0.0  # the seam's signed fold angle rho (radians, + convex) in the model
 
 
 @dataclass(frozen=True)
@@ -146,6 +149,7 @@ class _Glued:
 
     n: int
     tabs: list = field(init=False)  # shapely Polygons
+    tab_mountain: list = field(init=False)  # per tab: its seam is convex
     slits: list = field(init=False)
     texts: list = field(init=False)
     glue: list = field(default_factory=list)
@@ -156,10 +160,23 @@ class _Glued:
     small: int = 0
 
     def __post_init__(self) -> None:
-        self.tabs, self.slits, self.texts = ([[] for _ in range(self.n)] for _ in range(3))
+        self.tabs, self.tab_mountain, self.slits, self.texts = ([[] for _ in range(self.n)] for _ in range(4))
 
 
-def _glue(pairs, drawn: list[_Drawn], tabs: bool) -> _Glued:
+def seam_fold_angles(inputs: list[PieceInput]) -> dict[tuple[int, int], float]:
+    """Signed fold angle rho (radians, + convex) of every edge of the model the pieces make, keyed
+    by its whole-mesh vertex ids (low, high): the pieces' faces put back together in 3D, so a seam
+    between two pieces gets the angle of its two faces in the model."""
+    n = max(int(inp.vertex_ids.max()) for inp in inputs) + 1
+    vertices = np.zeros((n, 3))
+    for inp in inputs:
+        vertices[inp.vertex_ids] = inp.net.mesh.vertices
+    whole = Mesh(vertices, np.concatenate([inp.vertex_ids[inp.net.mesh.faces] for inp in inputs]))
+    keys = np.sort(whole.topology.edges, axis=1)
+    return {(int(a), int(b)): float(r) for (a, b), r in zip(keys, whole.fold_angles)}
+
+
+def _glue(pairs, drawn: list[_Drawn], tabs: bool, rho: dict[tuple[int, int], float]) -> _Glued:
     """Label both sides of every glued pair (label = its 1-based rank), note slits (two sides of
     one piece that touch in the plane) and give each pair its tab (`choose_tab`)."""
     from shapely.geometry import Polygon
@@ -180,14 +197,15 @@ def _glue(pairs, drawn: list[_Drawn], tabs: bool) -> _Glued:
         if tab is None:
             if tabs:
                 out.untabbed.append(label)
-            out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), None, 0.0))
+            out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), None, 0.0, rho[key]))
             continue
         piece = (o1, o2)[tab.side].piece
         out.tabs[piece].append(Polygon(tab.polygon))
+        out.tab_mountain[piece].append(rho[key] > 0)
         out.n_tabs += 1
         out.shrunk += tab.variant != 0
         out.moved += tab.side == 1
-        out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.height))
+        out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.height, rho[key]))
     return out
 
 
@@ -199,7 +217,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
 
     drawn = [_draw(inp, i, scale) for i, inp in enumerate(inputs)]
     pairs, open_edges = _pair_sides(drawn)
-    g = _glue(pairs, drawn, tabs)
+    g = _glue(pairs, drawn, tabs, seam_fold_angles(inputs))
     pieces = []
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
         name = piece_name(i)
@@ -211,7 +229,8 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         pieces.append(SheetPiece(
             name=name, part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
             outline=outline, mountain=d.mountain.reshape(-1, 2, 2), valley=d.valley.reshape(-1, 2, 2),
-            slits=np.array(g.slits[i]).reshape(-1, 2, 2), tabs=tab_arr, tab_folds=folds, texts=tuple(g.texts[i])))
+            slits=np.array(g.slits[i]).reshape(-1, 2, 2), tabs=tab_arr, tab_folds=folds, texts=tuple(g.texts[i]),
+            tab_mountain=np.array(g.tab_mountain[i], dtype=bool)))
     stats = LayoutStats(glue_edges=len(pairs), tabs=g.n_tabs, tabs_shrunk=g.shrunk, tabs_moved=g.moved,
                         untabbed=tuple(g.untabbed), small_labels=g.small, open_edges=open_edges)
     return pieces, g.glue, stats

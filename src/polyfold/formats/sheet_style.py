@@ -9,8 +9,8 @@ font size (em) in mm, `angle` is the reading direction in degrees, counter-clock
 the page. The baseline is placed explicitly (half a cap height below the centre) rather than via
 SVG's dominant-baseline, which cutting-machine software ignores.
 
-Line styles: cut = solid black; mountain = red dash-dot; valley = blue dashed; glue-tab folds
-are scored like valleys. Every file is written atomically (`files.atomic_write`).
+Line styles: cut = solid black; mountain = red dash-dot; valley = blue dashed; a glue-tab fold
+is a mountain on a convex seam and a valley on a concave one (seen from the printed side). Every file is written atomically (`files.atomic_write`).
 """
 
 from __future__ import annotations
@@ -59,9 +59,12 @@ def text_baseline(t: TextItem) -> tuple[float, float]:
 
 
 def crease_layers(page: Page) -> tuple[tuple[str, str, np.ndarray], ...]:
-    """(layer style, class, segments) for every scored line; tab folds are scored like valleys."""
+    """(layer style, class, segments) for every scored line. A glue tab tucks under its partner,
+    so seen from the printed side it folds like its seam: mountain on a convex seam, valley on a
+    concave one (`Page.tab_mountain`)."""
     return (
         ("mountain", "mountain", page.mountain),
         ("valley", "valley", page.valley),
-        ("valley", "tab-fold", page.tab_folds),
+        ("mountain", "tab-fold", page.tab_folds[page.tab_mountain]),
+        ("valley", "tab-fold", page.tab_folds[~page.tab_mountain]),
     )
