@@ -104,7 +104,8 @@ def assert_sheet_ok(sheet: NetSheet) -> None:
     overlaps, everything inside the margins (the footer strip excluded)."""
     page = sheet.page
     n = len(sheet.pieces)
-    res = check_pages(list(sheet.pieces), [0] * n, 1, page.width, page.height - FOOTER_MM, MARGIN_MM, GAP_MM)
+    box = (MARGIN_MM, MARGIN_MM, page.width - MARGIN_MM, page.height - FOOTER_MM - MARGIN_MM)
+    res = check_pages(list(sheet.pieces), [0] * n, 1, box, GAP_MM)
     assert res["problems"] == []
 
 

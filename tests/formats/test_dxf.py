@@ -51,3 +51,49 @@ def test_dxf_layers_units_entities_and_flip(page: Page, tmp_path) -> None:
     anchor = np.array([texts[0].dxf.align_point.x, texts[0].dxf.align_point.y])
     bx, by = sheet_style.text_baseline(page.texts[0])
     np.testing.assert_allclose(anchor, [bx, page.height - by], atol=PAGE_TOL)
+
+
+def test_dxf_header_is_the_page_in_mm(page: Page, tmp_path) -> None:
+    path = tmp_path / "page.dxf"
+    write_dxf_page(page, path)
+    doc = ezdxf.readfile(path)
+    w, h = page.width, page.height
+    assert doc.header["$INSUNITS"] == 4 and doc.header["$MEASUREMENT"] == 1
+    assert tuple(doc.header["$LIMMIN"])[:2] == (0, 0) and tuple(doc.header["$LIMMAX"])[:2] == (w, h)
+    assert tuple(doc.header["$EXTMIN"]) == (0, 0, 0) and tuple(doc.header["$EXTMAX"]) == (w, h, 0)
+    assert tuple(doc.header["$PLIMMAX"])[:2] == (w, h)
+    layout = doc.layouts.get("Layout1").dxf_layout.dxf  # what a CAD program plots on
+    assert (layout.paper_width, layout.paper_height) == (w, h) and layout.plot_paper_units == 1  # mm
+    assert (layout.left_margin, layout.top_margin, layout.scale_numerator, layout.scale_denominator) == (0, 0, 1, 1)
+    # every drawn point lies within the extents
+    for e in doc.modelspace():
+        pts = [(x, y) for x, y, *_ in e.get_points()] if e.dxftype() == "LWPOLYLINE" else \
+              [tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]] if e.dxftype() == "LINE" else [tuple(e.dxf.align_point)[:2]]
+        assert all(0 <= x <= w and 0 <= y <= h for x, y in pts)
+
+
+def test_dxf_short_creases_show_a_gap(tmp_path) -> None:
+    """Creases of 3 mm (and shorter) show at least one gap between two dashes of their own
+    linetype, as ezdxf's linetype renderer draws them, and hold one whole pattern (AutoCAD draws a
+    line shorter than its pattern solid); long ones keep the SVG's dash lengths."""
+    from ezdxf.render.linetypes import LineTypeRenderer
+
+    crease = lambda x, y, length: [[x, y], [x + length, y]]
+    page = Page(100.0, 60.0, cut=([[5, 5], [95, 5], [95, 55], [5, 55]],),
+                mountain=[crease(10, 10, 3.0), crease(10, 20, 40.0)], valley=[crease(10, 30, 3.0)],
+                tab_folds=[crease(10, 40, 1.0), crease(10, 50, 3.0)], tab_mountain=[False, True], texts=())
+    path = tmp_path / "short.dxf"
+    write_dxf_page(page, path)
+    doc = ezdxf.readfile(path)
+    ltscale = doc.header["$LTSCALE"]
+    lines = doc.modelspace().query('LINE[layer=="MOUNTAIN" | layer=="VALLEY"]')
+    assert len(lines) == 5
+    for e in lines:
+        linetype = doc.layers.get(e.dxf.layer).dxf.linetype
+        dashes = np.array(doc.linetypes.get(linetype).pattern_tags.compile()) * ltscale * e.dxf.get("ltscale", 1.0)
+        length = e.dxf.start.distance(e.dxf.end)
+        dash_pieces = list(LineTypeRenderer(dashes.tolist()).line_segment(e.dxf.start, e.dxf.end))
+        assert len(dash_pieces) >= 2, (e.dxf.layer, length)  # at least one gap, between two dashes
+        assert dashes.sum() <= length + 1e-9
+        if length >= 10:
+            np.testing.assert_allclose(dashes, sheet_style.STYLES["mountain"]["dash"])

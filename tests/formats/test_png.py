@@ -1,5 +1,5 @@
 """formats/png.py: the PNG page writer (read back by hand): piece colours, tabs, cut and crease
-colours, aspect kept."""
+colours, aspect kept, the scale bar and registration marks."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from conftest import read_png, square_net, tetra_net
+from polyfold.fabricate.page import Page, footer, registration_marks
 from polyfold.fabricate.sheet import net_sheet
 from polyfold.formats.png import page_image, piece_colors, write_page_png
 from polyfold.formats.sheet_style import STYLES, TAB_RGB
@@ -48,3 +49,15 @@ def test_png_valley_blue(tmp_path):
     assert img.shape[1] == 100 and img.shape[0] == math.ceil(sheet.page.height * 100 / sheet.page.width)
     blue = (img[:, :, 2] > 200) & (img[:, :, 0] < 60)
     assert blue.sum() > 20
+
+
+def test_png_scale_bar_and_marks_black():
+    page = Page(210.0, 297.0, cut=(), mountain=[], valley=[], tab_folds=[], texts=(),
+                scale_bar=footer("x", 10.0, 200.0, 281.0)[1], marks=registration_marks(210.0, 297.0))
+    s = 1000 / 210.0
+    img = page_image(page, 1000).astype(int)
+    black = lambda x, y: img[int(y * s), int(x * s)].sum() == 0
+    assert black(12.5, 12.5) and not black(8.0, 12.5)  # inside the filled square, beside it
+    assert black(190.0, 10.0) and black(200.0, 20.0) and black(10.0, 280.0) and black(20.0, 287.0)  # L legs
+    bar = page.scale_bar.segments()[0]
+    assert black(bar[0, 0] + 1, bar[0, 1]) and black(bar[1, 0] - 1, bar[0, 1]) and not black(bar[1, 0] + 2, bar[0, 1])

@@ -1,16 +1,18 @@
 """formats/svg.py: the SVG page writer's layers (Inkscape layers, z-order), units, exact
-coordinates, crease styles, labels and preview fills."""
+coordinates, crease styles, labels and preview fills, the scale bar and registration marks; the
+cut file's plain strokes. (The cut file plotted by Inkscape: tests/pipeline/test_export.py.)"""
 
 from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 
 import numpy as np
 
 from conftest import PAGE_TOL
-from polyfold.fabricate.page import Page
-from polyfold.formats.svg import write_svg_page
+from polyfold.fabricate.page import Page, footer, registration_marks
+from polyfold.formats.svg import write_cut_svg, write_svg_page
 
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -76,3 +78,39 @@ def test_svg_without_faces_has_no_preview(page: Page, tmp_path) -> None:
     bare = Page(page.width, page.height, page.cut, page.mountain, page.valley, page.tab_folds, page.texts)
     write_svg_page(bare, tmp_path / "bare.svg")
     assert "preview" not in _layers(ET.parse(tmp_path / "bare.svg").getroot())
+
+
+def test_print_svg_draws_scale_bar_and_marks(page: Page, tmp_path) -> None:
+    text, bar = footer("test net", 10.0, 110.0, 80.0)
+    marked = replace(page, texts=(*page.texts, text), scale_bar=bar, marks=registration_marks(page.width, page.height))
+    write_svg_page(marked, tmp_path / "marked.svg")
+    root = ET.parse(tmp_path / "marked.svg").getroot()
+    layers = _layers(root)
+    order = [g.get("id") for g in root.findall(f"{SVG}g")]
+    assert order == ["preview", "labels", "scale", "registration", "valley", "mountain", "cut"]
+    assert layers["scale"].get("class") == "no-cut" and layers["registration"].get("class") == "no-cut"
+    segs = [_path_points(p.get("d")) for p in layers["scale"].findall(f"{SVG}path")]
+    np.testing.assert_allclose(segs, bar.segments(), atol=PAGE_TOL)
+    assert [t.text for t in layers["scale"].iter(f"{SVG}text")] == [bar.label.text]
+    square, *corners = layers["registration"].findall(f"{SVG}path")
+    assert square.get("fill") == "#000000" and square.get("d").endswith("Z")
+    np.testing.assert_allclose([_path_points(c.get("d")) for c in corners], marked.marks.corners, atol=PAGE_TOL)
+    assert all(c.get("stroke") == "#000000" and c.get("fill") is None for c in corners)  # layer: fill none
+
+
+def test_cut_svg_is_plain_strokes_of_the_print_geometry(page: Page, tmp_path) -> None:
+    slit = replace(page, slits=[[[30.0, 30.0], [40.0, 40.0]]], marks=registration_marks(page.width, page.height))
+    write_svg_page(slit, tmp_path / "print.svg")
+    write_cut_svg(slit, tmp_path / "cut.svg")
+    root = ET.parse(tmp_path / "cut.svg").getroot()
+    assert root.get("viewBox") == ET.parse(tmp_path / "print.svg").getroot().get("viewBox")
+    cut, printed = _layers(root), _layers(ET.parse(tmp_path / "print.svg").getroot())
+    assert list(cut) == ["valley", "mountain", "cut"]  # no preview, labels, scale or marks
+    assert not list(root.iter(f"{SVG}text")) and not any(el.get("class") == "no-cut" for el in root.iter())
+    for name, layer in cut.items():
+        assert layer.get("fill") == "none" and layer.get("stroke-dasharray") is None
+        assert [p.get("d") for p in layer] == [p.get("d") for p in printed[name].findall(f"{SVG}path")]
+    paths = cut["cut"].findall(f"{SVG}path")
+    assert [p.get("d").endswith("Z") for p in paths] == [True] * len(page.cut) + [False]  # outlines closed, the slit open
+    n_scores = len(cut["mountain"]) + len(cut["valley"])
+    assert n_scores == len(page.mountain) + len(page.valley) + len(page.tab_folds)

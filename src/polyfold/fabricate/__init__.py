@@ -5,7 +5,9 @@
     labels.py     glue labels beside cut edges, piece names and their labels
     fit.py        splitting a net until every piece fits a page (`split_to_fit`, `PieceTooLarge`)
     pack.py       packing pieces onto pages by their real outlines; shelves
-    page.py       the sheet model (`Page`, `TextItem`) the writers of formats/ draw; `place`, `page_of`
+    page.py       the sheet model (`Page`, `TextItem`, `ScaleBar`, `RegistrationMarks`) the writers of
+                  formats/ draw; `place`, `page_of`, `footer`, `registration_marks`
+    paper.py      sizes on paper: gaps, footer, scale bar, registration marks (light)
     check.py      independent shapely checks of finished pages (`check_pages`)
     sheet.py      one sheet for a whole net, as `polyfold unfold --svg/--png` draws it (`net_sheet`)
 """

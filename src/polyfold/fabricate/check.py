@@ -7,18 +7,20 @@ from .pieces import SheetPiece
 from .tabs import OVERLAP_MM2
 
 
-def check_pages(placed: list[SheetPiece], page_index: list[int], n_pages: int, width: float, height: float,
-                margin: float, gap: float) -> dict:
+def check_pages(placed: list[SheetPiece], page_index: list[int], n_pages: int,
+                box: tuple[float, float, float, float], gap: float) -> dict:
     """Independent checks of the final sheets (shapely), on the placed geometry: no two pieces
     (with their tabs) overlap or come closer than `gap`, no two faces of a piece overlap, no tab
-    overlaps a face or another tab, every outline and label lies inside the margins (height is the
-    area available to pieces). Returns counts per kind and the problems as text."""
+    overlaps a face or another tab, every outline and label lies inside `box` (x0, y0, x1, y1) mm,
+    the area available to pieces (inside the margins, above the footer strip, clear of
+    registration marks). Returns counts per kind and the problems as text."""
     import shapely
-    from shapely.geometry import Polygon, box
+    from shapely.geometry import Polygon
 
     counts = {"page_overlaps": 0, "net_overlaps": 0, "tab_overlaps": 0, "outside_margins": 0}
     problems: list[str] = []
-    inner = box(margin, margin, width - margin, height - margin).buffer(1e-6)
+    x0, y0, x1, y1 = box
+    inner = shapely.box(x0, y0, x1, y1).buffer(1e-6)
     for page in range(n_pages):
         on = [p for i, p in enumerate(placed) if page_index[i] == page]
         outlines = [p.outline for p in on]
@@ -49,7 +51,7 @@ def check_pages(placed: list[SheetPiece], page_index: list[int], n_pages: int, w
                         counts["tab_overlaps"] += 1
                         problems.append(f"piece {p.name}: two tabs overlap")
             for t in p.texts:
-                if not (margin <= t.x <= width - margin and margin <= t.y <= height - margin):
+                if not (x0 <= t.x <= x1 and y0 <= t.y <= y1):
                     counts["outside_margins"] += 1
                     problems.append(f"page {page + 1}: a label of piece {p.name} lies outside the margins")
     return {**counts, "problems": problems}

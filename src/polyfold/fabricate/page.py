@@ -5,6 +5,10 @@ pieces on it (`place` a piece where packing put it, `page_of` the placed pieces)
 Text placement: (x, y) is the centre of the text, `size` is the font size (em) in mm, `angle` is
 the reading direction in degrees, counter-clockwise as seen on the page. The writers of
 `formats/` (SVG, PDF, DXF, PNG) draw a Page the same way in every format.
+
+Besides the pieces a page may carry print-only furniture, drawn by the print writers (SVG, PDF,
+PNG) and left out of the cut SVG and the DXF: a `ScaleBar` in the footer strip (`footer`) and
+print-and-cut `RegistrationMarks` (`registration_marks`, sizes in `paper.py`).
 """
 
 from __future__ import annotations
@@ -15,20 +19,21 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .paper import FOOTER_FONT_MM
+from .paper import (FOOTER_FONT_MM, FOOTER_MM, MARK_INSET_MM, MARK_LEG_MM, MARK_LINE_MM, MARK_SQUARE_MM,
+                    SCALE_BAR_MM)
 
 if TYPE_CHECKING:
     from .pack import Placement
     from .pieces import SheetPiece
 
 
-TEXT_KINDS = frozenset({"edge-label", "piece-label", "title"})
+TEXT_KINDS = frozenset({"edge-label", "piece-label", "title", "scale-label"})
 
 
 @dataclass(frozen=True)
 class TextItem:
     """A label: `text` centred at (x, y) mm, `angle` degrees CCW as seen on the page, `size` mm
-    font size, `kind` one of "edge-label", "piece-label", "title"."""
+    font size, `kind` one of "edge-label", "piece-label", "title", "scale-label"."""
 
     text: str
     x: float
@@ -44,6 +49,74 @@ class TextItem:
             raise ValueError(f"TextItem {self.text!r}: position/angle must be finite and size > 0")
 
 
+SCALE_TICK_MM = 2.0  # height of the scale bar's end ticks
+
+
+@dataclass(frozen=True)
+class ScaleBar:
+    """A printed length to check 100 % printing: a bar from (x, y) to (x + length, y) mm with end
+    ticks `tick` mm tall pointing up (y down: towards smaller y), and `label` (e.g. "50 mm")
+    centred above the ticks."""
+
+    x: float
+    y: float
+    length: float
+    tick: float
+    label: TextItem
+
+    def __post_init__(self) -> None:
+        if not all(math.isfinite(v) for v in (self.x, self.y, self.length, self.tick)) or self.length <= 0:
+            raise ValueError(f"scale bar: position must be finite and length > 0, got {self.length}")
+
+    def segments(self) -> np.ndarray:
+        """(3, 2, 2) the bar, the left tick, the right tick (page mm)."""
+        x0, x1, y, top = self.x, self.x + self.length, self.y, self.y - self.tick
+        return np.array([[[x0, y], [x1, y]], [[x0, top], [x0, y]], [[x1, top], [x1, y]]], dtype=np.float64)
+
+
+# eq=False: numpy fields make a generated __eq__/__hash__ meaningless (ambiguous truth values).
+@dataclass(frozen=True, eq=False)
+class RegistrationMarks:
+    """Print-and-cut registration marks (page mm): `square` (4, 2) a filled polygon; `corners`
+    (2, 3, 2) two L-shaped polylines (corner point in the middle) stroked `line` mm wide."""
+
+    square: np.ndarray
+    corners: np.ndarray
+    line: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "square", _finite(self.square, "marks.square", (-1, 2)))
+        object.__setattr__(self, "corners", _finite(self.corners, "marks.corners", (-1, 3, 2)))
+        if not (math.isfinite(self.line) and self.line > 0):
+            raise ValueError(f"marks: line width must be > 0, got {self.line}")
+
+
+def registration_marks(width: float, height: float) -> RegistrationMarks:
+    """Silhouette Studio's "Type 1" marks on a width x height mm page (see `paper.py`): the filled
+    square at the top-left, L-shaped corners at the top-right and bottom-left."""
+    i, s, leg = MARK_INSET_MM, MARK_SQUARE_MM, MARK_LEG_MM
+    square = [[i, i], [i + s, i], [i + s, i + s], [i, i + s]]
+    top_right = [[width - i - leg, i], [width - i, i], [width - i, i + leg]]
+    bottom_left = [[i, height - i - leg], [i, height - i], [i + leg, height - i]]
+    return RegistrationMarks(np.array(square, float), np.array([top_right, bottom_left], float), MARK_LINE_MM)
+
+
+def footer(text: str, x0: float, x1: float, top: float) -> tuple[TextItem, ScaleBar | None]:
+    """The footer strip [x0, x1] x [top, top + FOOTER_MM] mm: a scale bar at its right end
+    (SCALE_BAR_MM, or 20 or 10 mm when the strip is under twice that; none under 20 mm) and
+    `text` centred on the rest of the strip."""
+    gap = 3.0
+    length = next((v for v in (SCALE_BAR_MM, 20.0, 10.0) if 2 * v <= x1 - x0), None)
+    bar = None
+    if length is not None:
+        bx = x1 - length
+        # label glyphs (cap height ~0.72 em) in the strip's top half, ticks and bar below them
+        label = TextItem(f"{length:g} mm", bx + length / 2, top + 1.5, 0.0, FOOTER_FONT_MM, "scale-label")
+        bar = ScaleBar(bx, top + 3.2 + SCALE_TICK_MM, length, SCALE_TICK_MM, label)
+        x1 = bx - gap
+    return TextItem(text, (x0 + x1) / 2, top + FOOTER_MM / 2, 0.0, FOOTER_FONT_MM, "title"), bar
+
+
 # eq=False: numpy fields make a generated __eq__/__hash__ meaningless (ambiguous truth values).
 @dataclass(frozen=True, eq=False)
 class Page:
@@ -55,7 +128,8 @@ class Page:
     side (its seam is convex), False for a valley (concave seam; default: all valleys);
     texts: labels; faces: optional (n, 3, 2) triangles per piece, filled light in previews only;
     slits: (n, 2, 2) cut segments inside an outline (two faces of one piece that touch along a cut
-    edge: the outline alone would not separate them). Arrays are coerced to float64 and validated on construction.
+    edge: the outline alone would not separate them); scale_bar, marks: optional print-only
+    furniture (see the module docstring). Arrays are coerced to float64 and validated on construction.
     """
 
     width: float
@@ -69,6 +143,8 @@ class Page:
     slits: np.ndarray = ()  # type: ignore[assignment]
     tabs: tuple[np.ndarray, ...] = ()  # optional (4, 2) glue-tab polygons, shaded in previews only
     tab_mountain: np.ndarray = ()  # type: ignore[assignment]
+    scale_bar: ScaleBar | None = None
+    marks: RegistrationMarks | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.width) and math.isfinite(self.height) and self.width > 0 and self.height > 0):
@@ -94,6 +170,10 @@ class Page:
         if len(tm) != len(self.tab_folds):
             raise ValueError(f"tab_mountain: expected {len(self.tab_folds)} flags, got {len(tm)}")
         object.__setattr__(self, "tab_mountain", tm)
+        if self.scale_bar is not None and not isinstance(self.scale_bar, ScaleBar):
+            raise ValueError(f"scale_bar must be a ScaleBar, got {type(self.scale_bar).__name__}")
+        if self.marks is not None and not isinstance(self.marks, RegistrationMarks):
+            raise ValueError(f"marks must be RegistrationMarks, got {type(self.marks).__name__}")
 
 
 def _finite(a, name: str, shape: tuple[int, ...]) -> np.ndarray:

@@ -1,4 +1,6 @@
-"""PDF sheets: all pages in one document, each exactly its own size (reportlab)."""
+"""PDF sheets: all pages in one document, each exactly its own size (reportlab): the print file,
+drawn like the print SVG (preview fills, creases, cut lines, labels, the scale bar and, with
+--marks, the registration marks)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..fabricate.page import Page
+from ..fabricate.page import Page, TextItem
 from .files import atomic_write
 from .sheet_style import MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
 
@@ -39,6 +41,47 @@ def _pdf_polygon(c, pts_pt: np.ndarray, stroke: int, fill: int) -> None:
     c.drawPath(p, stroke=stroke, fill=fill)
 
 
+def _pdf_text(c, page: Page, t: TextItem) -> None:
+    """One centred text item (fill colour already set)."""
+    bx, by = text_baseline(t)
+    c.saveState()
+    c.translate(bx * MM_TO_PT, (page.height - by) * MM_TO_PT)
+    c.rotate(t.angle)  # PDF rotation is CCW with y up: the same visual sense as ours
+    c.setFont("Helvetica", t.size * MM_TO_PT)
+    c.drawCentredString(0, 0, t.text)
+    c.restoreState()
+
+
+def _draw_furniture(c, page: Page) -> None:
+    """The scale bar (solid black hairlines and its label) and the registration marks (a filled
+    square, L-shaped corners `marks.line` wide with sharp corners), when the page has them."""
+    black = [v / 255 for v in TEXT_RGB]
+    if page.scale_bar is not None:
+        c.setStrokeColorRGB(*black)
+        c.setLineWidth(STROKE_MM * MM_TO_PT)
+        c.setDash([], 0)
+        c.setLineCap(0)
+        for (x0, y0), (x1, y1) in _pt(page, page.scale_bar.segments()):
+            c.line(x0, y0, x1, y1)
+        c.setFillColorRGB(*black)
+        _pdf_text(c, page, page.scale_bar.label)
+    if page.marks is not None:
+        c.setFillColorRGB(*black)
+        _pdf_polygon(c, _pt(page, page.marks.square), stroke=0, fill=1)
+        c.setStrokeColorRGB(*black)
+        c.setLineWidth(page.marks.line * MM_TO_PT)
+        c.setDash([], 0)
+        c.setLineJoin(0)  # miter: a sharp corner, as the cutter's sensor expects
+        c.setLineCap(0)
+        for corner in page.marks.corners:
+            pts = _pt(page, corner)
+            p = c.beginPath()
+            p.moveTo(*pts[0])
+            for x, y in pts[1:]:
+                p.lineTo(x, y)
+            c.drawPath(p, stroke=1, fill=0)
+
+
 def _draw_pdf_page(c, page: Page) -> None:
     """Draw `page` on the current page of reportlab canvas `c` (page size already set)."""
     c.setFillColorRGB(*(v / 255 for v in TAB_RGB))
@@ -65,13 +108,8 @@ def _draw_pdf_page(c, page: Page) -> None:
 
     c.setFillColorRGB(*(v / 255 for v in TEXT_RGB))
     for t in page.texts:
-        bx, by = text_baseline(t)
-        c.saveState()
-        c.translate(bx * MM_TO_PT, (page.height - by) * MM_TO_PT)
-        c.rotate(t.angle)  # PDF rotation is CCW with y up: the same visual sense as ours
-        c.setFont("Helvetica", t.size * MM_TO_PT)
-        c.drawCentredString(0, 0, t.text)
-        c.restoreState()
+        _pdf_text(c, page, t)
+    _draw_furniture(c, page)
 
 
 def pdf_bytes(pages: Sequence[Page], title: str = "polyfold net") -> bytes:

@@ -2,7 +2,8 @@
 
 The sheet preview is drawn like the other sheet writers draw a Page (same colours as
 `sheet_style`): faces filled one light colour per piece, glue tabs light grey, cut lines black,
-mountains red, valleys and tab folds blue. Labels are not drawn (no font rasteriser here).
+mountains red, valleys and tab folds blue, the scale bar and registration marks black. Labels
+are not drawn (no font rasteriser here).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 from ..fabricate.page import Page
 from .files import atomic_write
 from .raster import draw_segments, fill_triangles, part_colors, render_mesh
-from .sheet_style import STYLES, TAB_RGB, crease_layers
+from .sheet_style import STYLES, TAB_RGB, TEXT_RGB, crease_layers
 
 PIECE_SATURATION = 0.28  # light piece fills (part_colors' hues), so the lines stay readable
 PIECE_VALUE = 0.98
@@ -61,6 +62,13 @@ def page_image(page: Page, width_px: int = 1200) -> np.ndarray:
     rings = [np.stack([r, np.roll(r, -1, axis=0)], axis=1) for r in page.cut]
     cuts = np.concatenate([*rings, page.slits]) if rings else page.slits
     draw_segments(img, cuts * s, STYLES["cut"]["rgb"], thick=2)
+    if page.scale_bar is not None:
+        draw_segments(img, page.scale_bar.segments() * s, TEXT_RGB)
+    if page.marks is not None:
+        sq = page.marks.square * s
+        fill_triangles(img, np.array([sq[[0, 1, 2]], sq[[0, 2, 3]]]), np.array([TEXT_RGB, TEXT_RGB], dtype=np.uint8))
+        legs = np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in page.marks.corners])
+        draw_segments(img, legs * s, TEXT_RGB, thick=2)
     return img
 
 

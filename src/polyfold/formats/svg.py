@@ -1,11 +1,31 @@
-"""SVG sheets: one page per file, mm units, Inkscape layers (cut, mountain, valley, labels, preview)."""
+"""SVG sheets, one page per file, mm units, Inkscape layers: the print file and the cut file.
+
+`svg_page_string` is the print file (sheet-NN.svg): every layer (preview, labels, scale,
+registration, valley, mountain, cut). `cut_svg_string` is the cut file (cut-NN.svg) for cutting
+machines: only the layers valley, mountain and cut, drawn by the same code with the same
+coordinates, as plain strokes: no fills, no text, no hidden or print-only layers, one closed path
+per outline, one open path per slit and per score line.
+
+Score lines in the cut file are solid strokes in their layer's colour (mountain red #ff0000,
+valley and tab folds blue #0000ff, cuts black), not dashed. Silhouette Studio ("cut by line
+colour" in its Send panel) and Cricut Design Space (an operation per layer, e.g. Score or
+Perforate) assign a tool to each colour or layer and run it along the path's geometry: a solid
+line gives one score stroke (scoring tool, low-force blade pass or the machine's perforation
+setting, as the user chooses), whereas a dashed path, once the dashes are turned into geometry
+(stroke to path, DXF/HPGL conversions), becomes dozens of tiny separate cuts that perforate or
+tear the paper. The print file keeps the dashes: on paper they tell mountain from valley.
+Registration marks are not in the cut file: print-and-cut software (Silhouette Studio) draws its
+own at the positions set in its Registration Marks panel; in a cut file they would be cut.
+"""
 
 from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
 
-from ..fabricate.page import Page
+import numpy as np
+
+from ..fabricate.page import Page, TextItem
 from .files import atomic_write
 from .sheet_style import PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
 
@@ -31,12 +51,27 @@ def _layer(parent: ET.Element, name: str, **attrs: str) -> ET.Element:
     return ET.SubElement(parent, "g", {"id": name, "inkscape:groupmode": "layer", "inkscape:label": name, **attrs})
 
 
-def svg_page_string(page: Page) -> str:
-    """The SVG document (str) for one page: layers preview, labels, valley, mountain, cut
-    (bottom to top, so cut lines are drawn over everything)."""
+def _polyline_d(points: np.ndarray, closed: bool) -> str:
+    """Path data of a polyline (page mm), closed with Z when `closed`. Every point has its own
+    command letter (no implicit lineto): the plainest form for cutting software's importers."""
+    d = f"M{_num(points[0, 0])},{_num(points[0, 1])} " + " ".join(f"L{_num(x)},{_num(y)}" for x, y in points[1:])
+    return d + " Z" if closed else d
+
+
+def _text(parent: ET.Element, t: TextItem) -> None:
+    """One centred text element (font attributes come from the parent layer)."""
+    bx, by = text_baseline(t)
+    el = ET.SubElement(parent, "text", {"class": t.kind, "x": _num(bx), "y": _num(by), "font-size": _num(t.size)})
+    if t.angle:
+        # SVG rotate() is clockwise on screen (y down); our angles are counter-clockwise.
+        el.set("transform", f"rotate({_num(-t.angle)} {_num(bx)} {_num(by)})")
+    el.text = t.text
+
+
+def _svg_root(page: Page) -> ET.Element:
     # Namespace declarations are written as plain attributes: ET.register_namespace would change
     # serialisation globally for every other user of ElementTree in the process.
-    root = ET.Element("svg", {
+    return ET.Element("svg", {
         "xmlns": SVG_NS,
         "xmlns:inkscape": INKSCAPE_NS,
         "version": "1.1",
@@ -45,59 +80,96 @@ def svg_page_string(page: Page) -> str:
         "viewBox": f"0 0 {_num(page.width)} {_num(page.height)}",
     })
 
-    if page.faces or page.tabs:
-        g = _layer(root, "preview", **{"class": "no-cut", "fill": _hex(PREVIEW_RGB), "stroke": "none"})
-        ET.SubElement(g, "desc").text = "preview fill: print only, do not cut"
-        for i, tris in enumerate(page.faces):
-            d = " ".join(f"M{_num(a)},{_num(b)} L{_num(c)},{_num(e)} L{_num(f)},{_num(h)} Z"
-                         for (a, b), (c, e), (f, h) in tris)
-            if d:
-                ET.SubElement(g, "path", {"id": f"preview-{i}", "d": d})
-        for i, t in enumerate(page.tabs):
-            d = f"M{_num(t[0, 0])},{_num(t[0, 1])} " + " ".join(f"L{_num(x)},{_num(y)}" for x, y in t[1:]) + " Z"
-            ET.SubElement(g, "path", {"id": f"tab-{i}", "class": "tab", "fill": _hex(TAB_RGB), "d": d})
 
-    g = _layer(root, "labels", **{
-        "class": "no-cut",
-        "fill": _hex(TEXT_RGB),
-        "stroke": "none",
-        "font-family": "Helvetica, Arial, sans-serif",
-        "text-anchor": "middle",
-    })
-    ET.SubElement(g, "desc").text = "labels: print or draw only, do not cut"
-    for t in page.texts:
-        bx, by = text_baseline(t)
-        el = ET.SubElement(g, "text", {"class": t.kind, "x": _num(bx), "y": _num(by), "font-size": _num(t.size)})
-        if t.angle:
-            # SVG rotate() is clockwise on screen (y down); our angles are counter-clockwise.
-            el.set("transform", f"rotate({_num(-t.angle)} {_num(bx)} {_num(by)})")
-        el.text = t.text
-
+def _line_layers(root: ET.Element, page: Page, dashed: bool) -> None:
+    """The layers valley, mountain (one path per score line) and cut (one closed path per
+    outline, one path per slit), on top of what `root` holds; dashed creases or solid ones."""
     width = _num(STROKE_MM)
     groups: dict[str, ET.Element] = {}
     for style in ("valley", "mountain"):
         st = STYLES[style]
-        groups[style] = _layer(root, style, **{
-            "fill": "none", "stroke": _hex(st["rgb"]), "stroke-width": width,
-            "stroke-dasharray": ",".join(_num(v) for v in st["dash"]), "stroke-linecap": "butt",
-        })
+        attrs = {"fill": "none", "stroke": _hex(st["rgb"]), "stroke-width": width, "stroke-linecap": "butt"}
+        if dashed:
+            attrs["stroke-dasharray"] = ",".join(_num(v) for v in st["dash"])
+        groups[style] = _layer(root, style, **attrs)
     for style, cls, segs in crease_layers(page):
-        for (x0, y0), (x1, y1) in segs:
-            ET.SubElement(groups[style], "path", {"class": cls, "d": f"M{_num(x0)},{_num(y0)} L{_num(x1)},{_num(y1)}"})
+        for seg in segs:
+            ET.SubElement(groups[style], "path", {"class": cls, "d": _polyline_d(seg, closed=False)})
 
     g = _layer(root, "cut", **{"fill": "none", "stroke": _hex(STYLES["cut"]["rgb"]), "stroke-width": width,
                                 "stroke-linejoin": "round"})
     for i, poly in enumerate(page.cut):
-        d = f"M{_num(poly[0, 0])},{_num(poly[0, 1])} L" + " ".join(f"{_num(x)},{_num(y)}" for x, y in poly[1:]) + " Z"
-        ET.SubElement(g, "path", {"id": f"cut-{i}", "class": "cut", "d": d})
-    for i, ((x0, y0), (x1, y1)) in enumerate(page.slits):
-        ET.SubElement(g, "path", {"id": f"slit-{i}", "class": "cut slit", "d": f"M{_num(x0)},{_num(y0)} L{_num(x1)},{_num(y1)}"})
+        ET.SubElement(g, "path", {"id": f"cut-{i}", "class": "cut", "d": _polyline_d(poly, closed=True)})
+    for i, seg in enumerate(page.slits):
+        ET.SubElement(g, "path", {"id": f"slit-{i}", "class": "cut slit", "d": _polyline_d(seg, closed=False)})
 
+
+def _document(root: ET.Element) -> str:
     ET.indent(root, space=" ")
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
 
 
+def svg_page_string(page: Page) -> str:
+    """The print SVG (str) of one page: layers preview, labels, scale, registration (with marks),
+    valley, mountain, cut (bottom to top, so cut lines are drawn over everything)."""
+    root = _svg_root(page)
+    if page.faces or page.tabs:
+        g = _layer(root, "preview", **{"class": "no-cut", "fill": _hex(PREVIEW_RGB), "stroke": "none"})
+        ET.SubElement(g, "desc").text = "preview fill: print only, do not cut"
+        for i, tris in enumerate(page.faces):
+            d = " ".join(_polyline_d(tri, closed=True) for tri in tris)
+            if d:
+                ET.SubElement(g, "path", {"id": f"preview-{i}", "d": d})
+        for i, t in enumerate(page.tabs):
+            ET.SubElement(g, "path", {"id": f"tab-{i}", "class": "tab", "fill": _hex(TAB_RGB),
+                                      "d": _polyline_d(t, closed=True)})
+
+    text_font = {"font-family": "Helvetica, Arial, sans-serif", "text-anchor": "middle"}
+    g = _layer(root, "labels", **{"class": "no-cut", "fill": _hex(TEXT_RGB), "stroke": "none", **text_font})
+    ET.SubElement(g, "desc").text = "labels: print or draw only, do not cut"
+    for t in page.texts:
+        _text(g, t)
+
+    if page.scale_bar is not None:
+        bar = page.scale_bar
+        g = _layer(root, "scale", **{"class": "no-cut", "fill": "none", "stroke": _hex(TEXT_RGB),
+                                     "stroke-width": _num(STROKE_MM), "stroke-linecap": "butt"})
+        ET.SubElement(g, "desc").text = f"scale bar: {bar.length:g} mm when printed at 100 %; print only, do not cut"
+        for seg in bar.segments():
+            ET.SubElement(g, "path", {"class": "scale-bar", "d": _polyline_d(seg, closed=False)})
+        label = ET.SubElement(g, "g", {"fill": _hex(TEXT_RGB), "stroke": "none", **text_font})
+        _text(label, bar.label)
+
+    if page.marks is not None:
+        m = page.marks
+        g = _layer(root, "registration", **{"class": "no-cut", "fill": "none", "stroke": "none"})
+        ET.SubElement(g, "desc").text = "print-and-cut registration marks (Silhouette Type 1): print only, do not cut"
+        ET.SubElement(g, "path", {"class": "mark-square", "fill": _hex(TEXT_RGB),
+                                  "d": _polyline_d(m.square, closed=True)})
+        for corner in m.corners:
+            ET.SubElement(g, "path", {"class": "mark-corner", "stroke": _hex(TEXT_RGB), "stroke-width": _num(m.line),
+                                      "stroke-linejoin": "miter", "stroke-linecap": "butt",
+                                      "d": _polyline_d(corner, closed=False)})
+
+    _line_layers(root, page, dashed=True)
+    return _document(root)
+
+
+def cut_svg_string(page: Page) -> str:
+    """The cut SVG (str) of one page: layers valley, mountain, cut as plain solid strokes, the
+    same coordinates as `svg_page_string` (see the module docstring)."""
+    root = _svg_root(page)
+    _line_layers(root, page, dashed=False)
+    return _document(root)
+
+
 def write_svg_page(page: Page, path: str | os.PathLike) -> None:
-    """Write one page as an SVG file (mm units, layers "cut", "mountain", "valley", "labels",
-    optional "preview") to `path`, atomically."""
+    """Write one page as a print SVG file (mm units, layers "cut", "mountain", "valley",
+    "labels", optional "preview", "scale", "registration") to `path`, atomically."""
     atomic_write(path, svg_page_string(page))
+
+
+def write_cut_svg(page: Page, path: str | os.PathLike) -> None:
+    """Write one page as a cut SVG file (layers "cut", "mountain", "valley"; see the module
+    docstring) to `path`, atomically."""
+    atomic_write(path, cut_svg_string(page))

@@ -1,44 +1,50 @@
 """make's export stage: the make folder, written through formats/ into a staged folder and moved
 in at the end (report.json last, so it marks a finished run).
 
-The folder: sheets.pdf (all pages), sheet-NN.svg and sheet-NN.dxf per page, part-K.obj per part,
-piece-X.fold per piece (net, folding path, source faces), assembly.json, instructions.html and
-report.json. Files of an earlier run that this run does not produce are removed (they would be
-mistaken for this run's).
+The folder: sheets.pdf (all pages), sheet-NN.svg (print), cut-NN.svg (cutting machines: cut and
+score lines only) and sheet-NN.dxf per page, part-K.obj per part, piece-X.fold per piece (net,
+folding path, source faces), assembly.json, instructions.html and report.json. Every printed page
+has a scale bar in its footer; with --marks, registration marks. Files of an earlier run that
+this run does not produce are removed (they would be mistaken for this run's).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
-from ..fabricate.page import Page, page_of
-from ..fabricate.paper import FOOTER_MM
+from ..fabricate.page import Page, footer, page_of, registration_marks
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
 from ..formats.fold import dumps, piece_fold
 from ..formats.meshes import obj_text
 from ..formats.pdf import pdf_bytes
-from ..formats.svg import svg_page_string
+from ..formats.svg import cut_svg_string, svg_page_string
 from ..mesh.mesh import Mesh
 from .folding import FoldedPiece
 from .instructions import instructions_html
 from .options import MakeOptions
 from .parts import Part
 from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, PieceReport
-from .sheets import Sheets
+from .sheets import Sheets, pack_box
 
-STALE = ("sheet-*.svg", "sheet-*.dxf", "piece-*.fold", "part-*.obj")
+STALE = ("sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "piece-*.fold", "part-*.obj")
 
 
 def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
-    """One `Page` per sheet, with its footer line."""
+    """One `Page` per sheet: its pieces, the footer line and scale bar in the footer strip (below
+    the packed area, beside the marks' corner with --marks), the registration marks with --marks."""
     n_pages = sheets.packing.n_pages
     on_page = sheets.page_of_piece()
-    footer_y = sheets.height - opts.margin - FOOTER_MM / 2
-    return [page_of([p for i, p in enumerate(sheets.pieces) if on_page[i] == k], sheets.width, sheets.height,
-                    f"{name} - sheet {k + 1}/{n_pages} - {opts.size:g} mm - polyfold", footer_y)
-            for k in range(n_pages)]
+    x0, _, x1, strip_top = pack_box(sheets.width, sheets.height, opts)
+    marks = registration_marks(sheets.width, sheets.height) if opts.marks else None
+    pages = []
+    for k in range(n_pages):
+        page = page_of([p for i, p in enumerate(sheets.pieces) if on_page[i] == k], sheets.width, sheets.height)
+        text, bar = footer(f"{name} - sheet {k + 1}/{n_pages} - {opts.size:g} mm - polyfold", x0, x1, strip_top)
+        pages.append(replace(page, texts=(*page.texts, text), scale_bar=bar, marks=marks))
+    return pages
 
 
 
@@ -81,6 +87,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         for k, page in enumerate(pages):
             svgs.append(f"sheet-{k + 1:02d}.svg")
             stage.write(svgs[-1], svg_page_string(page))
+            stage.write(f"cut-{k + 1:02d}.svg", cut_svg_string(page))
             dxf_document(page).saveas(stage.path(f"sheet-{k + 1:02d}.dxf"))
         for k, part in enumerate(parts):
             sub = mesh.submesh(part.faces)

@@ -7,6 +7,7 @@ from html import escape
 
 import numpy as np
 
+from ..fabricate.paper import MARK_INSET_MM, MARK_LEG_MM, MARK_LINE_MM
 from ..formats.png import png_bytes
 from ..formats.raster import part_colors, render_mesh
 from ..mesh.mesh import Mesh
@@ -41,9 +42,14 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
          f"<h1>Building {escape(name)}</h1>",
          f"<p><img src='data:image/png;base64,{_png_b64(mesh, part_faces, None)}' alt='the model, parts in colour'></p>",
          f"<p>{len(part_faces)} part(s), {len(pieces)} piece(s) on {n_pages} {escape(opts.paper)} page(s); "
-         f"model {opts.size:g} mm long. Print <code>sheets.pdf</code> at 100 % (no scaling), or send the SVG/DXF "
-         "sheets to a cutting machine: layer <b>cut</b> is cut, <b>mountain</b> (red, dash-dot) and "
-         "<b>valley</b> (blue, dashed) are scored. Fold mountains away from you and valleys towards you, "
+         f"model {opts.size:g} mm long. Print <code>sheets.pdf</code> (or <code>sheet-NN.svg</code>) at 100 % "
+         "(no scaling: measure the scale bar in the footer) and cut with <code>cut-NN.svg</code> on a cutting "
+         "machine (black is cut; red mountain and blue valley lines are scored), or by hand along the black lines; "
+         "on paper mountains are red dash-dot and valleys blue dashed. "
+         + ("The pages carry print-and-cut registration marks in Silhouette Studio's Type 1 layout "
+            f"({MARK_INSET_MM:g} mm inset, {MARK_LEG_MM:g} mm legs, {MARK_LINE_MM:g} mm thick): set the same in its "
+            "Registration Marks panel. " if opts.marks else "")
+         + "Fold mountains away from you and valleys towards you, "
          "with the printed side outside. Every edge label appears twice: glue the tab of one copy under the "
          "other copy.</p>",
          "<h2>Sheets</h2>"]

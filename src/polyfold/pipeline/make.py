@@ -28,7 +28,7 @@ from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
                      PieceReport, StageReports)
-from .sheets import Sheets, fit_parts, lay_out, printable
+from .sheets import Sheets, fit_parts, lay_out, pack_box
 
 Progress = Callable[[str, str], None]  # (stage, message)
 
@@ -83,9 +83,8 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     """The independent page checks; PolyfoldError (nothing written) when one fails."""
     say("check", "checking every page")
     tc = time.perf_counter()
-    _, pack_height = printable(sheets.width, sheets.height)
-    checks = check_pages(list(sheets.pieces), sheets.page_of_piece(), sheets.packing.n_pages, sheets.width,
-                         pack_height, opts.margin, GAP_MM)
+    checks = check_pages(list(sheets.pieces), sheets.page_of_piece(), sheets.packing.n_pages,
+                         pack_box(sheets.width, sheets.height, opts), GAP_MM)
     problems = checks.pop("problems")
     report = ChecksReport(seconds=time.perf_counter() - tc, **checks, problems=tuple(problems), paths_verified=verified,
                           pieces=len(sheets.pieces), untabbed_edges=tuple(sheets.stats.untabbed))
@@ -124,7 +123,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
         raise PolyfoldError(f"{name}: {exc}") from None
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
-    fitted, page_splits = fit_parts(parts, scale, opts, printable(width, height), name)
+    fitted, page_splits = fit_parts(parts, scale, opts, pack_box(width, height, opts), name)
     fit_seconds = time.perf_counter() - ts
     folded, fold_report = fold_pieces(fitted, opts, deadline, say)
     sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say)

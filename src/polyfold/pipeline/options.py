@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
-from ..fabricate.paper import FOOTER_MM
+from ..fabricate.paper import FOOTER_MM, MARK_CLEAR_MM
 
 PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
 INFLATE_MODES = ("none", "constrained", "uniform")
@@ -34,6 +34,7 @@ class MakeOptions:
     fold: bool = True  # plan and verify a folding path per piece
     contact_tol: float = CONTACT_TOL
     resolution_deg: float = 1.0
+    marks: bool = False  # print-and-cut registration marks (Silhouette "Type 1") on the printed pages
 
 
 def paper_size(spec: str) -> tuple[float, float]:
@@ -63,4 +64,8 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
     width, height = paper_size(opts.paper)
     if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
         raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")
+    if opts.marks and not (max(opts.margin, MARK_CLEAR_MM) + opts.margin + FOOTER_MM < min(width, height)
+                           and 2 * MARK_CLEAR_MM <= min(width, height)):
+        raise PolyfoldError(f"--marks: the registration marks leave no room on a {width:g} x {height:g} mm page "
+                            f"with {opts.margin:g} mm margins")
     return width, height

@@ -3,6 +3,12 @@ anything is written.
 
 Scale: the model's longest bounding-box side becomes `--size` mm. Parts whose pieces (with room
 for their tabs) do not fit a page are split along creases first (`fit_parts`), before folding.
+
+Where pieces go on a page (`pack_box`): inside the margins and above the footer strip; with
+`--marks` the top and left margins grow to `paper.MARK_CLEAR_MM` so the registration marks'
+corners (top-left, top-right, bottom-left) stay free. That gives up a strip along two sides
+rather than only the three corner squares, but keeps the packing a rectangle, so fitting,
+packing and the check all reason about one box.
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ from ..errors import PolyfoldError
 from ..fabricate.fit import PieceTooLarge, split_to_fit
 from ..fabricate.pack import Packing, pack_outlines
 from ..fabricate.page import place
-from ..fabricate.paper import FOOTER_MM, GAP_MM
+from ..fabricate.paper import FOOTER_MM, GAP_MM, MARK_CLEAR_MM
 from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
 from ..mesh.mesh import Mesh
 from .folding import FoldedPiece
@@ -25,24 +31,35 @@ from .options import MakeOptions
 from .parts import Part
 
 
-def printable(width: float, height: float) -> tuple[float, float]:
-    """The page area pieces are packed into (the footer strip excluded), mm."""
-    return width, height - FOOTER_MM
+def pack_box(width: float, height: float, opts: MakeOptions) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) mm: the part of a width x height page that pieces are packed into (see
+    the module docstring); the footer strip is the FOOTER_MM below y1."""
+    near = max(opts.margin, MARK_CLEAR_MM) if opts.marks else opts.margin
+    return near, near, width - opts.margin, height - opts.margin - FOOTER_MM
 
 
-def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, page: tuple[float, float],
+def _packer_page(box: tuple[float, float, float, float]) -> tuple[tuple[float, float], float]:
+    """The (page size, margin) that the packer and `split_to_fit`, which know one margin all
+    round, are given for `box`: x0 == y0, so a (x1 + x0) x (y1 + y0) mm page with margin x0 has
+    exactly `box` inside its margins."""
+    x0, y0, x1, y1 = box
+    return (x1 + x0, y1 + y0), x0
+
+
+def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[float, float, float, float],
               name: str) -> tuple[list[Part], int]:
     """The parts with their nets split along creases until every piece (with room for its tabs)
-    fits the page; the number of creases cut. PolyfoldError naming the largest size that fits when
-    a single face does not."""
+    fits `box` (`pack_box`); the number of creases cut. PolyfoldError naming the largest size that
+    fits when a single face does not."""
     fitted, splits = [], 0
     for part in parts:
         try:
-            net, cuts = split_to_fit(part.net, scale, page, opts.margin)
+            net, cuts = split_to_fit(part.net, scale, *_packer_page(box))
         except PieceTooLarge as exc:
             largest = math.floor(opts.size * exc.factor * 10) / 10
             raise PolyfoldError(f"{name}: at --size {opts.size:g} mm face {exc.face} alone (with its tabs) does not "
-                                f"fit on {opts.paper} paper with {opts.margin:g} mm margins; the largest size that "
+                                f"fit on {opts.paper} paper with {opts.margin:g} mm margins"
+                                f"{' and registration marks' if opts.marks else ''}; the largest size that "
                                 f"fits is {largest:g} mm (or use larger --paper)") from None
         splits += cuts
         fitted.append(Part(part.faces, net))
@@ -79,7 +96,8 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     say("layout", f"tabs and labels for {len(folded)} pieces")
     pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
-    packing = pack_outlines([p.outline for p in pieces], printable(width, height), margin=opts.margin,
-                            gap=GAP_MM, seed=opts.seed, time_limit=max(2.0, min(10.0, deadline.left())))
+    page, margin = _packer_page(pack_box(width, height, opts))
+    packing = pack_outlines([p.outline for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
+                            time_limit=max(2.0, min(10.0, deadline.left())))
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
     return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl)

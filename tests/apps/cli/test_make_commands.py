@@ -42,6 +42,7 @@ def test_make_bunny_default_cli(models_dir, tmp_path):
     out = tmp_path / "bunny"
     (out).mkdir()
     (out / "sheet-09.svg").write_text("stale")
+    (out / "cut-09.svg").write_text("stale")
     proc = run_cli("make", src, "-o", out)
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
@@ -50,11 +51,11 @@ def test_make_bunny_default_cli(models_dir, tmp_path):
     n_pages = report["stages"]["layout"]["pages"]
     pieces = report["pieces"]
     assert set(report["outputs"]) == {p.name for p in out.iterdir()}
-    assert not (out / "sheet-09.svg").exists()
+    assert not (out / "sheet-09.svg").exists() and not (out / "cut-09.svg").exists()
     assert not list(out.glob(".polyfold-*"))
     # sheets in every format, one per page
     svgs = sorted(out.glob("sheet-*.svg"))
-    assert len(svgs) == n_pages == len(list(out.glob("sheet-*.dxf")))
+    assert len(svgs) == n_pages == len(list(out.glob("sheet-*.dxf"))) == len(list(out.glob("cut-*.svg")))
     pdf = (out / "sheets.pdf").read_bytes()
     assert pdf.startswith(b"%PDF") and len(re.findall(rb"/Type /Page\b", pdf)) == n_pages
     labels = Counter()
@@ -81,6 +82,7 @@ def test_make_bunny_default_cli(models_dir, tmp_path):
     html = (out / "instructions.html").read_text()
     assert all(f"<b>{r['piece']}</b>" in html for r in pieces) and "data:image/png;base64," in html
     assert all(f"src='{s.name}'" in html for s in svgs)
+    assert "cut-NN.svg" in html and "sheet-NN.svg" in html
 
 
 def test_too_large_and_bad_options(models_dir, tmp_path):
@@ -94,3 +96,5 @@ def test_too_large_and_bad_options(models_dir, tmp_path):
     assert proc.returncode == 2 and "unknown paper" in one_line(proc.stderr)
     proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--tau", 0.1, "--parts", 2, "-q")
     assert proc.returncode == 2 and "--tau or --parts" in one_line(proc.stderr)
+    proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--paper", "50x80mm", "--marks", "-q")
+    assert proc.returncode == 2 and "--marks" in one_line(proc.stderr)

@@ -29,13 +29,15 @@ def make(
     seed: int = typer.Option(1, "--seed", help="Random seed (same seed, same sheets)."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the searches (unfold, fold)."),
     fold: bool = options.FOLD,
+    marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
     """Mesh in, printable sheets out: inflate, segment, unfold, fold, lay out with tabs and labels, export."""
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
-                                    time_limit=time_limit, fold=fold, contact_tol=contact_tol)
+                                    time_limit=time_limit, fold=fold, contact_tol=contact_tol,
+                                    marks=marks)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -144,6 +146,7 @@ def batch(
     tabs: str = options.TABS,
     seed: int = typer.Option(1, "--seed", help="Random seed (same seed, same sheets; --study cspace: the net and samples)."),
     fold: bool = options.FOLD,
+    marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress and no table: only the summary line and errors."),
 ) -> None:
@@ -155,7 +158,8 @@ def batch(
 
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
-                                    time_limit=time_limit, fold=fold, contact_tol=contact_tol)
+                                    time_limit=time_limit, fold=fold, contact_tol=contact_tol,
+                                    marks=marks)
     if study is not None and study not in ("cspace", "unfold"):
         fail(f"--study must be 'cspace' or 'unfold', not {study!r}", 2)
     from ..batch import run_batch

@@ -37,12 +37,15 @@ SIZE = typer.Option(_D.size, "--size", min=1e-6, help="Longest dimension of the 
 MARGIN = typer.Option(_D.margin, "--margin", min=0.0, help="Page margin, mm.")
 TABS = typer.Option("auto", "--tabs", help="auto (glue tabs where they fit) | none.")
 FOLD = typer.Option(_D.fold, "--fold/--no-fold", help="Plan and verify a folding path for every piece.")
+MARKS = typer.Option(_D.marks, "--marks/--no-marks",
+                     help="Print-and-cut registration marks (Silhouette Studio 'Type 1', 10 mm inset) on the printed "
+                          "pages; pieces keep out of the marked corners.")
 CONTACT_TOL_OPTION = contact_tol_option()
 
 
 def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str, tau: Optional[float],
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
-                 time_limit: float, fold: bool, contact_tol: float) -> MakeOptions:
+                 time_limit: float, fold: bool, contact_tol: float, marks: bool) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -50,7 +53,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
         fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
-                       contact_tol=contact_tol)
+                       contact_tol=contact_tol, marks=marks)
 
 
 @contextlib.contextmanager
