@@ -190,14 +190,20 @@ def fan_net(wedge_deg: float) -> Net:
     return make_net(xy, faces, mesh_vertex, v3, [-1] + list(range(n - 1)))
 
 
-def test_no_tab_when_both_sides_are_blocked():
-    # a 3-degree gap: every tab variant (sides at 10 degrees or steeper) runs into the other side
+def test_a_glue_strip_when_both_sides_are_blocked():
+    # a 3-degree gap: no tab, not even a clipped one, fits between the two sides: the seam gets a
+    # glue strip, a separate piece labelled like a tab on both halves, folding against its seam
     sheet = net_sheet([fan_net(3.0)], 100.0)
     assert_sheet_ok(sheet)
     (glue,) = sheet.glue
-    assert glue.tab_piece is None and sheet.stats.untabbed == (glue.label,)
-    assert sheet.pieces[0].tabs == () and sheet.page.tabs == ()
-    assert labels_of(sheet) == {glue.label: 2}  # the labels still say what to glue
+    fan, strip = sheet.pieces
+    assert glue.tab_piece == 1 and strip.name == "S" + glue.label and sheet.stats.untabbed == ()
+    assert sheet.stats.reduced_tabs == ((glue.label, "glue strip"),)
+    assert fan.tabs == () and sheet.page.tabs == ()
+    assert labels_of(sheet) == {glue.label: 4}  # both sides and both halves of the strip
+    side = np.linalg.norm(np.diff(strip.valley[0], axis=0))  # a convex seam: the strip folds as a valley
+    seam = np.linalg.norm(fan.faces_xy[0, 1] - fan.faces_xy[0, 0])  # P-Q0 on the first face
+    assert len(strip.mountain) == 0 and math.isclose(side, seam, rel_tol=1e-6)
     # a wide gap: the tab fits on the first side
     wide = net_sheet([fan_net(90.0)], 100.0)
     assert wide.glue[0].tab_piece == 0 and wide.stats.tabs == 1 and wide.stats.tabs_moved == 0

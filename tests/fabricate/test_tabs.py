@@ -1,5 +1,6 @@
 """fabricate/tabs.py: a glue tab goes on the other side of the edge when the first is blocked (by
-a face or a tab already placed), and on neither when both are."""
+a face or a tab already placed), is clipped around what is in the way when neither side has room
+for a whole one, and is None only when not even the minimum glue area fits."""
 
 from __future__ import annotations
 
@@ -7,30 +8,53 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from polyfold.fabricate.tabs import TAB_VARIANTS, CutSide, choose_tab
+from polyfold.fabricate.tabs import MIN_GLUE_FRAC, TAB_CLEAR_MM, TAB_VARIANTS, CutSide, Room, choose_tab, full_depth
+
+
+def _rooms(*faces_per_piece):
+    return [Room(np.array([Polygon(f) for f in faces], dtype=object)) for faces in faces_per_piece]
+
+
+TRI0 = np.array([[0.0, 0.0], [20.0, 0.0], [10.0, 15.0]])
+TRI1 = TRI0 + [40.0, 0.0]
+SIDE0 = CutSide(0, 0, 0, TRI0[0], TRI0[1], TRI0)
+SIDE1 = CutSide(1, 0, 0, TRI1[0], TRI1[1], TRI1)
 
 
 def test_tab_moves_to_the_other_side_when_the_first_is_blocked():
-    # two unit-ish triangles 20 mm apart; in front of side 0's edge (y = 0, tab downwards) lies
-    # another face of its piece, 0.5 mm away: too close for any tab variant
-    tri0 = np.array([[0.0, 0.0], [20.0, 0.0], [10.0, 15.0]])
-    tri1 = tri0 + [40.0, 0.0]
-    blocker = Polygon([(-5, -0.5), (25, -0.5), (10, -20)])
-    bodies = [shapely.union_all([Polygon(tri0), blocker]), Polygon(tri1)]
-    side0 = CutSide(0, 0, 0, tri0[0], tri0[1], tri0)
-    side1 = CutSide(1, 0, 0, tri1[0], tri1[1], tri1)
-    tab = choose_tab((side0, side1), bodies, bodies, [[], []])
-    assert tab is not None and tab.side == 1 and tab.variant == 0
-    assert tab.polygon[:, 1].max() <= 1e-9  # below the edge, away from its face
-    assert np.allclose(tab.polygon[[0, 3]], tri1[:2])
+    # in front of side 0's edge (y = 0, tab downwards) lies another face of its piece, 0.5 mm away
+    blocker = np.array([(-5, -0.5), (25, -0.5), (10, -20)])
+    tab = choose_tab((SIDE0, SIDE1), _rooms([TRI0, blocker], [TRI1]))
+    assert tab is not None and tab.side == 1 and tab.reason == "full"
+    (poly,) = tab.polygons
+    assert poly[:, 1].max() <= 1e-9  # below the edge, away from its face
+    assert np.allclose(poly[[0, 3]], TRI1[:2]) and np.allclose(tab.folds[0], TRI1[:2])
+    assert np.isclose(tab.depth, full_depth(20.0))
     # nothing in the way: the first side
-    free = choose_tab((side0, side1), [Polygon(tri0), Polygon(tri1)], [Polygon(tri0), Polygon(tri1)], [[], []])
-    assert free.side == 0
+    assert choose_tab((SIDE0, SIDE1), _rooms([TRI0], [TRI1])).side == 0
     # a tab already there blocks as a face does
-    placed = [[Polygon([(0, 0), (20, 0), (20, -3), (0, -3)])], []]
-    assert choose_tab((side0, side1), [Polygon(tri0), Polygon(tri1)], [Polygon(tri0), Polygon(tri1)], placed).side == 1
-    # both sides blocked: no tab
-    blocker1 = Polygon([(35, -0.5), (65, -0.5), (50, -20)])
-    both = [bodies[0], shapely.union_all([Polygon(tri1), blocker1])]
-    assert choose_tab((side0, side1), both, both, [[], []]) is None
-    assert TAB_VARIANTS[0] == (1.0, 45.0)
+    rooms = _rooms([TRI0], [TRI1])
+    rooms[0].extra.append(Polygon([(0, 0), (20, 0), (20, -3), (0, -3)]))
+    assert choose_tab((SIDE0, SIDE1), rooms).side == 1
+    # both sides blocked right at the edge: no tab
+    blocker1 = blocker + [40.0, 0.0]
+    assert choose_tab((SIDE0, SIDE1), _rooms([TRI0, blocker], [TRI1, blocker1])) is None
+    assert TAB_VARIANTS[0] == ("full", 45.0, "full")
+
+
+def test_a_tab_is_clipped_around_a_face_in_its_way_and_keeps_its_distance():
+    # a narrow face reaching down to 1 mm below the middle of both edges: no whole tab fits, a
+    # tab split in two around it does
+    spike = np.array([(9.0, -1.0), (11.0, -1.0), (10.0, -30.0)])
+    rooms = _rooms([TRI0, spike], [TRI1, spike + [40.0, 0.0]])
+    tab = choose_tab((SIDE0, SIDE1), rooms)
+    assert tab is not None and tab.reason == "split" and len(tab.polygons) == 2
+    whole = Polygon([(0, 0), (20, 0), (20 - full_depth(20), -full_depth(20)), (full_depth(20), -full_depth(20))])
+    parts = [Polygon(p) for p in tab.polygons]
+    assert sum(p.area for p in parts) >= MIN_GLUE_FRAC * whole.area
+    for p in parts:
+        assert p.distance(Polygon(spike)) >= TAB_CLEAR_MM - 1e-6
+        assert shapely.area(shapely.intersection(p, Polygon(TRI0))) < 1e-6
+    # every part sits on the edge: its fold is a stretch of the edge
+    for fold in tab.folds:
+        assert np.allclose(fold[:, 1], 0.0) and fold[:, 0].min() >= -1e-9 and fold[:, 0].max() <= 20 + 1e-9

@@ -39,7 +39,9 @@ def test_every_closed_mesh_makes_clean_sheets(path, tmp_path):
         sheet = read_sheet(svg)
         assert check_sheet(sheet, 10.0) == [], svg.name
         glue.update(text for kind, text in sheet["labels"] if kind == "edge-label")
-    assert set(glue.values()) <= {2}
+    strips = {label for label, why in report["stages"]["layout"]["reduced_tabs"] if why == "glue strip"}
+    assert report["stages"]["layout"]["untabbed_edges"] == []
+    assert {label: n for label, n in glue.items() if n != 2} == {label: 4 for label in strips}  # both sides (+ a strip)
     assert sum(r["faces"] for r in report["pieces"]) == report["input"]["faces"]
 
 

@@ -23,14 +23,14 @@ def check_pages(placed: list[SheetPiece], page_index: list[int], n_pages: int,
     inner = shapely.box(x0, y0, x1, y1).buffer(1e-6)
     for page in range(n_pages):
         on = [p for i, p in enumerate(placed) if page_index[i] == page]
-        outlines = [p.outline for p in on]
+        outlines = [p.footprint for p in on]  # outlines and off-face labels
         for a in range(len(on)):
             for b in range(a + 1, len(on)):
                 if outlines[a].distance(outlines[b]) < gap - 1e-6:
                     counts["page_overlaps"] += 1
                     problems.append(f"page {page + 1}: pieces {on[a].name} and {on[b].name} overlap or touch")
         for p in on:
-            if not inner.contains(p.outline):
+            if not inner.contains(p.footprint):
                 counts["outside_margins"] += 1
                 problems.append(f"page {page + 1}: piece {p.name} crosses the margin")
             tris = shapely.polygons(p.faces_xy)

@@ -145,6 +145,7 @@ class Page:
     tab_mountain: np.ndarray = ()  # type: ignore[assignment]
     scale_bar: ScaleBar | None = None
     marks: RegistrationMarks | None = None
+    leaders: np.ndarray = ()  # type: ignore[assignment]  # (n, 2, 2) thin printed lines to off-face labels
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.width) and math.isfinite(self.height) and self.width > 0 and self.height > 0):
@@ -158,7 +159,7 @@ class Page:
                 raise ValueError(f"cut[{i}] needs at least 3 distinct points, got {len(p)}")
             cut.append(p)
         object.__setattr__(self, "cut", tuple(cut))
-        for name in ("mountain", "valley", "tab_folds", "slits"):
+        for name in ("mountain", "valley", "tab_folds", "slits", "leaders"):
             object.__setattr__(self, name, _finite(getattr(self, name), name, (-1, 2, 2)))
         faces = tuple(_finite(f, f"faces[{i}]", (-1, 3, 2)) for i, f in enumerate(self.faces))
         object.__setattr__(self, "faces", faces)
@@ -217,6 +218,7 @@ def place(piece: SheetPiece, placement: Placement) -> SheetPiece:
         x, y = placement.apply(np.array([[t.x, t.y]]))[0]
         texts.append(replace(t, x=float(x), y=float(y), angle=upright(t.angle - placement.angle)))
     return replace(piece, faces_xy=tf(piece.faces_xy), body=tg(piece.body), outline=tg(piece.outline),
+                   footprint=tg(piece.footprint), leaders=tf(piece.leaders),
                    mountain=tf(piece.mountain), valley=tf(piece.valley), slits=tf(piece.slits),
                    tabs=tuple(tf(t) for t in piece.tabs), tab_folds=tf(piece.tab_folds), texts=tuple(texts))
 
@@ -230,6 +232,6 @@ def page_of(pieces: list[SheetPiece], width: float, height: float, footer: str |
     cat = lambda name: np.concatenate([getattr(p, name).reshape(-1, 2, 2) for p in pieces]) if pieces else np.zeros((0, 2, 2))
     return Page(width=width, height=height, cut=tuple(r for p in pieces for r in p.cut_rings()),
                 mountain=cat("mountain"), valley=cat("valley"), tab_folds=cat("tab_folds"), texts=tuple(texts),
-                faces=tuple(p.faces_xy for p in pieces), slits=cat("slits"),
+                faces=tuple(p.faces_xy for p in pieces), slits=cat("slits"), leaders=cat("leaders"),
                 tabs=tuple(t for p in pieces for t in p.tabs),
                 tab_mountain=np.concatenate([p.tab_mountain for p in pieces]) if pieces else np.zeros(0, bool))

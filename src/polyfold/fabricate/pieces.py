@@ -9,16 +9,17 @@ side carries the glue tab (`tabs.choose_tab`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..mesh.geometry import FLAT_EPS  # flat creases are not scored, as in the FOLD files
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
-from .labels import edge_label, piece_label, piece_name
+from .labels import LabelStats, PieceLabels, label_font, piece_name, text_width
 from .page import TextItem
-from .tabs import CutSide, choose_tab
+from .paper import MIN_LABEL_MM
+from .tabs import CutSide, Room, Tab, choose_tab, full_depth
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,10 +52,12 @@ class SheetPiece:
     mountain: np.ndarray  # (m, 2, 2)
     valley: np.ndarray  # (v, 2, 2)
     slits: np.ndarray  # (s, 2, 2) cut edges inside the outline
-    tabs: tuple[np.ndarray, ...]  # (4, 2) trapezoids
-    tab_folds: np.ndarray  # (t, 2, 2)
+    tabs: tuple[np.ndarray, ...]  # (k, 2) tab polygons (trapezoids, or clipped)
+    tab_folds: np.ndarray  # (t, 2, 2) the fold line under each tab polygon
     texts: tuple[TextItem, ...]
     tab_mountain: np.ndarray  # (t,) bool: tab t folds as a mountain seen from the printed side (convex seam)
+    footprint: object  # shapely geometry: outline + off-face labels (what packing keeps apart)
+    leaders: np.ndarray  # (l, 2, 2) printed lines from an edge to its off-face label
 
     def cut_rings(self) -> list[np.ndarray]:
         """The outline's boundary rings (exterior and holes), without the repeated last point."""
@@ -74,7 +77,7 @@ class GlueEdge:
     mesh_edge: tuple[int, int]  # whole-mesh vertex ids
     pieces: tuple[int, int]  # piece index of each side
     tab_piece: int | None  # the piece whose side carries the tab; None: no tab fits either side
-    tab_height_mm: float
+    tab_height_mm: float  # the tab's depth from its fold line
     fold_angle: float = 0.0  # the seam's signed fold angle rho (radians, + convex) in the model
 
 
@@ -82,11 +85,14 @@ class GlueEdge:
 class LayoutStats:
     glue_edges: int
     tabs: int
-    tabs_shrunk: int
+    tabs_shrunk: int  # tabs smaller than full (reduced_tabs says which and why)
     tabs_moved: int  # put on the second side because the first had no room
     untabbed: tuple[str, ...]  # labels of the edges without a tab
-    small_labels: int  # labels below LABEL_MIN_MM (they still fit inside their face)
+    small_labels: int  # labels with no readable place (at their face's centroid, over lines or labels)
     open_edges: int  # boundary edges of the input mesh (cut, nothing to glue to)
+    reduced_tabs: tuple[tuple[str, str], ...] = ()  # (edge label, reason: tabs.Tab.reason) of reduced tabs
+    labels_on_tabs: int = 0  # glue labels printed on their tab (no room in the face)
+    labels_outside: int = 0  # glue labels printed just outside their edge
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,26 +149,6 @@ def _pair_sides(drawn: list[_Drawn]) -> tuple[list[tuple[tuple[int, int], list[C
     return pairs, open_edges
 
 
-@dataclass
-class _Glued:
-    """What gluing adds to each piece (lists per piece index) and the counts of LayoutStats."""
-
-    n: int
-    tabs: list = field(init=False)  # shapely Polygons
-    tab_mountain: list = field(init=False)  # per tab: its seam is convex
-    slits: list = field(init=False)
-    texts: list = field(init=False)
-    glue: list = field(default_factory=list)
-    untabbed: list = field(default_factory=list)
-    n_tabs: int = 0
-    shrunk: int = 0
-    moved: int = 0
-    small: int = 0
-
-    def __post_init__(self) -> None:
-        self.tabs, self.tab_mountain, self.slits, self.texts = ([[] for _ in range(self.n)] for _ in range(4))
-
-
 def seam_fold_angles(inputs: list[PieceInput]) -> dict[tuple[int, int], float]:
     """Signed fold angle rho (radians, + convex) of every edge of the model the pieces make, keyed
     by its whole-mesh vertex ids (low, high): the pieces' faces put back together in 3D, so a seam
@@ -176,61 +162,133 @@ def seam_fold_angles(inputs: list[PieceInput]) -> dict[tuple[int, int], float]:
     return {(int(a), int(b)): float(r) for (a, b), r in zip(keys, whole.fold_angles)}
 
 
-def _glue(pairs, drawn: list[_Drawn], tabs: bool, rho: dict[tuple[int, int], float]) -> _Glued:
-    """Label both sides of every glued pair (label = its 1-based rank), note slits (two sides of
-    one piece that touch in the plane) and give each pair its tab (`choose_tab`)."""
-    from shapely.geometry import Polygon
-    from shapely.prepared import prep
+@dataclass
+class _Glued:
+    """What gluing adds to each piece (lists per piece index) and the counts of LayoutStats."""
 
-    bodies = [d.body for d in drawn]
-    prepared = [prep(b) for b in bodies] if tabs else []
+    n: int
+    tabs: list = field(init=False)  # per piece: tab polygons (k, 2)
+    tab_folds: list = field(init=False)  # per piece: fold segment (2, 2) of each tab polygon
+    tab_mountain: list = field(init=False)  # per piece: per tab polygon, its seam is convex
+    slits: list = field(init=False)
+    glue: list = field(default_factory=list)
+    untabbed: list = field(default_factory=list)
+    reduced: list = field(default_factory=list)  # (label, reason) of every tab smaller than full
+    n_tabs: int = 0
+    moved: int = 0
+
+    def __post_init__(self) -> None:
+        self.tabs, self.tab_folds, self.tab_mountain, self.slits = ([[] for _ in range(self.n)] for _ in range(4))
+
+
+def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
+          rho: dict[tuple[int, int], float]) -> tuple[_Glued, list[Tab | None]]:
+    """Note slits (two sides of one piece that touch in the plane) and give each glued pair (label
+    = its 1-based rank) its tab (`choose_tab`); every tab joins its piece's `Room`."""
+    from shapely.geometry import Polygon
+
     out = _Glued(len(drawn))
+    chosen: list[Tab | None] = []
     for idx, (key, (o1, o2)) in enumerate(pairs):
         label = str(idx + 1)
         if o1.piece == o2.piece and np.allclose(o1.p0, o2.p1, atol=1e-6) and np.allclose(o1.p1, o2.p0, atol=1e-6):
             out.slits[o1.piece].append(np.array([o1.p0, o1.p1]))  # the two sides touch in the plane
-        for o in (o1, o2):
-            item, big = edge_label(o.tri, o.k, label)
-            out.texts[o.piece].append(item)
-            out.small += not big
-        tab = choose_tab((o1, o2), bodies, prepared, out.tabs) if tabs else None
+        tab = choose_tab((o1, o2), rooms) if tabs else None
+        chosen.append(tab)
         if tab is None:
             if tabs:
                 out.untabbed.append(label)
             out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), None, 0.0, rho[key]))
             continue
         piece = (o1, o2)[tab.side].piece
-        out.tabs[piece].append(Polygon(tab.polygon))
-        out.tab_mountain[piece].append(rho[key] > 0)
+        for poly, fold in zip(tab.polygons, tab.folds):
+            out.tabs[piece].append(poly)
+            out.tab_folds[piece].append(fold)
+            out.tab_mountain[piece].append(rho[key] > 0)
+            rooms[piece].extra.append(Polygon(poly))
         out.n_tabs += 1
-        out.shrunk += tab.variant != 0
         out.moved += tab.side == 1
-        out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.height, rho[key]))
-    return out
+        if tab.reason != "full":
+            out.reduced.append((label, tab.reason))
+        out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.depth, rho[key]))
+    return out, chosen
 
 
-def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
-                       ) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
+            min_label_mm: float) -> tuple[list[PieceLabels], LabelStats]:
+    """Every piece's name, then the glue label of both sides of every glued pair (`PieceLabels`)."""
+    size = label_font(min_label_mm)
+    placed = [PieceLabels(room, size) for room in rooms]
+    for i, d in enumerate(drawn):
+        placed[i].piece(d.faces_xy, piece_name(i))
+    for idx, ((_key, sides), tab) in enumerate(zip(pairs, chosen)):
+        for s, side in enumerate(sides):
+            mine = tab is not None and tab.side == s
+            placed[side.piece].edge(side, str(idx + 1), tab.polygons if mine else (), tab.folds if mine else None)
+    stats = LabelStats()
+    for p in placed:
+        stats.on_tabs += p.stats.on_tabs
+        stats.outside += p.stats.outside
+        stats.unplaced += p.stats.unplaced
+    return placed, stats
+
+
+def glue_strip(label: str, length: float, rho: float, part: int, size: float) -> SheetPiece:
+    """A glue strip for a seam `length` mm long that has no room for a tab: a separate rectangle,
+    2 x `tabs.full_depth` wide, glued behind both sides of the seam, scored along its middle and
+    labelled like a tab on both halves. Its printed side faces the model's inside, so it folds the
+    other way from its seam: a valley on a convex seam. Named "S" + the seam's label."""
+    import shapely
+
+    depth = full_depth(length)
+    rect = np.array([[0.0, -depth], [length, -depth], [length, depth], [0.0, depth]])
+    body = shapely.Polygon(rect)
+    line = np.array([[[0.0, 0.0], [length, 0.0]]])
+    none = np.zeros((0, 2, 2))
+    angle = 0.0 if text_width(label, size) < length else 90.0
+    texts = tuple(TextItem(label, length / 2, y, angle, size, "edge-label") for y in (-depth / 2, depth / 2))
+    return SheetPiece(name=f"S{label}", part=part, face_ids=np.zeros(0, dtype=np.int64), faces_xy=np.zeros((0, 3, 2)),
+                      body=body, outline=body, mountain=line if rho < 0 else none, valley=line if rho >= 0 else none,
+                      slits=none, tabs=(), tab_folds=none, texts=texts, tab_mountain=np.zeros(0, dtype=bool),
+                      footprint=body, leaders=none)
+
+
+def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
+                       min_label_mm: float = MIN_LABEL_MM) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
     """Draw every piece in mm and pair up their cut edges (see the module docstring). Tabs:
-    `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed."""
+    `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed.
+    Labels: `labels.PieceLabels`, cap height at least `min_label_mm`."""
     import shapely
 
     drawn = [_draw(inp, i, scale) for i, inp in enumerate(inputs)]
     pairs, open_edges = _pair_sides(drawn)
-    g = _glue(pairs, drawn, tabs, seam_fold_angles(inputs))
+    rooms = [Room(shapely.polygons(d.faces_xy)) for d in drawn]
+    rho = seam_fold_angles(inputs)
+    g, chosen = _glue(pairs, drawn, rooms, tabs, rho)
+    placed, label_stats = _labels(pairs, drawn, rooms, chosen, min_label_mm)
     pieces = []
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
-        name = piece_name(i)
-        tab_polys = g.tabs[i]
-        outline = shapely.union_all([d.body, *tab_polys]) if tab_polys else d.body
-        tab_arr = tuple(np.asarray(t.exterior.coords)[:-1] for t in tab_polys)
-        folds = np.array([[t[0], t[3]] for t in tab_arr]).reshape(-1, 2, 2)
-        g.texts[i].append(piece_label(d.faces_xy, name))
+        tab_polys = [shapely.Polygon(t) for t in g.tabs[i]]
+        # snapped to a 1e-6 mm grid: a clipped tab meets its face mid-edge, where float noise would
+        # leave a hair-thin gap or sliver instead of one outline
+        outline = shapely.union_all([d.body, *tab_polys], grid_size=1e-6) if tab_polys else d.body
+        footprint = shapely.union_all([outline, *placed[i].outside]) if placed[i].outside else outline
         pieces.append(SheetPiece(
-            name=name, part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
+            name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
             outline=outline, mountain=d.mountain.reshape(-1, 2, 2), valley=d.valley.reshape(-1, 2, 2),
-            slits=np.array(g.slits[i]).reshape(-1, 2, 2), tabs=tab_arr, tab_folds=folds, texts=tuple(g.texts[i]),
-            tab_mountain=np.array(g.tab_mountain[i], dtype=bool)))
-    stats = LayoutStats(glue_edges=len(pairs), tabs=g.n_tabs, tabs_shrunk=g.shrunk, tabs_moved=g.moved,
-                        untabbed=tuple(g.untabbed), small_labels=g.small, open_edges=open_edges)
+            slits=np.array(g.slits[i]).reshape(-1, 2, 2), tabs=tuple(g.tabs[i]),
+            tab_folds=np.array(g.tab_folds[i]).reshape(-1, 2, 2), texts=tuple(placed[i].items),
+            tab_mountain=np.array(g.tab_mountain[i], dtype=bool), footprint=footprint,
+            leaders=np.array(placed[i].leaders).reshape(-1, 2, 2)))
+    size = label_font(min_label_mm)
+    for label in g.untabbed:  # the last resort: a separate glue strip behind the seam
+        idx = int(label) - 1
+        key, (o1, _o2) = pairs[idx]
+        pieces.append(glue_strip(label, o1.length, rho[key], inputs[o1.piece].part, size))
+        g.glue[idx] = replace(g.glue[idx], tab_piece=len(pieces) - 1, tab_height_mm=full_depth(o1.length))
+        g.reduced.append((label, "glue strip"))
+    stats = LayoutStats(glue_edges=len(pairs), tabs=g.n_tabs, tabs_shrunk=len(g.reduced), tabs_moved=g.moved,
+                        untabbed=(), small_labels=label_stats.unplaced, open_edges=open_edges,
+                        reduced_tabs=tuple(g.reduced), labels_on_tabs=label_stats.on_tabs,
+                        labels_outside=label_stats.outside)
     return pieces, g.glue, stats

@@ -63,7 +63,7 @@ def net_pieces(nets: Sequence[Net]) -> list[PieceInput]:
 def _shelves(pieces: list[SheetPiece]) -> tuple[list[Placement], float, float]:
     """Placements of the pieces on rows about as wide as the pieces' total area is deep (unturned,
     GAP_MM apart), and the (width, height) mm the rows take."""
-    bounds = np.array([p.outline.bounds for p in pieces])  # (n, 4): xmin, ymin, xmax, ymax
+    bounds = np.array([p.footprint.bounds for p in pieces])  # (n, 4): xmin, ymin, xmax, ymax
     sizes = bounds[:, 2:] - bounds[:, :2]
     row = max(float(sizes[:, 0].max()), math.sqrt(float(np.prod(sizes + GAP_MM, axis=1).sum())))
     offsets = shelf_offsets(sizes.tolist(), row, math.inf, GAP_MM)

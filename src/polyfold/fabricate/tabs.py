@@ -1,26 +1,42 @@
-"""Glue tabs: the one routine that puts a trapezoid on one side of a glued cut edge.
+"""Glue tabs: the one routine that gives a glued cut edge its tab, overlapping nothing.
 
-In: the two sides (`CutSide`) of a cut edge in mm (y down), the faces of each piece and the tabs
-already on it. Out: the `Tab` (which side, its polygon, its height), or None when no variant has
-room on either side.
+In: the two sides (`CutSide`) of a glued cut edge in mm (y down) and the `Room` of each piece (its
+faces, and the tabs and labels already on it). Out: a `Tab` (which side, its polygons, the fold
+segment of each, its depth, and why it is smaller than a full tab), or None when no tab with the
+minimum glue area fits on either side (the caller then makes a glue strip).
+
+Sizes. A full tab is a trapezoid `full_depth(L)` deep (40 % of the edge length L, between
+TAB_MIN_MM and TAB_MAX_MM) with 45-degree sides, steeper on short edges so its top keeps 10 % of
+the edge. When it does not fit, in order, on either side: flatter sides (they slip into the
+notches of a net), a lower tab (TAB_MIN_MM), then the full tab clipped: everything within
+TAB_CLEAR_MM of the piece's other faces, tabs and labels removed (tapered where something comes
+close, split in two where it reaches the fold line). A clipped tab keeps at least MIN_GLUE_FRAC of
+the full tab's glue area and reaches TAB_MIN_DEPTH_MM from its fold line; less does not hold.
+
+Clearance. Apart from the corners where its fold line meets the neighbouring faces, every tab
+stays TAB_CLEAR_MM from everything else on its piece, so a blade never runs two cuts closer.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-TAB_MAX_MM = 6.0  # full tab height
-TAB_REL = 0.4  # tab height as a fraction of its edge length (before the cap)
-TAB_MIN_MM = 1.0  # smaller tabs are useless: no tab instead
+TAB_MAX_MM = 6.0  # full tab depth on long edges
+TAB_REL = 0.4  # full tab depth as a fraction of its edge length, between TAB_MIN_MM and TAB_MAX_MM
+TAB_MIN_MM = 3.0  # a lowered tab: the least depth that still takes a finger and glue
+TAB_MIN_DEPTH_MM = 2.0  # a clipped (tapered) tab must reach this far from its fold line somewhere
+MIN_GLUE_FRAC = 0.4  # a clipped tab keeps this fraction of the full tab's area
+TAB_CLEAR_MM = 0.5  # gap kept between a tab and the piece's other faces, tabs and labels
 OVERLAP_MM2 = 1e-4  # intersections below this area (0.01 x 0.01 mm) are touching, not overlap
+MIN_PART_MM2 = 1.0  # parts of a clipped tab smaller than this are dropped
+SIMPLIFY_MM = 0.02  # clipped tabs' outlines are simplified this much (fewer cutter nodes)
 
-# (height factor, side angle) in order of preference: full 45-degree trapezoids first, then flatter
-# and lower ones that fit into the notches of a net
-TAB_VARIANTS = ((1.0, 45.0), (1.0, 30.0), (0.6, 30.0), (0.6, 18.0), (0.35, 18.0), (0.35, 10.0))
+# (depth: "full" or "min", side angle in degrees, reason) in order of preference
+TAB_VARIANTS = (("full", 45.0, "full"), ("full", 30.0, "flatter"), ("full", 15.0, "flatter"),
+                ("min", 45.0, "lower"), ("min", 15.0, "lower"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,67 +51,174 @@ class CutSide:
     p1: np.ndarray
     tri: np.ndarray
 
+    @property
+    def length(self) -> float:
+        return float(math.hypot(*(self.p1 - self.p0)))
+
+    def outward(self) -> np.ndarray:
+        """Unit normal of the edge pointing away from its face."""
+        u = (self.p1 - self.p0) / max(self.length, 1e-12)
+        n = np.array([-u[1], u[0]])
+        return -n if np.dot(self.tri.mean(axis=0) - self.p0, n) > 0 else n
+
 
 @dataclass(frozen=True, eq=False)
 class Tab:
-    """The tab of a glued edge: on `sides[side]`, trapezoid `polygon` (4, 2) = (base start, top,
-    top, base end), `height` mm, made with TAB_VARIANTS[variant] (0: full size)."""
+    """The tab of a glued edge, on `sides[side]`: `polygons` (one, or several parts of a split
+    tab), `folds` (k, 2, 2) the stretch of the fold line under each part, `depth` mm (deepest
+    point from the fold line) and `reason`: "full", or how it was reduced ("flatter", "lower",
+    "tapered": clipped around something, "split": clipped into several parts)."""
 
     side: int
-    polygon: np.ndarray
-    height: float
-    variant: int
+    polygons: tuple[np.ndarray, ...]
+    folds: np.ndarray
+    depth: float
+    reason: str
 
 
-def overlap(a, b, prepared_b=None) -> bool:
-    """True when polygons a and b share more than OVERLAP_MM2 of area (touching is fine)."""
-    import shapely
-
-    if not (prepared_b or b).intersects(a):
-        return False
-    return shapely.area(shapely.intersection(a, b)) > OVERLAP_MM2
+def full_depth(length: float) -> float:
+    """Depth of a full tab on an edge `length` mm long."""
+    return min(TAB_MAX_MM, max(TAB_MIN_MM, TAB_REL * length))
 
 
-def tab_polygon(side: CutSide, factor: float, side_deg: float) -> np.ndarray | None:
-    """Trapezoid on the outer side of the cut edge: height factor * min(TAB_REL * length, TAB_MAX_MM),
-    sides at `side_deg` to the base (a flatter side slips into a narrow notch of the net)."""
-    d = side.p1 - side.p0
-    length = math.hypot(d[0], d[1])
+def tab_polygon(side: CutSide, depth: float, side_deg: float) -> np.ndarray | None:
+    """Trapezoid (4, 2) = (base start, top, top, base end) outside the face, `depth` mm deep, its
+    sides at `side_deg` to the base or steeper, so the top keeps 10 % of the edge."""
+    length = side.length
     if length < 1e-9:
         return None
-    u = d / length
-    n = np.array([-u[1], u[0]])
-    if np.dot(side.tri.mean(axis=0) - side.p0, n) > 0:
-        n = -n  # away from the face
-    h = min(TAB_REL * length, TAB_MAX_MM) * factor
-    inset = h / math.tan(math.radians(side_deg))
-    if 2 * inset > 0.9 * length:  # the sides would cross: lower the tab so its top keeps 10 %
-        inset = 0.45 * length
-        h = inset * math.tan(math.radians(side_deg))
-    if h < TAB_MIN_MM:
+    u = (side.p1 - side.p0) / length
+    n = side.outward()
+    inset = min(depth / math.tan(math.radians(side_deg)), 0.45 * length)
+    return np.array([side.p0, side.p0 + u * inset + n * depth, side.p1 - u * inset + n * depth, side.p1])
+
+
+@dataclass(eq=False)
+class Room:
+    """What is on one piece, for the tabs and labels still to place: its face polygons (shapely,
+    in an STRtree) and the tabs and off-face label boxes placed so far (`extra`)."""
+
+    faces: np.ndarray  # shapely Polygons, one per face
+    tree: object = field(init=False)
+    extra: list = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        import shapely
+
+        self.tree = shapely.STRtree(self.faces)
+
+    def obstacles(self, region, skip_face: int | None = None) -> list:
+        """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
+        near = [self.faces[i] for i in self.tree.query(region) if i != skip_face]
+        x0, y0, x1, y1 = region.bounds
+        for g in self.extra:
+            a0, b0, a1, b1 = g.bounds
+            if a0 <= x1 and x0 <= a1 and b0 <= y1 and y0 <= b1:
+                near.append(g)
+        return near
+
+    def blocked(self, poly, skip_face: int | None = None, clear: float = 0.0, keep_free: list | None = None) -> bool:
+        """True when `poly` overlaps a face (but `skip_face`) or an extra, or comes within `clear`
+        mm of one outside the discs `keep_free` (shapely geometries where near contact is expected)."""
+        import shapely
+
+        grown = poly.buffer(clear, quad_segs=2) if clear else poly
+        near = self.obstacles(grown, skip_face)
+        if not near:
+            return False
+        others = shapely.union_all(near)
+        if shapely.area(shapely.intersection(poly, others)) > OVERLAP_MM2:
+            return True
+        hit = shapely.intersection(grown, others)
+        if keep_free:
+            hit = shapely.difference(hit, shapely.union_all(keep_free))
+        return shapely.area(hit) > OVERLAP_MM2
+
+
+def _fold_of(part, side: CutSide) -> np.ndarray | None:
+    """The stretch (2, 2) of the side's edge under a tab part: its boundary points on the edge."""
+    pts = np.asarray(part.exterior.coords)
+    length = side.length
+    u = (side.p1 - side.p0) / length
+    rel = pts - side.p0
+    off = np.abs(rel[:, 0] * u[1] - rel[:, 1] * u[0])
+    on = off < 1e-6 * max(1.0, length)
+    if on.sum() < 2:
         return None
-    return np.array([side.p0, side.p0 + u * inset + n * h, side.p1 - u * inset + n * h, side.p1])
+    t = np.clip(rel[on] @ u, 0.0, length)
+    if t.max() - t.min() < 1e-6:
+        return None
+    return np.array([side.p0 + u * t.min(), side.p0 + u * t.max()])
 
 
-def choose_tab(sides: tuple[CutSide, CutSide], bodies: Sequence, prepared: Sequence,
-               piece_tabs: Sequence[list]) -> Tab | None:
-    """The tab of a glued pair: a trapezoid on the first side; if it would overlap a face
-    (bodies[piece], shapely; prepared[piece] its prepared form) or a tab already on that piece
-    (piece_tabs[piece], shapely Polygons), the other side; then both sides again with the lower /
-    flatter TAB_VARIANTS. A tab may touch faces and tabs (its fold line, corners) but not share
-    more than OVERLAP_MM2 of area with them. None when nothing fits."""
+def _depth(poly: np.ndarray, side: CutSide) -> float:
+    return float(np.max((poly - side.p0) @ side.outward()))
+
+
+def _clipped(side: CutSide, room: Room) -> Tab | None:
+    """The full tab minus everything within TAB_CLEAR_MM of the piece's other faces and extras;
+    None when less than the minimum glue area or depth stays."""
+    import shapely
     from shapely.geometry import Polygon
 
-    for variant, (factor, side_deg) in enumerate(TAB_VARIANTS):
+    full = tab_polygon(side, full_depth(side.length), 45.0)
+    if full is None:
+        return None
+    whole = Polygon(full)
+    near = room.obstacles(whole.buffer(TAB_CLEAR_MM, quad_segs=2), side.face)
+    rest = whole
+    if near:
+        # grown so the chords of the buffer's arcs and the simplification below keep TAB_CLEAR_MM
+        grow = TAB_CLEAR_MM / math.cos(math.pi / 8) + SIMPLIFY_MM
+        rest = shapely.difference(whole, shapely.union_all(near).buffer(grow, quad_segs=2))
+        # opening: slivers thinner than a millimetre do not hold glue
+        rest = rest.buffer(-0.3, quad_segs=2).buffer(0.3, quad_segs=2).intersection(rest)
+    parts, folds = [], []
+    for g in getattr(rest, "geoms", [rest]):
+        if g.geom_type != "Polygon" or g.area < MIN_PART_MM2:
+            continue
+        g = g.simplify(SIMPLIFY_MM).intersection(whole)  # back inside the trapezoid: off its own face
+        fold = _fold_of(g, side)
+        if fold is None or g.geom_type != "Polygon":
+            continue
+        parts.append(np.asarray(g.exterior.coords)[:-1])
+        folds.append(fold)
+    if not parts:
+        return None
+    area = sum(Polygon(p).area for p in parts)
+    depth = max(_depth(p, side) for p in parts)
+    if area < MIN_GLUE_FRAC * whole.area or depth < min(TAB_MIN_DEPTH_MM, full_depth(side.length)) - 1e-9:
+        return None
+    return Tab(-1, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
+
+
+def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
+    """The tab of a glued pair: the first of TAB_VARIANTS that fits on either side (the first side
+    first), else the larger clipped tab of the two sides; None when nothing fits (see the module
+    docstring). A tab may touch the faces beside its fold line at the corners, nothing else."""
+    from shapely.geometry import Point, Polygon
+
+    for depth_kind, side_deg, reason in TAB_VARIANTS:
         for s, side in enumerate(sides):
-            poly = tab_polygon(side, factor, side_deg)
+            depth = full_depth(side.length) if depth_kind == "full" else TAB_MIN_MM
+            if depth_kind == "min" and depth >= full_depth(side.length):
+                continue
+            poly = tab_polygon(side, depth, side_deg)
             if poly is None:
                 continue
             tab = Polygon(poly)
-            if not tab.is_valid or overlap(tab, bodies[side.piece], prepared[side.piece]):
-                continue
-            if any(overlap(tab, t) for t in piece_tabs[side.piece]):
-                continue
-            height = float(np.linalg.norm((poly[1] + poly[2]) / 2 - (poly[0] + poly[3]) / 2))
-            return Tab(s, poly, height, variant)
-    return None
+            corners = [Point(side.p0).buffer(2 * TAB_CLEAR_MM), Point(side.p1).buffer(2 * TAB_CLEAR_MM)]
+            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, corners):
+                return Tab(s, (poly,), np.array([[side.p0, side.p1]]), depth, reason)
+    best = None
+    for s, side in enumerate(sides):
+        tab = _clipped(side, rooms[side.piece])
+        if tab is not None and (best is None or _area(tab) > _area(best)):
+            best = Tab(s, tab.polygons, tab.folds, tab.depth, tab.reason)
+    return best
+
+
+def _area(tab: Tab) -> float:
+    from shapely.geometry import Polygon
+
+    return sum(Polygon(p).area for p in tab.polygons)

@@ -20,12 +20,12 @@ import math
 import numpy as np
 
 from ..fabricate.page import Page, TextItem
+from ..fabricate.paper import CAP_HEIGHT  # centres text vertically, gives the DXF text height
 
 
 MM_TO_PT = 72.0 / 25.4
 
 
-CAP_HEIGHT = 0.718  # Helvetica's cap height per em: centres text vertically, gives the DXF text height
 
 
 # One style table for all writers so SVG, PDF and DXF agree. Pure red / blue because cutting

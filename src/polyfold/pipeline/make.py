@@ -101,7 +101,8 @@ def _layout_report(sheets: Sheets, opts: MakeOptions, scale: float, splits: int,
         margin_mm=opts.margin, pages=sheets.packing.n_pages,
         utilisation=sheets.packing.utilisation, splits_for_page=splits, glue_edges=st.glue_edges, tabs=st.tabs,
         tabs_shrunk=st.tabs_shrunk, tabs_moved=st.tabs_moved, untabbed_edges=tuple(st.untabbed),
-        small_labels=st.small_labels, open_edges=st.open_edges)
+        small_labels=st.small_labels, open_edges=st.open_edges, reduced_tabs=st.reduced_tabs,
+        labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside, min_label_mm=opts.min_label_mm)
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
-from ..fabricate.paper import FOOTER_MM, MARK_CLEAR_MM
+from ..fabricate.paper import FOOTER_MM, MARK_CLEAR_MM, MIN_LABEL_MM
 
 PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
 INFLATE_MODES = ("none", "constrained", "uniform")
@@ -35,6 +35,7 @@ class MakeOptions:
     contact_tol: float = CONTACT_TOL
     resolution_deg: float = 1.0
     marks: bool = False  # print-and-cut registration marks (Silhouette "Type 1") on the printed pages
+    min_label_mm: float = MIN_LABEL_MM  # least cap height of every label (mm)
 
 
 def paper_size(spec: str) -> tuple[float, float]:
@@ -61,6 +62,8 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
         raise PolyfoldError(f"--segment must be auto or none, not {opts.segment!r}")
     if not (opts.size > 0 and math.isfinite(opts.size)):
         raise PolyfoldError(f"--size must be a positive number of mm, not {opts.size}")
+    if not (0.5 <= opts.min_label_mm <= 10):
+        raise PolyfoldError(f"--min-label-mm must be between 0.5 and 10 mm, not {opts.min_label_mm}")
     width, height = paper_size(opts.paper)
     if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
         raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")

@@ -20,10 +20,12 @@ from ..mesh.mesh import Mesh, face_components
 from ..segment.segment import DEFAULT_TAU, segment
 from ..unfold.net import Net
 from ..unfold.search import UnfoldStats, unfold
+from ..unfold.tabroom import open_notches
 from .options import MakeOptions
 from .report import NetReport, SegmentReport, UnfoldReport
 
 MIN_UNFOLD_S = 0.5  # the least time a part's search gets, however little is left
+TAB_ROOM_S = 5.0  # the most time a part's net spends opening notches for tabs (`open_notches`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,6 +99,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline,
             else:
                 todo = subs + todo
                 continue
+        net, room = open_notches(net, deadline=Deadline.after(min(TAB_ROOM_S, max(0.1, deadline.left()))))
         unfold_s += time.perf_counter() - tu
         nets.append(NetReport(faces=int(len(faces)), pieces=int(net.n_pieces), seconds=st.seconds, method=st.method,
                               timed_out=bool(st.timed_out)))

@@ -102,8 +102,12 @@ class LayoutReport:
     tabs_shrunk: int
     tabs_moved: int
     untabbed_edges: tuple[str, ...]
-    small_labels: int
+    small_labels: int  # glue labels with no readable place (never shrunk: at their face's centroid)
     open_edges: int
+    reduced_tabs: tuple[tuple[str, str], ...] = ()  # (edge label, why): "flatter", "lower", "tapered", "split", "glue strip"
+    labels_on_tabs: int = 0
+    labels_outside: int = 0  # beside their edge, with a leader line when further away
+    min_label_mm: float = 2.0  # the least cap height asked for
 
 
 @dataclass(frozen=True)

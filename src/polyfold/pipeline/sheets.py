@@ -94,10 +94,11 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     """Tabs and labels for every piece, then the pieces packed onto as few pages as possible."""
     tl = time.perf_counter()
     say("layout", f"tabs and labels for {len(folded)} pieces")
-    pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs)
+    pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
+                                             min_label_mm=opts.min_label_mm)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     page, margin = _packer_page(pack_box(width, height, opts))
-    packing = pack_outlines([p.outline for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
+    packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                             time_limit=max(2.0, min(10.0, deadline.left())))
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
     return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl)

@@ -31,13 +31,14 @@ def make(
     fold: bool = options.FOLD,
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
+    min_label_mm: float = options.MIN_LABEL,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
     """Mesh in, printable sheets out: inflate, segment, unfold, fold, lay out with tabs and labels, export."""
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks)
+                                    marks=marks, min_label_mm=min_label_mm)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -54,6 +55,13 @@ def make(
         if lay.untabbed_edges:
             say(f"warning: {len(lay.untabbed_edges)} glue edge(s) without a tab (no room on either side): "
                  f"{', '.join(lay.untabbed_edges[:10])}{' ...' if len(lay.untabbed_edges) > 10 else ''}")
+        strips = [label for label, why in lay.reduced_tabs if why == "glue strip"]
+        if strips:
+            say(f"{len(strips)} seam(s) had no room for a tab and get a glue strip (piece S + label): "
+                f"{', '.join(strips[:10])}{' ...' if len(strips) > 10 else ''}")
+        if lay.small_labels:
+            say(f"warning: {lay.small_labels} label(s) found no free place at {lay.min_label_mm:g} mm and are "
+                "printed over their face (try a larger --size or a smaller --min-label-mm)")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "

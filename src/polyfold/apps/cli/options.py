@@ -41,11 +41,14 @@ MARKS = typer.Option(_D.marks, "--marks/--no-marks",
                      help="Print-and-cut registration marks (Silhouette Studio 'Type 1', 10 mm inset) on the printed "
                           "pages; pieces keep out of the marked corners.")
 CONTACT_TOL_OPTION = contact_tol_option()
+MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
+                         help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
 
 def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str, tau: Optional[float],
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
-                 time_limit: float, fold: bool, contact_tol: float, marks: bool) -> MakeOptions:
+                 time_limit: float, fold: bool, contact_tol: float, marks: bool,
+                 min_label_mm: float = _D.min_label_mm) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -53,7 +56,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
         fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
-                       contact_tol=contact_tol, marks=marks)
+                       contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm)
 
 
 @contextlib.contextmanager

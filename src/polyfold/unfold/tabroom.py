@@ -1,0 +1,208 @@
+"""Room for glue tabs: edge swaps that open the narrow notches of a net.
+
+A net's outline has a corner wherever its cut edges meet at a vertex. Seen from outside the net a
+corner leaves a free angle (2 pi minus the face angles it holds); at a leaf of the cut tree it is
+the vertex's angle defect, tiny on a smooth surface. A corner narrower than NOTCH_DEG leaves no
+room for the glue tab of either edge beside it. `open_notches` swaps tree edges (cut a crease at
+the notch's vertex that halves its angle, glue a cut edge that reconnects the two halves) while
+the net stays overlap-free and the notches' total shortfall (`corner_penalty`) falls.
+
+In: a single-piece `Net` of a closed or open mesh, the creases that must stay (`keep`, e.g. flat
+regions), a `Deadline`. Out: a `Net` of the same faces (one piece, overlap-free, re-laid out) and
+`TabRoomStats`. Multi-piece nets are returned unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..collide.flat import overlapping_pairs
+from ..deadline import Deadline
+from ..mesh.geometry import corner_angles
+from . import kernels as K
+from .net import Net, _dfs_intervals
+from .problem import UnfoldProblem
+
+NOTCH_DEG = 40.0  # corners with less free angle than this leave too little room for a tab
+MAX_TRIES = 24  # reconnecting cut edges tried (best first) per crease cut at a notch
+MAX_PASSES = 4  # passes over the notches
+MAX_CUTS = 4  # creases tried per notch (those nearest to halving its angle first)
+
+
+@dataclass(frozen=True)
+class TabRoomStats:
+    notches_before: int  # corners narrower than NOTCH_DEG
+    notches_after: int
+    swaps: int
+    timed_out: bool
+
+
+class _Fans:
+    """Corner bookkeeping of one mesh: for a vertex and a crease mask, the outline corners there."""
+
+    def __init__(self, net: Net) -> None:
+        mesh = net.mesh
+        topo = mesh.topology
+        self.faces = mesh.faces
+        self.face_edges = topo.face_edges
+        self.edge_faces = topo.edge_faces
+        self.angle = corner_angles(mesh.vertices, mesh.faces)
+        flat = mesh.faces.reshape(-1)
+        order = np.argsort(flat, kind="stable")
+        self.ptr = np.searchsorted(flat[order], np.arange(mesh.n_vertices + 1))
+        self.inc_face = order // 3
+        self.inc_corner = order % 3
+
+    def corners(self, v: int, crease: np.ndarray) -> list[tuple[int, int, float]]:
+        """(edge in, edge out, held angle) of every outline corner at vertex v: turning around v
+        through creases from a cut (or boundary) edge to the next one. Empty when every edge at v
+        is a crease (v inside the net)."""
+        out = []
+        for i in range(self.ptr[v], self.ptr[v + 1]):
+            f, j = int(self.inc_face[i]), int(self.inc_corner[i])
+            e_in = int(self.face_edges[f, (j + 2) % 3])
+            if crease[e_in]:
+                continue
+            held = 0.0
+            for _ in range(self.ptr[v + 1] - self.ptr[v]):
+                held += float(self.angle[f, j])
+                e_out = int(self.face_edges[f, j])
+                if not crease[e_out]:
+                    break
+                a, b = self.edge_faces[e_out]
+                f = int(b if a == f else a)
+                j = int(np.flatnonzero(self.faces[f] == v)[0])
+            out.append((e_in, e_out, held))
+        return out
+
+    def penalty(self, v: int, crease: np.ndarray) -> float:
+        return sum(corner_penalty(2 * math.pi - held) for _, _, held in self.corners(v, crease))
+
+
+def corner_penalty(free: float) -> float:
+    """Shortfall of a corner's free angle (radians) below NOTCH_DEG, as a fraction of it."""
+    return max(0.0, 1.0 - free / math.radians(NOTCH_DEG))
+
+
+def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
+    """The single-piece net of `crease` rooted where `net` is, or None when it overlaps."""
+    mesh = net.mesh
+    n = mesh.n_faces
+    parent = np.empty(n, np.int64)
+    parent_edge = np.empty(n, np.int64)
+    order = np.empty(n, np.int64)
+    if K.tree_from_creases(crease, int(net.order[0]), problem.adj_ptr, problem.adj_face, problem.adj_edge,
+                           parent, parent_edge, order) != n:
+        return None
+    coords = np.empty((n, 3, 2))
+    K.layout_tree(order, parent, parent_edge, mesh.faces, mesh.topology.face_edges, problem.local, coords)
+    count, _ = overlapping_pairs(coords, parent, problem.tol, 0)
+    if count:
+        return None
+    return Net(mesh=mesh, parent=parent, parent_edge=parent_edge, order=order, coords=coords,
+               piece=np.zeros(n, dtype=np.int64))
+
+
+def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = Deadline.never()
+                 ) -> tuple[Net, TabRoomStats]:
+    """The net with fewer narrow corners (see the module docstring); `keep` (E,) bool: creases no
+    swap may cut."""
+    crease = net.crease_mask.copy()
+    fans = _Fans(net)
+    n_v = net.mesh.n_vertices
+    pen = np.array([fans.penalty(v, crease) for v in range(n_v)])
+    before = int(np.count_nonzero(pen > 0))
+    if net.n_pieces != 1 or before == 0:
+        return net, TabRoomStats(before, before, 0, False)
+    problem = UnfoldProblem.from_mesh(net.mesh, base=int(net.order[0]))
+    edges = net.mesh.topology.edges
+    edge_faces = net.mesh.topology.edge_faces
+    inner = (edge_faces >= 0).all(axis=1)
+    keep = np.zeros(len(crease), bool) if keep is None else keep
+    swaps, timed_out = 0, False
+    for _ in range(MAX_PASSES):  # a swap can open room for another: pass again while one helps
+        done = swaps
+        for v in np.argsort(-pen, kind="stable")[:int(np.count_nonzero(pen > 0))]:
+            if pen[v] <= 0:  # opened by an earlier swap
+                continue
+            if deadline.expired():
+                timed_out = True
+                break
+            swapped = _open_one(int(v), net, crease, fans, pen, problem, edges, edge_faces, inner, keep)
+            if swapped is not None:
+                net = swapped
+                swaps += 1
+        if swaps == done or timed_out:
+            break
+    return net, TabRoomStats(before, int(np.count_nonzero(pen > 0)), swaps, timed_out)
+
+
+def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep) -> Net | None:
+    """One swap at vertex v's narrowest corner, if one lowers the penalty and keeps the net
+    overlap-free; updates crease and pen in place. Returns the new net or None."""
+    corners = fans.corners(v, crease)
+    if not corners:
+        return None
+    e_in, e_out, held = min(corners, key=lambda c: 2 * math.pi - c[2])
+    # the creases inside this corner, with the angle held before each: cut the one nearest half
+    walk = _creases_in_corner(fans, v, e_in, crease)
+    if not walk:
+        return None
+    target = held / 2
+    walk.sort(key=lambda ea: abs(ea[1] - target))
+    tin, tout = _dfs_intervals(net.parent)
+    verts = net.mesh.vertices
+    mid = verts[edges].mean(axis=1)
+    here = verts[v]
+    for e2, _ in walk[:MAX_CUTS]:
+        if keep[e2]:
+            continue
+        a, b = edge_faces[e2]
+        child = a if net.parent[a] == b else b  # the face below the crease in the tree
+        in_sub = (tin >= tin[child]) & (tin < tout[child])
+        fa, fb = edge_faces[:, 0], edge_faces[:, 1]
+        cand = np.flatnonzero(inner & ~crease & (in_sub[np.maximum(fa, 0)] != in_sub[np.maximum(fb, 0)]))
+        scored = []
+        for g in cand:
+            touched = {int(x) for x in (*edges[e2], *edges[g])}
+            crease[e2], crease[g] = False, True
+            new = {u: fans.penalty(u, crease) for u in touched}
+            crease[e2], crease[g] = True, False
+            delta = sum(new.values()) - sum(pen[u] for u in touched)
+            if delta < -1e-9:
+                scored.append((delta, int(g), new))
+        # equal gains: the cut edge nearest v first (the moved half turns least, overlaps least)
+        scored.sort(key=lambda s: (round(s[0], 2), float(np.linalg.norm(mid[s[1]] - here)), s[1]))
+        for delta, g, new in scored[:MAX_TRIES]:
+            crease[e2], crease[g] = False, True
+            relaid = _relaid(net, problem, crease)
+            if relaid is not None:
+                for u, p in new.items():
+                    pen[u] = p
+                return relaid
+            crease[e2], crease[g] = True, False
+    return None
+
+
+def _creases_in_corner(fans: _Fans, v: int, e_in: int, crease: np.ndarray) -> list[tuple[int, float]]:
+    """(crease, angle held before it) for the creases met turning around v from cut edge e_in."""
+    for i in range(fans.ptr[v], fans.ptr[v + 1]):
+        f, j = int(fans.inc_face[i]), int(fans.inc_corner[i])
+        if int(fans.face_edges[f, (j + 2) % 3]) == e_in:
+            break
+    else:
+        return []
+    out, held = [], 0.0
+    for _ in range(fans.ptr[v + 1] - fans.ptr[v]):
+        held += float(fans.angle[f, j])
+        e = int(fans.face_edges[f, j])
+        if not crease[e]:
+            break
+        out.append((e, held))
+        a, b = fans.edge_faces[e]
+        f = int(b if a == f else a)
+        j = int(np.flatnonzero(fans.faces[f] == v)[0])
+    return out
