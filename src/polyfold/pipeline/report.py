@@ -104,6 +104,8 @@ class LayoutReport:
     untabbed_edges: tuple[str, ...]
     small_labels: int
     open_edges: int
+    smallest_edge_mm: float  # shortest printed face edge
+    smallest_face_mm: float  # smallest height of a printed face (twice its area over its longest side)
 
 
 @dataclass(frozen=True)

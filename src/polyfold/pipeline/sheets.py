@@ -52,7 +52,8 @@ def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, page: tuple[fl
 @dataclass(frozen=True, eq=False)
 class Sheets:
     """The pieces in mm, placed on their pages (pieces[i] is folded[i]), the glue pairs, the
-    layout facts, the packing (page of each piece) and the page size."""
+    layout facts, the packing (page of each piece), the page size and the scale (mm per model
+    unit)."""
 
     pieces: tuple[SheetPiece, ...]
     glue: tuple[GlueEdge, ...]
@@ -61,6 +62,7 @@ class Sheets:
     width: float
     height: float
     seconds: float
+    scale: float
 
     def page_of_piece(self) -> list[int]:
         """0-based page of every piece."""
@@ -82,4 +84,4 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     packing = pack_outlines([p.outline for p in pieces], printable(width, height), margin=opts.margin,
                             gap=GAP_MM, seed=opts.seed, time_limit=max(2.0, min(10.0, deadline.left())))
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
-    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl)
+    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl, scale)

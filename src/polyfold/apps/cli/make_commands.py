@@ -9,6 +9,7 @@ from typing import List, Optional
 
 import typer
 
+from ...fabricate.paper import BUILDABLE_EDGE_MM, size_for_edge
 from . import options
 from .app import app, bench_app, fail, guard, load, say
 
@@ -52,10 +53,15 @@ def make(
         if lay.untabbed_edges:
             say(f"warning: {len(lay.untabbed_edges)} glue edge(s) without a tab (no room on either side): "
                  f"{', '.join(lay.untabbed_edges[:10])}{' ...' if len(lay.untabbed_edges) > 10 else ''}")
+        if lay.smallest_edge_mm < BUILDABLE_EDGE_MM:
+            say(f"warning: the smallest printed edge is {lay.smallest_edge_mm:.3g} mm, under {BUILDABLE_EDGE_MM:g} mm "
+                f"(hard to fold and glue): --size {size_for_edge(size, lay.smallest_edge_mm)} would make it "
+                f"{BUILDABLE_EDGE_MM:g} mm")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
-             f"page(s), {rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
+             f"page(s), smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
+             f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 
 
