@@ -1,7 +1,7 @@
-"""pipeline/export.py: the FOLD pieces of a make folder are in mm where they are printed (their
-sheet transform puts every net vertex on the printed lines of their page, their folded frame is
-the part at the printed scale), and the FOLD project's own ORIPA converter (npm `fold`) keeps every
-vertex of them."""
+"""pipeline/export.py, its FOLD pieces (the rest of export: test_export.py): in mm where they are
+printed (their sheet transform puts every net vertex on the printed lines of their page, their
+folded frame is the part at the printed scale), and the FOLD project's own ORIPA converter (npm
+`fold`) keeps every vertex of them."""
 
 from __future__ import annotations
 
