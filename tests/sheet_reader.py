@@ -7,7 +7,9 @@ Every reader gives `Sheet`s in page millimetres, origin at the page's top-left c
 SVG's frame; DXF and PDF have y up and are flipped here):
 
 - outlines: closed cut paths (rings (n, 2), first point not repeated);
-- cut_lines (k, 2, 2): open cut strokes (slits), as segments;
+- cut_lines (k, 2, 2): open cut strokes (slits) on the pieces, as segments; open cut-coloured
+  strokes off the pieces (a scale bar, registration corners: a PDF tells them by colour only) are
+  printed marks, in `marks`;
 - folds: {"mountain": (k, 2, 2), "valley": (k, 2, 2)} scored lines, as segments; fold_classes
   gives the SVG class of each segment (e.g. "valley" or "tab-fold"; "" in DXF and PDF);
 - faces / tabs: the SVG preview's face and tab polygons (empty for DXF; the PDF's fills are in
@@ -93,6 +95,7 @@ class Sheet:
     tabs: list[np.ndarray] = field(default_factory=list)
     fills: list[tuple[tuple[float, float, float], np.ndarray]] = field(default_factory=list)
     labels: list[Label] = field(default_factory=list)
+    marks: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))
 
     def lines(self) -> np.ndarray:
         """Every cut and fold stroke as segments (k, 2, 2): outline sides, slits, folds."""
@@ -160,7 +163,10 @@ def _finish(sheet: Sheet, strokes: list[tuple[str, str, list[np.ndarray], list[n
             segs = _segments(opens + [np.vstack([r, r[:1]]) for r in rings])
             folds[kind].append(segs)
             classes[kind].extend([cls] * len(segs))
-    sheet.cut_lines = _segments(cut_open)
+    cuts = _segments(cut_open)
+    paper = shapely.union_all([shapely.make_valid(shapely.Polygon(r)) for r in sheet.outlines if len(r) >= 3]).buffer(0.01)
+    on = np.array([paper.covers(shapely.LineString(seg)) for seg in cuts], dtype=bool).reshape(-1)
+    sheet.cut_lines, sheet.marks = cuts[on].reshape(-1, 2, 2), cuts[~on].reshape(-1, 2, 2)
     sheet.folds = {k: np.concatenate(v) if v else np.zeros((0, 2, 2)) for k, v in folds.items()}
     sheet.fold_classes = classes
     return sheet
