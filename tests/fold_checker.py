@@ -17,6 +17,10 @@ b. congruence with the mesh: every net triangle has the side lengths of its sour
 c. no two faces overlap in the plane;
 d. the number of pieces (faces joined by creases);
 e. folding each piece by its edges_foldAngle reproduces the foldedForm, which is the mesh itself.
+
+Units: a net in the mesh's units is compared with the mesh as it is; a net in mm (`frame_unit`
+"mm", as `polyfold make` writes its pieces) with the mesh times the file's
+`polyfold:mmPerModelUnit`.
 """
 
 from __future__ import annotations
@@ -448,6 +452,8 @@ def check_fold(fold_path, mesh_path, tol: float = 1e-6, orientation: str = "sour
     if report.problems:
         return report
     verts, polys = read_mesh(os.fspath(mesh_path))
+    if fold.get("frame_unit") == "mm" and "polyfold:mmPerModelUnit" in fold:
+        verts = verts * float(fold["polyfold:mmPerModelUnit"])  # the mesh at the net's scale
     used_v = sorted({v for p in polys for v in p if 0 <= v < len(verts)})
     diag = float(np.linalg.norm(np.ptp(verts[used_v], axis=0))) if used_v else 0.0
     if not diag > 0:

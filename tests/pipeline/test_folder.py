@@ -37,7 +37,9 @@ def test_pose_follows_the_path(make_dir: Path) -> None:
     moved = 0
     for piece in folder.pieces:
         fold = piece.fold
-        folded = np.asarray(fold["file_frames"][0]["vertices_coords"])[np.asarray(fold["faces_vertices"])]
+        # make's pieces are in mm; poses are in the model's units (those of the part OBJs)
+        assert fold["frame_unit"] == "mm" and piece.unit == 1 / fold["polyfold:mmPerModelUnit"]
+        folded = np.asarray(fold["file_frames"][0]["vertices_coords"])[np.asarray(fold["faces_vertices"])] * piece.unit
         goal = piece.pose(1.0)
         # t = 1 lands exactly on the model (the foldedForm), in the model's own frame
         assert np.abs(goal - folded).max() < 1e-9 * size, piece.name
@@ -46,7 +48,8 @@ def test_pose_follows_the_path(make_dir: Path) -> None:
         # t = 0 is the flat net: every corner in one plane, the same triangles as the crease pattern
         centred = flat.reshape(-1, 3) - flat.reshape(-1, 3).mean(axis=0)
         assert np.linalg.svd(centred, compute_uv=False)[2] < 1e-9 * size
-        xy = np.asarray(fold["vertices_coords"])[np.asarray(fold["faces_vertices"])]
+        xy = np.asarray(fold["vertices_coords"])[np.asarray(fold["faces_vertices"])] * piece.unit
+        np.testing.assert_allclose(piece.flat_xy[np.asarray(fold["faces_vertices"])], xy)
         flat_xy = np.concatenate([xy, np.zeros(xy.shape[:2] + (1,))], axis=2)
         np.testing.assert_allclose(_edge_lengths(flat), _edge_lengths(flat_xy), atol=1e-9 * size)
         # in between: rigid faces (paper does not stretch)

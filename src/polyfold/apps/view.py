@@ -331,7 +331,7 @@ class Viewer:
         x = y = shelf = 0.0
         gap = 0.15
         for i, piece in enumerate(pieces):
-            xy = piece.net.coords * self._k
+            xy = piece.flat_xy * self._k
             faces = piece.net.faces
             lo, hi = xy.min(axis=0), xy.max(axis=0)
             w, d = hi - lo

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import PolyfoldError
+from ..mesh.geometry import face_areas
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net, cut_creases, subtree_areas
 from .pack import fits_page
@@ -35,6 +36,16 @@ def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> 
 
     hull = shapely.convex_hull(shapely.multipoints(points_mm)).buffer(pad, quad_segs=2)
     return fits_page(hull, page_size, margin)
+
+
+def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
+    """(shortest edge, smallest face height) of the mesh's faces printed at `scale` mm per model
+    unit, in mm. A face's smallest height is twice its area over its longest side: the width of
+    the narrowest strip of paper it makes (0 for a degenerate face)."""
+    tri = mesh.vertices[mesh.faces]
+    sides = np.linalg.norm(tri - np.roll(tri, -1, axis=1), axis=2)
+    heights = 2.0 * face_areas(mesh.vertices, mesh.faces) / np.maximum(sides.max(axis=1), 1e-300)
+    return float(sides.min()) * scale, float(heights.min()) * scale
 
 
 def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin: float,

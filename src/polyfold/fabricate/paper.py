@@ -10,6 +10,8 @@ extension draws them), the L legs `MARK_LEG_MM` long and `MARK_LINE_MM` thick. S
 print"; pieces keep out of them.
 """
 
+import math
+
 GAP_MM = 3.0  # minimum distance between pieces on a page, tabs included (room for scissors)
 FOOTER_MM = 6.0  # strip at the bottom of the printable area for the footer line and the scale bar
 FOOTER_FONT_MM = 2.5  # the footer line's font size
@@ -23,3 +25,10 @@ MARK_CLEAR_MM = MARK_INSET_MM + MARK_LEG_MM  # corner squares kept free of piece
 CAP_HEIGHT = 0.718  # Helvetica's cap height per em: a label's printed height, the DXF text height
 CHAR_EM = 0.62  # mean advance width of a Helvetica digit/capital, in em
 MIN_LABEL_MM = 2.0  # default least cap height of a label (`--min-label-mm`): readable when printed
+BUILDABLE_EDGE_MM = 5.0  # shorter printed edges are hard to cut, fold and glue: make warns
+
+
+def size_for_edge(size_mm: float, smallest_edge_mm: float, edge_mm: float = BUILDABLE_EDGE_MM) -> int:
+    """The --size (mm, rounded up to a whole mm) at which the smallest printed edge, now
+    smallest_edge_mm at size_mm, becomes edge_mm (the scale is proportional to the size)."""
+    return math.ceil(size_mm * edge_mm / smallest_edge_mm)

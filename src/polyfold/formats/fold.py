@@ -7,7 +7,8 @@ mountains), and a `foldedForm` frame holding the 3D position of every net vertex
 `polyfold:faces_meshFace` (source face in the input file's face order), `polyfold:faces_piece`,
 `polyfold:faces_component`, `polyfold:faces_parent` (the tree: net face joined to each face by a
 crease, -1 at the root of a piece), `polyfold:edges_meshEdge` (twin cut edges share the number),
-`polyfold:vertices_meshVertex`.
+`polyfold:vertices_meshVertex`. These files (`polyfold unfold`) are in the mesh's units
+(`frame_unit` "unit"); `piece_fold` writes make's pieces in mm as printed.
 """
 
 from __future__ import annotations
@@ -258,16 +259,41 @@ def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: fl
     return out
 
 
+PAGE_TO_FOLD = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # page mm (y down) <-> FOLD mm (y up): its own inverse
+
+
 def piece_fold(pattern: CreasePattern, *, title: str, file_title: str, whole_mesh_faces: Sequence[int],
-               path: FoldPath | None = None, resolution_deg: float = 1.0, contact_tol: float = CONTACT_TOL) -> dict:
+               path: FoldPath | None = None, resolution_deg: float = 1.0, contact_tol: float = CONTACT_TOL,
+               mm_per_unit: float | None = None, page: int | None = None, to_page: np.ndarray | None = None) -> dict:
     """The FOLD document of one piece of a make folder: its crease pattern (frame_title `title`),
     its folding path when it has one (`with_path`), file_title, and `polyfold:faces_wholeMeshFace`
-    (the piece's faces as faces of the whole model)."""
+    (the piece's faces as faces of the whole model).
+
+    Printed scale (make): with mm_per_unit (mm per model unit), page (1-based) and to_page (2, 3),
+    the affine map from the pattern's coordinates (model units, y up) to the printed piece on its
+    page (mm, origin at the page's top-left corner, y down), the file is in mm (`frame_unit` "mm"):
+    vertices_coords are the printed positions in the FOLD convention, (x, -y) of the page point
+    (y up, the printed = outer side facing +z, faces still CCW), the foldedForm frame is the model
+    scaled to mm, and the custom keys are `polyfold:page`, `polyfold:sheet_transform` (the 2x3
+    matrix [[a, b, c], [d, e, f]] taking a vertex (x, y) of the file to the page point
+    (a x + b y + c, d x + e y + f) in mm, origin top-left, y down: here [[1, 0, 0], [0, -1, 0]])
+    and `polyfold:mmPerModelUnit` (the model, e.g. part-K.obj, times this is the foldedForm).
+    Fold angles, the path and its relative contact tolerance do not depend on the unit."""
     fold = pattern_fold(pattern, title=title)
     if path is not None:
         fold = with_path(fold, path, resolution_deg, contact_tol)
     fold["file_title"] = file_title
     fold["polyfold:faces_wholeMeshFace"] = [int(x) for x in whole_mesh_faces]
+    if mm_per_unit is not None:
+        if to_page is None or page is None:
+            raise ValueError("a FOLD piece in mm needs its page and its placement (to_page)")
+        a = PAGE_TO_FOLD[:, :2] @ np.asarray(to_page, dtype=np.float64)  # pattern -> FOLD mm (y up)
+        fold["frame_unit"] = "mm"
+        fold["vertices_coords"] = (pattern.coords @ a[:, :2].T + a[:, 2]).tolist()
+        fold["file_frames"] = [dict(fold["file_frames"][0], vertices_coords=(pattern.folded * mm_per_unit).tolist())]
+        fold["polyfold:page"] = int(page)
+        fold["polyfold:sheet_transform"] = PAGE_TO_FOLD.tolist()
+        fold["polyfold:mmPerModelUnit"] = float(mm_per_unit)
     return fold
 
 

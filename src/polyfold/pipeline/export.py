@@ -3,7 +3,8 @@ in at the end (report.json last, so it marks a finished run).
 
 The folder: sheets.pdf (all pages), sheet-NN.svg (print), cut-NN.svg (cutting machines: cut and
 score lines only) and sheet-NN.dxf per page, part-K.obj per part, piece-X.fold per piece (net,
-folding path, source faces), assembly.json, instructions.html and report.json. Every printed page
+folding path, source faces; in mm where it is printed, with its page and sheet transform:
+`formats.fold.piece_fold`), assembly.json, instructions.html and report.json. Every printed page
 has a scale bar in its footer; with --marks, registration marks. Files of an earlier run that
 this run does not produce are removed (they would be mistaken for this run's).
 """
@@ -14,6 +15,9 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
+from ..fabricate.pack import Placement
 from ..fabricate.page import Page, footer, page_of, registration_marks
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
@@ -22,6 +26,8 @@ from ..formats.meshes import obj_text
 from ..formats.pdf import pdf_bytes
 from ..formats.svg import cut_svg_string, svg_page_string
 from ..mesh.mesh import Mesh
+from ..unfold.net import Net
+from ..unfold.pattern import CreasePattern
 from .folding import FoldedPiece
 from .instructions import instructions_html
 from .options import MakeOptions
@@ -47,6 +53,14 @@ def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
     return pages
 
 
+def pattern_to_page(pattern: CreasePattern, net: Net, scale: float, placement: Placement) -> np.ndarray:
+    """The affine map (2, 3) from a piece's crease pattern coordinates (model units, y up; the
+    net's corners translated) to where the piece is printed on its page (mm, y down): scaled and
+    y flipped as `fabricate.pieces` draws it, then rotated and moved by the packer's placement."""
+    shift = (pattern.coords[pattern.faces] - net.coords).reshape(-1, 2).mean(axis=0)  # pattern = net + shift
+    origin, ex, ey = placement.apply(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]))
+    linear = np.column_stack([ex - origin, ey - origin]) @ np.diag([scale, -scale])  # rotation @ flip @ scale
+    return np.column_stack([linear, origin - linear @ shift])
 
 
 def piece_reports(folded: list[FoldedPiece], sheets: Sheets) -> tuple[PieceReport, ...]:
@@ -93,11 +107,12 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             sub = mesh.submesh(part.faces)
             stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
         rows = piece_reports(folded, sheets)
-        for fp, piece, row in zip(folded, sheets.pieces, rows):
+        for fp, piece, row, placement in zip(folded, sheets.pieces, rows, sheets.packing.placements):
             stage.write(row.fold_file, dumps(piece_fold(
                 fp.pattern, title=f"part {fp.part} piece", file_title=f"{model} piece {piece.name} (part {fp.part})",
                 whole_mesh_faces=fp.mesh_faces, path=fp.path, resolution_deg=opts.resolution_deg,
-                contact_tol=opts.contact_tol)))
+                contact_tol=opts.contact_tol, mm_per_unit=sheets.scale, page=row.page,
+                to_page=pattern_to_page(fp.pattern, fp.net, sheets.scale, placement))))
         stage.write("assembly.json", assembly(model, opts, parts, sheets, rows).to_json())
         stage.write("instructions.html", instructions_html(
             model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),

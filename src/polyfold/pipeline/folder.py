@@ -36,9 +36,11 @@ class ViewPiece:
     frames (K, E): the folding path in FOLD degrees (valley positive), None when the piece has no
     verified path (it is then shown folded only);
     rotation (P, 3, 3) / translation (P, 3): per FOLD piece, the rigid motion (Kabsch fit of the
-    goal pose onto the foldedForm) that puts the folded net onto the model; fit_error: largest
-    corner distance between the aligned goal pose and the foldedForm, in model units (nan
-    without a foldedForm frame).
+    goal pose onto the foldedForm) that puts the folded net onto the model, in the file's unit;
+    unit: model units per unit of the file (1 / `polyfold:mmPerModelUnit` for make's pieces,
+    which are in mm; 1 for files in the model's units); fit_error: largest corner distance
+    between the aligned goal pose and the foldedForm, in model units (nan without a foldedForm
+    frame).
     """
 
     name: str
@@ -49,6 +51,7 @@ class ViewPiece:
     rotation: np.ndarray
     translation: np.ndarray
     fit_error: float
+    unit: float = 1.0
 
     @property
     def verified(self) -> bool:
@@ -58,13 +61,19 @@ class ViewPiece:
     def tree(self) -> FoldTree:
         return self.net.tree
 
+    @property
+    def flat_xy(self) -> np.ndarray:
+        """The flat net's vertices (V, 2) in model units (printed side +z)."""
+        return self.net.coords * self.unit
+
     def pose(self, t: float) -> np.ndarray:
         """Face corners (F, 3, 3) in the model frame at fraction t in [0, 1] of the folding path
         (0 flat, 1 folded onto the model). Without a path the piece stays folded."""
         deg = self.net.goal if self.frames is None else path_degrees(self.frames, t)
         corners = fold_positions(self.tree, fold_deg_to_rho(deg))
         piece = self.tree.piece
-        return np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
+        posed = np.einsum("fij,fkj->fki", self.rotation[piece], corners) + self.translation[piece][:, None, :]
+        return posed * self.unit if self.unit != 1.0 else posed
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,9 +112,21 @@ def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return r, cq - r @ cp
 
 
+def model_units_per_file_unit(fold: dict) -> float:
+    """Model units per unit of a FOLD file: 1 / `polyfold:mmPerModelUnit` for a file in mm that
+    states it (make's pieces), else 1. PolyfoldError when the stated scale is not positive."""
+    if fold.get("frame_unit") != "mm" or "polyfold:mmPerModelUnit" not in fold:
+        return 1.0
+    scale = fold["polyfold:mmPerModelUnit"]
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (math.isfinite(scale) and scale > 0):
+        raise PolyfoldError(f"polyfold:mmPerModelUnit must be a positive number, not {scale!r}")
+    return 1.0 / float(scale)
+
+
 def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
     """A ViewPiece of a FOLD dict: builds the fold tree, checks the path and fits the rigid motion
     that lands the goal pose on the foldedForm (fold_positions keeps each root face flat)."""
+    unit = model_units_per_file_unit(fold)
     net = fold_net(fold)
     tree = net.tree
     frames = net.path
@@ -128,7 +149,7 @@ def prepare_piece(fold: dict, name: str = "", part: int = 0) -> ViewPiece:
             moved = goal[on] @ r.T + t
             fit_error = max(fit_error, float(np.abs(moved - target[on]).max()))
     return ViewPiece(name=name, part=part, fold=fold, net=net, frames=frames, rotation=rotation,
-                     translation=translation, fit_error=fit_error)
+                     translation=translation, fit_error=fit_error * unit, unit=unit)
 
 
 def pose_piece(fold: dict, t: float) -> np.ndarray:

@@ -18,7 +18,7 @@ from typing import Callable
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fabricate.check import check_pages
-from ..fabricate.fit import model_scale
+from ..fabricate.fit import model_scale, smallest_printed
 from ..fabricate.paper import GAP_MM
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
@@ -94,15 +94,18 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     return report
 
 
-def _layout_report(sheets: Sheets, opts: MakeOptions, scale: float, splits: int, seconds: float) -> LayoutReport:
+def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, splits: int,
+                   seconds: float) -> LayoutReport:
     st = sheets.stats
+    edge, face = smallest_printed(mesh, scale)
     return LayoutReport(
         seconds=seconds, scale_mm_per_unit=scale, paper=opts.paper, page_mm=(sheets.width, sheets.height),
         margin_mm=opts.margin, pages=sheets.packing.n_pages,
         utilisation=sheets.packing.utilisation, splits_for_page=splits, glue_edges=st.glue_edges, tabs=st.tabs,
         tabs_shrunk=st.tabs_shrunk, tabs_moved=st.tabs_moved, untabbed_edges=tuple(st.untabbed),
-        small_labels=st.small_labels, open_edges=st.open_edges, reduced_tabs=st.reduced_tabs,
-        labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside, min_label_mm=opts.min_label_mm)
+        small_labels=st.small_labels, open_edges=st.open_edges, smallest_edge_mm=edge, smallest_face_mm=face,
+        reduced_tabs=st.reduced_tabs, labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside,
+        min_label_mm=opts.min_label_mm)
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),
@@ -129,7 +132,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     folded, fold_report = fold_pieces(fitted, opts, deadline, say)
     sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say)
     checks = _check(sheets, opts, name, fold_report.verified, say)
-    layout_report = _layout_report(sheets, opts, scale, page_splits, sheets.seconds + fit_seconds)
+    layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, sheets.seconds + fit_seconds)
     te = time.perf_counter()
     say("export", "writing sheets and files")
 

@@ -104,6 +104,8 @@ class LayoutReport:
     untabbed_edges: tuple[str, ...]
     small_labels: int  # glue labels with no readable place (never shrunk: at their face's centroid)
     open_edges: int
+    smallest_edge_mm: float  # shortest printed face edge
+    smallest_face_mm: float  # smallest height of a printed face (twice its area over its longest side)
     reduced_tabs: tuple[tuple[str, str], ...] = ()  # (edge label, why): "flatter", "lower", "tapered", "split", "glue strip"
     labels_on_tabs: int = 0
     labels_outside: int = 0  # beside their edge, with a leader line when further away

@@ -69,7 +69,8 @@ def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[flo
 @dataclass(frozen=True, eq=False)
 class Sheets:
     """The pieces in mm, placed on their pages (pieces[i] is folded[i]), the glue pairs, the
-    layout facts, the packing (page of each piece) and the page size."""
+    layout facts, the packing (page of each piece), the page size and the scale (mm per model
+    unit)."""
 
     pieces: tuple[SheetPiece, ...]
     glue: tuple[GlueEdge, ...]
@@ -78,6 +79,7 @@ class Sheets:
     width: float
     height: float
     seconds: float
+    scale: float
 
     def page_of_piece(self) -> list[int]:
         """0-based page of every piece."""
@@ -101,4 +103,4 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                             time_limit=max(2.0, min(10.0, deadline.left())))
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
-    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl)
+    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl, scale)

@@ -6,9 +6,13 @@ test_batch.py, test_benchpaper.py.)"""
 from __future__ import annotations
 
 import json
+import math
 import re
 from collections import Counter
 from pathlib import Path
+
+import numpy as np
+import pytest
 
 from conftest import check_sheet, one_line, read_sheet, run_cli
 from fold_checker import check_fold, read_mesh
@@ -98,3 +102,35 @@ def test_too_large_and_bad_options(models_dir, tmp_path):
     assert proc.returncode == 2 and "--tau or --parts" in one_line(proc.stderr)
     proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--paper", "50x80mm", "--marks", "-q")
     assert proc.returncode == 2 and "--marks" in one_line(proc.stderr)
+
+
+def _smallest_edge_mm(mesh_path: Path, size: float) -> float:
+    """The shortest face edge of a mesh file at the printed size (longest box side = size mm)."""
+    verts, polys = read_mesh(str(mesh_path))
+    used = sorted({v for p in polys for v in p})
+    scale = size / float(np.ptp(verts[used], axis=0).max())
+    return scale * min(float(np.linalg.norm(verts[p[k]] - verts[p[k - 1]])) for p in polys for k in range(len(p)))
+
+
+def test_small_edges_are_said(models_dir, tmp_path):
+    """The summary line and report.json give the smallest printed edge and face; under 5 mm, one
+    warning line names the --size that reaches 5 mm, and at that size there is no warning."""
+    src = models_dir / "bumpy-528.obj"
+    proc = run_cli("make", src, "-o", tmp_path / "a")
+    assert proc.returncode == 0, proc.stderr
+    lay = json.loads((tmp_path / "a" / "report.json").read_text())["stages"]["layout"]
+    edge = _smallest_edge_mm(src, 150.0)
+    assert edge < 5.0 and lay["smallest_edge_mm"] == pytest.approx(edge, rel=1e-9)
+    assert 0 < lay["smallest_face_mm"] <= lay["smallest_edge_mm"]
+    warnings = [ln for ln in proc.stderr.splitlines() if "smallest printed edge" in ln]
+    size = math.ceil(150.0 * 5.0 / edge)
+    assert len(warnings) == 1 and warnings[0].startswith("polyfold: warning:"), proc.stderr
+    assert f"is {edge:.3g} mm" in warnings[0] and f"--size {size} would" in warnings[0]
+    summary = proc.stderr.strip().splitlines()[-1]
+    assert (f"smallest edge {lay['smallest_edge_mm']:.3g} mm, narrowest face {lay['smallest_face_mm']:.3g} mm"
+            in summary)
+    proc = run_cli("make", src, "-o", tmp_path / "b", "--size", size)
+    assert proc.returncode == 0, proc.stderr
+    assert "smallest printed edge" not in proc.stderr
+    lay = json.loads((tmp_path / "b" / "report.json").read_text())["stages"]["layout"]
+    assert 5.0 <= lay["smallest_edge_mm"] < 5.0 * (size + 1) / size

@@ -9,6 +9,7 @@ from typing import List, Optional
 
 import typer
 
+from ...fabricate.paper import BUILDABLE_EDGE_MM, size_for_edge
 from . import options
 from .app import app, bench_app, fail, guard, load, say
 
@@ -62,10 +63,15 @@ def make(
         if lay.small_labels:
             say(f"warning: {lay.small_labels} label(s) found no free place at {lay.min_label_mm:g} mm and are "
                 "printed over their face (try a larger --size or a smaller --min-label-mm)")
+        if lay.smallest_edge_mm < BUILDABLE_EDGE_MM:
+            say(f"warning: the smallest printed edge is {lay.smallest_edge_mm:.3g} mm, under {BUILDABLE_EDGE_MM:g} mm "
+                f"(hard to fold and glue): --size {size_for_edge(size, lay.smallest_edge_mm)} would make it "
+                f"{BUILDABLE_EDGE_MM:g} mm")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
-             f"page(s), {rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
+             f"page(s), smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
+             f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 
 

@@ -1,0 +1,414 @@
+"""How buildable a `polyfold make` folder is, measured from its written files and the mesh alone.
+
+Stands alone (numpy, shapely, trimesh, and `sheet_reader` for the SVG / DXF / PDF; never
+polyfold): used by bench/bench_build.py and the tests. `measure_folder(folder, mesh_path)` reads
+
+- the sheets: sheet-NN.svg (print files; cut-NN.svg and other files beside them are not read),
+  sheet-NN.dxf and sheets.pdf, with `sheet_reader`;
+- assembly.json for the glue pairs (label, the mesh edge's two vertices, the pieces) and the size;
+  report.json only for the margin option;
+- the mesh file with trimesh (file order kept), scaled as make scales it (its longest bounding-box
+  side becomes size_mm); its fold angles are computed here (outward normals, + = convex).
+
+and measures (`Measures`):
+
+- pieces (assembly), pages (SVG files), utilisation: paper area of the pieces (SVG cut outlines,
+  holes removed) over pages x the page inside the margins;
+- glue edges: the assembly's glue pairs. Each label is printed beside both copies of its edge;
+  a copy is found on its page as the pair of printed corner points (outline corners, ends of
+  lines) of the edge's printed length nearest to the label. Beside it: the face (a preview face)
+  and beyond it either a tab (paper that is no face, attached along the edge, with a fold line
+  on the edge in the SVG), a face (a slit) or nothing;
+- untabbed: glue edges with no tab beyond either copy; reduced tabs: tabs shallower than the full
+  tab, min(0.4 x edge, 6 mm) (today's full size), measured as the tab's depth from its edge;
+- wrong-way fold marks (per format: svg, dxf, pdf): a tab whose fold line along its edge is not
+  drawn as its seam folds (mountain on a convex seam, valley on a concave one, seen from the
+  printed side = the outside), or is not drawn; seams within FLAT_DEG of flat take either;
+- labels (SVG; the footer and other titles not counted): under the minimum (cap height below
+  LABEL_MIN_MM), overlapping pairs of label boxes, and labels whose box crosses a cut or fold line;
+- flat regions cut: glue edges between faces within FLAT_DEG of coplanar, or along a diagonal of
+  a polygon of the input file (OBJ faces of 4 or more corners);
+- smallest printed edge and smallest face height (twice area over longest side), mm.
+
+`notes` says what could not be matched (labels not printed twice, copies not found, ...), so a
+number is never silently wrong.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from sheet_reader import FOLD_KINDS, Sheet, read_dxf, read_pdf, read_svg
+
+FLAT_DEG = 0.5  # seams flatter than this count as flat (coplanar faces)
+LABEL_MIN_MM = 2.0  # smallest readable cap height
+FULL_TAB_MM = 6.0  # today's full tab: min(FULL_TAB_REL x edge, FULL_TAB_MM) deep
+FULL_TAB_REL = 0.4
+LENGTH_TOL_MM = 1e-3  # printed and model edge lengths agree this well (coordinates are written to 1e-4 mm)
+PROBE_MM = 0.2  # how far beside an edge its sides are probed
+ATTACHED = 0.3  # a tab is attached to an edge when it runs along this fraction of it at least
+ON_LINE_MM = 0.02  # a fold line lies along an edge: both ends this close to its line
+OVERLAP_MM2 = 1e-3  # label boxes sharing less area than this only touch
+NOT_LABELS = ("title", "footer", "scale", "legend")  # text classes that are not glue or piece labels
+
+
+# ----------------------------------------------------------------------------------------------
+# The mesh
+
+
+@dataclass(frozen=True)
+class Model:
+    """A mesh file at its printed scale: vertices (model units), faces (F, 3), scale (mm per
+    unit), per undirected edge (a, b), a < b: its fold angle in degrees (+ convex, - concave,
+    None when not between exactly two faces) and whether it is a diagonal of an input polygon."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    scale: float
+    fold_deg: dict[tuple[int, int], float | None]
+    diagonals: frozenset[tuple[int, int]]
+
+
+def _obj_polygons(path: Path) -> list[list[int]]:
+    """The faces of an OBJ file as 0-based vertex lists (negative indices resolved)."""
+    polys, n_v = [], 0
+    for line in path.read_text(errors="replace").splitlines():
+        parts = line.split()
+        if not parts:
+            continue
+        if parts[0] == "v":
+            n_v += 1
+        elif parts[0] == "f":
+            ids = [int(p.split("/")[0]) for p in parts[1:]]
+            polys.append([i - 1 if i > 0 else n_v + i for i in ids])
+    return polys
+
+
+def load_model(mesh_path: str | Path, size_mm: float) -> Model:
+    """The mesh (trimesh, file order kept) scaled so its longest bounding-box side is size_mm."""
+    import trimesh
+
+    path = Path(mesh_path)
+    mesh = trimesh.load(str(path), process=False, maintain_order=True, force="mesh")
+    v = np.asarray(mesh.vertices, dtype=float)
+    f = np.asarray(mesh.faces, dtype=np.int64)
+    used = np.unique(f)
+    scale = size_mm / float(np.ptp(v[used], axis=0).max())
+    tri = v[f]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    outward = 1.0 if float(np.einsum("ij,ij->", tri[:, 0], normal)) >= 0 else -1.0  # signed volume
+    unit = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None] * outward
+    sides: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for fi, face in enumerate(f.tolist()):
+        for k in range(3):
+            a, b = face[k], face[(k + 1) % 3]
+            sides.setdefault((min(a, b), max(a, b)), []).append((fi, face[(k + 2) % 3]))
+    fold_deg: dict[tuple[int, int], float | None] = {}
+    for key, owners in sides.items():
+        if len(owners) != 2:
+            fold_deg[key] = None
+            continue
+        (f1, _), (_, c2) = owners
+        angle = math.degrees(math.acos(float(np.clip(unit[f1] @ unit[owners[1][0]], -1.0, 1.0))))
+        convex = float(unit[f1] @ (v[c2] - v[key[0]])) < 0  # the other face bends away from the outside
+        fold_deg[key] = angle if convex else -angle
+    diagonals = set()
+    if path.suffix.lower() == ".obj":
+        for poly in _obj_polygons(path):
+            n = len(poly)
+            for i in range(n):
+                for j in range(i + 2, n - (1 if i == 0 else 0)):
+                    diagonals.add((min(poly[i], poly[j]), max(poly[i], poly[j])))
+    return Model(v, f, scale, fold_deg, frozenset(diagonals))
+
+
+def smallest_sizes(model: Model) -> tuple[float, float]:
+    """(shortest edge, smallest face height) as printed, mm."""
+    tri = model.vertices[model.faces]
+    sides = np.linalg.norm(tri - np.roll(tri, -1, axis=1), axis=2)
+    area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    return float(sides.min()) * model.scale, float((area2 / sides.max(axis=1)).min()) * model.scale
+
+
+# ----------------------------------------------------------------------------------------------
+# The folder
+
+
+@dataclass
+class Copy:
+    """One printed copy of a glue edge: page (0-based), ends a, b (page mm), what lies beyond it
+    ("tab", "face", "none"), the tab's depth (mm, 0 without), and per format the kinds of the
+    fold lines drawn along it."""
+
+    page: int
+    a: np.ndarray
+    b: np.ndarray
+    beyond: str
+    depth: float = 0.0
+    marks: dict[str, set[str]] = field(default_factory=dict)
+
+
+@dataclass
+class Measures:
+    """What `measure_folder` measures (module docstring); the *_labels lists name the glue labels
+    concerned."""
+
+    pieces: int
+    pages: int
+    utilisation: float
+    glue_edges: int
+    untabbed: int
+    reduced_tabs: int
+    tabs: int
+    labels: int
+    small_labels: int
+    label_pairs: int
+    label_lines: int
+    flat_cut: int
+    wrong_way: dict[str, int]
+    smallest_edge_mm: float
+    smallest_face_mm: float
+    untabbed_labels: list[str] = field(default_factory=list)
+    wrong_way_labels: dict[str, list[str]] = field(default_factory=dict)
+    flat_cut_labels: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    copies: dict[str, list[Copy]] = field(default_factory=dict)  # glue label -> its printed copies found
+
+
+def _page_points(sheet: Sheet) -> np.ndarray:
+    """Every printed corner point of a page: outline corners and line ends (rounded duplicates
+    merged)."""
+    pts = [r for r in sheet.outlines] + [sheet.lines().reshape(-1, 2)]
+    allp = np.concatenate(pts) if pts else np.zeros((0, 2))
+    return np.unique(np.round(allp, 4), axis=0)
+
+
+class _Page:
+    """One page with what the measures need: its points, paper, faces and tab regions."""
+
+    def __init__(self, svg: Sheet) -> None:
+        self.svg = svg
+        self.points = _page_points(svg)
+        pieces = svg.pieces()
+        self.paper = shapely.union_all(pieces) if pieces else shapely.Polygon()
+        self.area = float(sum(p.area for p in pieces))
+        self.n_pieces = len(pieces)
+        faces = [shapely.Polygon(f) for f in svg.faces if len(f) >= 3]
+        self.faces = shapely.union_all(faces).buffer(1e-3) if faces else shapely.Polygon()
+        self.has_faces = bool(faces)
+        self.tabs = shapely.difference(self.paper, self.faces)
+        shapely.prepare(self.paper)
+        shapely.prepare(self.faces)
+
+    def locate(self, label_xy: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The printed face edge of `length` mm nearest the label: two corner points that far apart
+        (within LENGTH_TOL_MM; failing that, within 10 times as much: a corner merged with a
+        tab corner close by) with a face all along one side (when the page has preview faces)."""
+        d = np.linalg.norm(self.points - label_xy, axis=1)
+        near = self.points[d <= length + 20.0]
+        if len(near) < 2:
+            return None
+        i, j = np.triu_indices(len(near), 1)
+        error = np.abs(np.linalg.norm(near[i] - near[j], axis=1) - length)
+        for tol in (LENGTH_TOL_MM + 1e-5 * length, 10 * (LENGTH_TOL_MM + 1e-5 * length)):
+            ok = error <= tol
+            if not ok.any():
+                continue
+            a, b = near[i[ok]], near[j[ok]]
+            ab = b - a
+            t = np.clip(np.einsum("ij,ij->i", label_xy - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
+            dist = np.linalg.norm(a + t[:, None] * ab - label_xy, axis=1)
+            for k in np.argsort(dist, kind="stable"):
+                if not self.has_faces or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0)):
+                    return a[k], b[k]
+        return None
+
+    def side(self, a: np.ndarray, b: np.ndarray, sign: float) -> list[str]:
+        """What lies at PROBE_MM on one side (sign +1: left of a->b in page coordinates) of the
+        segment, at five points along it: "face", "tab" (paper, no face) or "none"."""
+        ab = b - a
+        n = np.array([-ab[1], ab[0]]) / np.linalg.norm(ab) * sign
+        out = []
+        for t in (0.2, 0.35, 0.5, 0.65, 0.8):
+            p = shapely.Point(*(a + t * ab + PROBE_MM * n))
+            out.append("face" if self.faces.contains(p) else "tab" if self.paper.contains(p) else "none")
+        return out
+
+    def tab_beyond(self, a: np.ndarray, b: np.ndarray, sign: float) -> float | None:
+        """Depth (mm) of the tab attached to the segment on that side (its farthest point from the
+        edge), or None when no tab is: a tab region there that runs along at least ATTACHED of
+        the segment (the tab of another copy reaching into a notch beside it does not count)."""
+        ab = b - a
+        n = np.array([-ab[1], ab[0]]) / np.linalg.norm(ab) * sign
+        probes = [shapely.Point(*(a + t * ab + PROBE_MM * n)) for t in (0.2, 0.35, 0.5, 0.65, 0.8)]
+        edge = shapely.LineString([a, b])
+        depth = None
+        for part in getattr(self.tabs, "geoms", [self.tabs]):
+            if part.is_empty or not any(part.contains(p) for p in probes):
+                continue
+            if shapely.intersection(edge, part.buffer(ON_LINE_MM)).length < ATTACHED * edge.length:
+                continue
+            ring = np.asarray(part.exterior.coords)
+            depth = max(depth or 0.0, float(((ring - a) @ n).max()))
+        return depth
+
+
+def _marks(sheet: Sheet, a: np.ndarray, b: np.ndarray) -> set[str]:
+    """Kinds of the fold lines of a sheet that lie along segment a-b."""
+    ab = b - a
+    length = float(np.linalg.norm(ab))
+    u = ab / length
+    n = np.array([-u[1], u[0]])
+    kinds = set()
+    for kind in FOLD_KINDS:
+        segs = sheet.folds[kind]
+        if not len(segs):
+            continue
+        rel = segs - a
+        off = np.abs(rel @ n)  # (k, 2) distances of both ends to the line
+        along = rel @ u
+        lo, hi = along.min(axis=1), along.max(axis=1)
+        overlap = np.minimum(hi, length) - np.maximum(lo, 0.0)
+        hit = (off.max(axis=1) <= ON_LINE_MM) & (overlap > 0.5 * np.minimum(hi - lo, length))
+        if hit.any():
+            kinds.add(kind)
+    return kinds
+
+
+def _label_measures(sheets: list[Sheet]) -> tuple[int, int, int, int]:
+    """(labels, under the minimum, overlapping pairs, labels crossing a line) over the SVG pages."""
+    n = small = pairs = crossing = 0
+    for sheet in sheets:
+        labels = [lb for lb in sheet.labels if not any(w in lb.kind.lower() for w in NOT_LABELS)]
+        n += len(labels)
+        small += sum(lb.cap < LABEL_MIN_MM - 1e-9 for lb in labels)
+        if not labels:
+            continue
+        boxes = np.array([lb.box() for lb in labels], dtype=object)
+        i, j = shapely.STRtree(boxes).query(boxes, predicate="intersects")
+        keep = i < j
+        if keep.any():
+            pairs += int((shapely.area(shapely.intersection(boxes[i[keep]], boxes[j[keep]])) > OVERLAP_MM2).sum())
+        lines = sheet.lines()
+        if len(lines):
+            geoms = shapely.linestrings(lines)
+            hit, _ = shapely.STRtree(geoms).query(boxes, predicate="intersects")
+            crossing += len(np.unique(hit))
+    return n, small, pairs, crossing
+
+
+def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
+    """The build-quality measures of a make folder (module docstring)."""
+    folder = Path(folder)
+    assembly = json.loads((folder / "assembly.json").read_text())
+    margin = 10.0
+    report = folder / "report.json"
+    if report.is_file():
+        margin = float(json.loads(report.read_text()).get("options", {}).get("margin", margin))
+    notes: list[str] = []
+    svg_files = sorted(folder.glob("sheet-*.svg"), key=lambda p: int(re.sub(r"\D", "", p.stem) or 0))
+    svgs = [read_svg(p) for p in svg_files]
+    pages = [_Page(s) for s in svgs]
+    formats: dict[str, list[Sheet]] = {"svg": svgs}
+    dxf_files = [p.with_suffix(".dxf") for p in svg_files]
+    if all(p.is_file() for p in dxf_files):
+        formats["dxf"] = [read_dxf(p, s.height, s.width) for p, s in zip(dxf_files, svgs)]
+    else:
+        notes.append("some sheet-NN.dxf missing: DXF not measured")
+    try:
+        import pypdf  # noqa: F401 (the PDF reader's library: a test extra)
+    except ImportError:
+        notes.append("pypdf not installed: PDF not measured")
+    else:
+        pdf = read_pdf(folder / "sheets.pdf") if (folder / "sheets.pdf").is_file() else []
+        if len(pdf) == len(svgs):
+            formats["pdf"] = pdf
+        else:
+            notes.append(f"sheets.pdf has {len(pdf)} pages, {len(svgs)} SVG sheets: PDF not measured")
+    model = load_model(mesh_path, float(assembly["size_mm"]))
+    n_pieces = len(assembly["pieces"])
+    drawn = sum(p.n_pieces for p in pages)
+    if drawn != n_pieces:
+        notes.append(f"{drawn} cut outlines for {n_pieces} pieces")
+    w, h = (svgs[0].width, svgs[0].height) if svgs else (0.0, 0.0)
+    usable = len(svgs) * max(w - 2 * margin, 0.0) * max(h - 2 * margin, 0.0)
+    utilisation = sum(p.area for p in pages) / usable if usable else 0.0
+
+    # every glue label where it is printed (SVG)
+    where: dict[str, list[tuple[int, np.ndarray]]] = {}
+    for k, sheet in enumerate(svgs):
+        for lb in sheet.labels:
+            c = lb.box().centroid
+            where.setdefault(lb.text, []).append((k, np.array([c.x, c.y])))
+    untabbed, wrong, flat_cut, reduced, n_tabs = [], {f: [] for f in formats}, [], 0, 0
+    unlocated = miscounted = unknown = 0
+    found: dict[str, list[Copy]] = {}
+    for row in assembly["glue"]:
+        label = str(row["label"])
+        a, b = (int(x) for x in row["mesh_vertices"])
+        key = (min(a, b), max(a, b))
+        deg = model.fold_deg.get(key)
+        if key not in model.fold_deg:
+            unknown += 1
+            continue
+        if (deg is not None and abs(deg) < FLAT_DEG) or key in model.diagonals:
+            flat_cut.append(label)
+        length = float(np.linalg.norm(model.vertices[a] - model.vertices[b])) * model.scale
+        spots = where.get(label, [])
+        if len(spots) != 2:
+            miscounted += 1
+        copies = []
+        for page, xy in spots:
+            seg = pages[page].locate(xy, length)
+            if seg is None:
+                unlocated += 1
+                continue
+            p0, p1 = seg
+            sides = {s: pages[page].side(p0, p1, s) for s in (1.0, -1.0)}
+            faces = {s: v.count("face") for s, v in sides.items()}
+            (ux, uy), (wx, wy) = p1 - p0, xy - p0
+            label_side = 1.0 if ux * wy - uy * wx > 0 else -1.0
+            # the copy's own face: the side with face paper; both or neither: the label's side
+            own = max(sides, key=lambda s: faces[s]) if faces[1.0] != faces[-1.0] else label_side
+            far = sides[-own]
+            depth = pages[page].tab_beyond(p0, p1, -own) if "tab" in far else None
+            if depth is not None and not _marks(svgs[page], p0, p1):
+                depth = None  # paper beyond but no fold line on the edge: another edge's tab reaching here
+            beyond = "tab" if depth is not None else "face" if "face" in far else "none"
+            copy = Copy(page, p0, p1, beyond, depth or 0.0)
+            if beyond == "tab":
+                copy.marks = {f: _marks(sheets[page], p0, p1) for f, sheets in formats.items()}
+            copies.append(copy)
+        found[label] = copies
+        tabbed = [c for c in copies if c.beyond == "tab"]
+        if len(copies) == 2 and not tabbed:
+            untabbed.append(label)
+        for c in tabbed:
+            n_tabs += 1
+            if c.depth < min(FULL_TAB_REL * length, FULL_TAB_MM) - 0.05:
+                reduced += 1
+            want = None if deg is None or abs(deg) < FLAT_DEG else "mountain" if deg > 0 else "valley"
+            for f, kinds in c.marks.items():
+                if not kinds or (want is not None and kinds != {want}) or len(kinds) > 1:
+                    wrong[f].append(label)
+    if miscounted:
+        notes.append(f"{miscounted} glue labels not printed exactly twice")
+    if unlocated:
+        notes.append(f"{unlocated} printed glue-label copies without an edge of the right length nearby")
+    if unknown:
+        notes.append(f"{unknown} glue pairs name vertices that are no edge of the mesh file")
+    n_labels, small, pairs, crossing = _label_measures(svgs)
+    edge, face = smallest_sizes(model)
+    return Measures(pieces=n_pieces, pages=len(svgs), utilisation=utilisation, glue_edges=len(assembly["glue"]),
+                    untabbed=len(untabbed), reduced_tabs=reduced, tabs=n_tabs, labels=n_labels, small_labels=small,
+                    label_pairs=pairs, label_lines=crossing, flat_cut=len(flat_cut),
+                    wrong_way={f: len(v) for f, v in wrong.items()}, smallest_edge_mm=edge, smallest_face_mm=face,
+                    untabbed_labels=untabbed, wrong_way_labels=wrong, flat_cut_labels=flat_cut, notes=notes,
+                    copies=found)
