@@ -19,7 +19,9 @@ and measures (`Measures`):
   lines) of the edge's printed length nearest to the label. Beside it: the face (a preview face)
   and beyond it either a tab (paper that is no face, attached along the edge, with a fold line
   on the edge in the SVG), a face (a slit) or nothing;
-- untabbed: glue edges with no tab beyond either copy; reduced tabs: tabs shallower than the full
+- untabbed: glue edges with no tab beyond either copy and no glue strip (a cut outline with no
+  face, carrying the label twice); a label with a leader line stands for the edge at the
+  leader's other end; reduced tabs: tabs shallower than the full
   tab, min(0.4 x edge, 6 mm) (today's full size), measured as the tab's depth from its edge;
 - wrong-way fold marks (per format: svg, dxf, pdf): a tab whose fold line along its edge is not
   drawn as its seam folds (mountain on a convex seam, valley on a concave one, seen from the
@@ -55,6 +57,7 @@ LENGTH_TOL_MM = 1e-3  # printed and model edge lengths agree this well (coordina
 PROBE_MM = 0.2  # how far beside an edge its sides are probed
 ATTACHED = 0.3  # a tab is attached to an edge when it runs along this fraction of it at least
 ON_LINE_MM = 0.02  # a fold line lies along an edge: both ends this close to its line
+LEADER_TOUCH_MM = 0.05  # a leader line ends this close to its label's box
 OVERLAP_MM2 = 1e-3  # label boxes sharing less area than this only touch
 NOT_LABELS = ("title", "footer", "scale", "legend")  # text classes that are not glue or piece labels
 
@@ -180,6 +183,7 @@ class Measures:
     flat_cut_labels: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     copies: dict[str, list[Copy]] = field(default_factory=dict)  # glue label -> its printed copies found
+    glue_strips: int = 0  # glue edges joined by a glue strip instead of a tab
 
 
 def _page_points(sheet: Sheet) -> np.ndarray:
@@ -335,20 +339,35 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
     model = load_model(mesh_path, float(assembly["size_mm"]))
     n_pieces = len(assembly["pieces"])
     drawn = sum(p.n_pieces for p in pages)
-    if drawn != n_pieces:
-        notes.append(f"{drawn} cut outlines for {n_pieces} pieces")
+    n_strips = sum(1 for pg in pages for p in pg.svg.pieces() if pg.has_faces and not p.intersects(pg.faces))
+    if drawn - n_strips != n_pieces:
+        notes.append(f"{drawn} cut outlines ({n_strips} glue strips) for {n_pieces} pieces")
     w, h = (svgs[0].width, svgs[0].height) if svgs else (0.0, 0.0)
     usable = len(svgs) * max(w - 2 * margin, 0.0) * max(h - 2 * margin, 0.0)
     utilisation = sum(p.area for p in pages) / usable if usable else 0.0
 
-    # every glue label where it is printed (SVG)
+    # every glue label where it is printed (SVG): a label with a leader line stands for the edge at
+    # the leader's other end; a label on a glue strip (paper with no face) stands for the strip
     where: dict[str, list[tuple[int, np.ndarray]]] = {}
+    on_strip: dict[str, int] = {}
     for k, sheet in enumerate(svgs):
+        strips = [p for p in sheet.pieces() if not pages[k].has_faces or not p.intersects(pages[k].faces)]
         for lb in sheet.labels:
-            c = lb.box().centroid
-            where.setdefault(lb.text, []).append((k, np.array([c.x, c.y])))
+            box = lb.box()
+            c = box.centroid
+            xy = np.array([c.x, c.y])
+            if any(st.contains(c) for st in strips):
+                on_strip[lb.text] = on_strip.get(lb.text, 0) + 1
+                continue
+            for line in sheet.leaders:
+                ends = [shapely.Point(*line[0]), shapely.Point(*line[-1])]
+                touch = [box.distance(e) < LEADER_TOUCH_MM for e in ends]
+                if touch[0] != touch[1]:
+                    xy = np.asarray(line[-1] if touch[0] else line[0], dtype=float)
+                    break
+            where.setdefault(lb.text, []).append((k, xy))
     untabbed, wrong, flat_cut, reduced, n_tabs = [], {f: [] for f in formats}, [], 0, 0
-    unlocated = miscounted = unknown = 0
+    unlocated = miscounted = unknown = strips_found = 0
     found: dict[str, list[Copy]] = {}
     for row in assembly["glue"]:
         label = str(row["label"])
@@ -388,7 +407,9 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
             copies.append(copy)
         found[label] = copies
         tabbed = [c for c in copies if c.beyond == "tab"]
-        if len(copies) == 2 and not tabbed:
+        if on_strip.get(label) == 2:
+            strips_found += 1  # glued with a strip behind both copies: tabbed
+        elif len(copies) == 2 and not tabbed:
             untabbed.append(label)
         for c in tabbed:
             n_tabs += 1
@@ -407,7 +428,7 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
     n_labels, small, pairs, crossing = _label_measures(svgs)
     edge, face = smallest_sizes(model)
     return Measures(pieces=n_pieces, pages=len(svgs), utilisation=utilisation, glue_edges=len(assembly["glue"]),
-                    untabbed=len(untabbed), reduced_tabs=reduced, tabs=n_tabs, labels=n_labels, small_labels=small,
+                    untabbed=len(untabbed), glue_strips=strips_found, reduced_tabs=reduced, tabs=n_tabs, labels=n_labels, small_labels=small,
                     label_pairs=pairs, label_lines=crossing, flat_cut=len(flat_cut),
                     wrong_way={f: len(v) for f, v in wrong.items()}, smallest_edge_mm=edge, smallest_face_mm=face,
                     untabbed_labels=untabbed, wrong_way_labels=wrong, flat_cut_labels=flat_cut, notes=notes,

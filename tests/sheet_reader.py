@@ -96,6 +96,7 @@ class Sheet:
     fills: list[tuple[tuple[float, float, float], np.ndarray]] = field(default_factory=list)
     labels: list[Label] = field(default_factory=list)
     marks: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))
+    leaders: list[np.ndarray] = field(default_factory=list)  # printed open lines of class "leader" (SVG)
 
     def lines(self) -> np.ndarray:
         """Every cut and fold stroke as segments (k, 2, 2): outline sides, slits, folds."""
@@ -318,6 +319,9 @@ def read_svg(path: str | Path) -> Sheet:
             if stroke is None:  # a fill: the preview's faces and tabs
                 if any("preview" in n.lower() for n in names + [cls]):
                     (sheet.tabs if "tab" in cls.split() else sheet.faces).extend(rings)
+                return
+            if "leader" in cls.split():  # a printed line from an edge to its label: neither cut nor score
+                sheet.leaders.extend(opens)
                 return
             kind = _kind_of([cls] + names)
             if kind is None:

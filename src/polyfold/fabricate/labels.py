@@ -8,7 +8,8 @@ label goes, in order:
    face's incentre);
 2. on the side's glue tab, when this side carries it;
 3. just outside the edge (beyond the tab on the side that has one), clear of the piece's faces,
-   tabs and labels, else a little further in a free spot with a leader line to the edge: an
+   tabs and labels, else a little further in a free spot with a leader line to the edge, else
+   up to FAR_STEPS_MM away in any direction, its leader crossing the piece's lines if it must: an
    off-face label, which the packer keeps clear of other pieces (`SheetPiece.footprint`);
 4. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
@@ -30,6 +31,7 @@ LABEL_PAD_MM = 0.25  # gap between a label's glyph box and any line or other lab
 CELL_MM = 10.0  # cell size of the label boxes' spatial hash
 LEADER_STEPS_MM = (2.0, 5.0, 9.0, 14.0)  # how far an off-face label with a leader may sit from its edge
 LEADER_HALF_MM = 0.1  # half the width of a leader line (clearance it needs)
+FAR_STEPS_MM = (8.0, 14.0, 20.0, 28.0)  # the last resort: a label this far away, its leader may cross the piece
 
 
 def shapely_point(p: np.ndarray):
@@ -234,7 +236,10 @@ class PieceLabels:
                 a = math.radians(turn)
                 w = np.array([n_out[0] * math.cos(a) - n_out[1] * math.sin(a), n_out[0] * math.sin(a) + n_out[1] * math.cos(a)])
                 spots.append((start + w * (dist + h / 2 + TAB_CLEAR_MM), w, True))
-        for center, w, leader in spots:
+        # last: any direction, further away, the leader crossing the piece's own lines if it must
+        far = [(start + np.array([math.cos(a), math.sin(a)]) * dist, None, "across")
+               for dist in FAR_STEPS_MM for a in np.radians(np.arange(0.0, 360.0, 30.0))]
+        for center, w, leader in spots + far:
             box = text_box(center, u, text, self.size)
             poly = Polygon(box)
             if self.room.blocked(poly, None, TAB_CLEAR_MM) or self.boxes.hits(box):
@@ -243,7 +248,9 @@ class PieceLabels:
             if leader:
                 end = np.asarray(poly.exterior.interpolate(poly.exterior.project(shapely_point(start))).coords[0])
                 line = LineString([start + (end - start) * min(1.0, TAB_CLEAR_MM / max(np.linalg.norm(end - start), 1e-9)), end])
-                if self.room.blocked(line.buffer(LEADER_HALF_MM), None) or self.boxes.hits_geom(line.buffer(LEADER_HALF_MM)):
+                if self.boxes.hits_geom(line.buffer(LEADER_HALF_MM)):
+                    continue
+                if leader != "across" and self.room.blocked(line.buffer(LEADER_HALF_MM), None):
                     continue
                 self.leaders.append(np.array([start, end]))
                 extra.append(LineString([start, end]).buffer(LEADER_HALF_MM))

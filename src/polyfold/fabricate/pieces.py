@@ -234,19 +234,19 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
 
 
 def glue_strip(label: str, length: float, rho: float, part: int, size: float) -> SheetPiece:
-    """A glue strip for a seam `length` mm long that has no room for a tab: a separate rectangle,
-    2 x `tabs.full_depth` wide, glued behind both sides of the seam, scored along its middle and
+    """A glue strip for a seam `length` mm long that has no room for a tab: a separate rectangle
+    as long as the seam (or its label), 2 x `tabs.full_depth` wide, glued behind both sides of the seam, scored along its middle and
     labelled like a tab on both halves. Its printed side faces the model's inside, so it folds the
     other way from its seam: a valley on a convex seam. Named "S" + the seam's label."""
     import shapely
 
     depth = full_depth(length)
-    rect = np.array([[0.0, -depth], [length, -depth], [length, depth], [0.0, depth]])
+    long = max(length, text_width(label, size) + 2.0)  # never shorter than its label (trim after gluing)
+    rect = np.array([[0.0, -depth], [long, -depth], [long, depth], [0.0, depth]])
     body = shapely.Polygon(rect)
-    line = np.array([[[0.0, 0.0], [length, 0.0]]])
+    line = np.array([[[0.0, 0.0], [long, 0.0]]])
     none = np.zeros((0, 2, 2))
-    angle = 0.0 if text_width(label, size) < length else 90.0
-    texts = tuple(TextItem(label, length / 2, y, angle, size, "edge-label") for y in (-depth / 2, depth / 2))
+    texts = tuple(TextItem(label, long / 2, y, 0.0, size, "edge-label") for y in (-depth / 2, depth / 2))
     return SheetPiece(name=f"S{label}", part=part, face_ids=np.zeros(0, dtype=np.int64), faces_xy=np.zeros((0, 3, 2)),
                       body=body, outline=body, mountain=line if rho < 0 else none, valley=line if rho >= 0 else none,
                       slits=none, tabs=(), tab_folds=none, texts=texts, tab_mountain=np.zeros(0, dtype=bool),

@@ -82,6 +82,9 @@ def dxf_document(page: Page):
             if 0 < length < shows_gap:
                 attribs["ltscale"] = length / shows_gap
             msp.add_line(a, b, dxfattribs=attribs)
+    for seg in page.leaders:
+        a, b = flip(seg)
+        msp.add_line(a, b, dxfattribs={"layer": "LABELS"})
     for t in page.texts:
         bx, by = text_baseline(t)
         # DXF text height is the cap height; the y flip keeps the CCW visual sense of `angle`.

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..fabricate.page import Page, TextItem
 from .files import atomic_write
-from .sheet_style import MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
+from .sheet_style import LEADER_MM, MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
 
 
 def _pt(page: Page, pts: np.ndarray) -> np.ndarray:
@@ -109,6 +109,12 @@ def _draw_pdf_page(c, page: Page) -> None:
     c.setFillColorRGB(*(v / 255 for v in TEXT_RGB))
     for t in page.texts:
         _pdf_text(c, page, t)
+    if len(page.leaders):
+        c.setStrokeColorRGB(*(v / 255 for v in TEXT_RGB))
+        c.setLineWidth(LEADER_MM * MM_TO_PT)
+        c.setDash([], 0)
+        for (x0, y0), (x1, y1) in _pt(page, page.leaders):
+            c.line(x0, y0, x1, y1)
     _draw_furniture(c, page)
 
 

@@ -50,8 +50,11 @@ def page_image(page: Page, width_px: int = 1200) -> np.ndarray:
         raise ValueError(f"PNG width must be at least 16 px, got {width_px}")
     s = int(width_px) / page.width
     img = np.full((max(1, math.ceil(page.height * s)), int(width_px), 3), 255, dtype=np.uint8)
-    if page.tabs:  # convex polygons: fans of triangles
-        tris = np.array([[t[0], t[i], t[i + 1]] for t in page.tabs for i in range(1, len(t) - 1)]) * s
+    if page.tabs:  # trapezoids or clipped (non-convex) tabs: constrained triangulations
+        import shapely
+
+        parts = shapely.constrained_delaunay_triangles(np.array([shapely.Polygon(t) for t in page.tabs]))
+        tris = np.array([np.asarray(tri.exterior.coords)[:3] for g in parts for tri in g.geoms]) * s
         fill_triangles(img, tris.reshape(-1, 3, 2), np.tile(np.array(TAB_RGB, dtype=np.uint8), (len(tris), 1)))
     if page.faces:
         colors = piece_colors(len(page.faces))
@@ -64,6 +67,7 @@ def page_image(page: Page, width_px: int = 1200) -> np.ndarray:
     draw_segments(img, cuts * s, STYLES["cut"]["rgb"], thick=2)
     if page.scale_bar is not None:
         draw_segments(img, page.scale_bar.segments() * s, TEXT_RGB)
+    draw_segments(img, page.leaders * s, TEXT_RGB)
     if page.marks is not None:
         sq = page.marks.square * s
         fill_triangles(img, np.array([sq[[0, 1, 2]], sq[[0, 2, 3]]]), np.array([TEXT_RGB, TEXT_RGB], dtype=np.uint8))

@@ -31,6 +31,7 @@ MM_TO_PT = 72.0 / 25.4
 # One style table for all writers so SVG, PDF and DXF agree. Pure red / blue because cutting
 # software (Silhouette "cut by colour", DXF ACI 1 / 5) maps exact colours to tools.
 STROKE_MM = 0.25
+LEADER_MM = 0.12  # leader lines to off-face labels: thinner than any cut or score line, black
 
 
 STYLES = {

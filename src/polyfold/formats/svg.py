@@ -27,7 +27,7 @@ import numpy as np
 
 from ..fabricate.page import Page, TextItem
 from .files import atomic_write
-from .sheet_style import PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
+from .sheet_style import LEADER_MM, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
 
 
 SVG_NS = "http://www.w3.org/2000/svg"
@@ -129,6 +129,9 @@ def svg_page_string(page: Page) -> str:
     ET.SubElement(g, "desc").text = "labels: print or draw only, do not cut"
     for t in page.texts:
         _text(g, t)
+    for seg in page.leaders:  # thin lines from an edge to its label beside the piece
+        ET.SubElement(g, "path", {"class": "leader", "fill": "none", "stroke": _hex(TEXT_RGB),
+                                  "stroke-width": _num(LEADER_MM), "d": _polyline_d(seg, closed=False)})
 
     if page.scale_bar is not None:
         bar = page.scale_bar

@@ -49,9 +49,12 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
          + ("The pages carry print-and-cut registration marks in Silhouette Studio's Type 1 layout "
             f"({MARK_INSET_MM:g} mm inset, {MARK_LEG_MM:g} mm legs, {MARK_LINE_MM:g} mm thick): set the same in its "
             "Registration Marks panel. " if opts.marks else "")
-         + "Fold mountains away from you and valleys towards you, "
-         "with the printed side outside. Every edge label appears twice: glue the tab of one copy under the "
-         "other copy.</p>",
+         + "The printed side is the outside of the model: every line is marked as seen from it, so fold "
+         "mountains away from you and valleys towards you, tab folds included (a tab folds like its seam, "
+         "and tucks under the other copy). Every edge label appears twice: glue the tab of one copy under "
+         "the other copy. A label that has no room in its face is printed on its tab or beside its edge "
+         "(with a thin leader line); a seam with no room for a tab has a glue strip (piece S and the "
+         "label): glue it behind both copies.</p>",
          "<h2>Sheets</h2>"]
     for f in sheet_files:
         h.append(f"<img class='sheet' src='{escape(f)}' alt='{escape(f)}'>")
