@@ -1,6 +1,8 @@
 """fabricate/fit.py: the smallest printed edge and face of a model at its printed scale, and
-(fabricate/paper.py) the --size that makes the smallest edge buildable. (Splitting nets to fit
-the page: test_sheet.py.)"""
+(fabricate/paper.py) the --size that makes the smallest edge buildable; `split_to_fit`: pieces split
+along creases until they fit the page, never through a flat region (coplanar faces, an input
+polygon); a single face or flat polygon too large for the page is a `PieceTooLarge` error with the
+largest scale that fits. (How make splits nets to fit the page: test_sheet.py.)"""
 
 from __future__ import annotations
 
@@ -8,10 +10,16 @@ import math
 
 import numpy as np
 import pytest
+import trimesh
 
-from polyfold.fabricate.fit import smallest_printed
+from conftest import assert_flat_regions_whole, single_component, subdivided_box
+from polyfold.fabricate.fit import PieceTooLarge, model_scale, smallest_printed, split_to_fit
 from polyfold.fabricate.paper import BUILDABLE_EDGE_MM, size_for_edge
+from polyfold.mesh.geometry import merged_edges
 from polyfold.mesh.mesh import Mesh
+from polyfold.pipeline.options import MakeOptions
+from polyfold.pipeline.sheets import pack_box
+from polyfold.unfold.search import unfold
 
 
 def test_smallest_printed_edge_and_face_height():
@@ -34,3 +42,64 @@ def test_size_for_edge_rounds_up():
     assert size_for_edge(150.0, 4.9) == 154  # 150 * 5 / 4.9 = 153.06
     assert size_for_edge(100.0, 2.5) == 200 == 100.0 * BUILDABLE_EDGE_MM / 2.5
     assert size_for_edge(150.0, 1.0, edge_mm=3.0) == 450
+
+
+# the A4 page and margin make fits pieces to (`pack_box` at the defaults: margins all round, footer)
+MARGIN = MakeOptions().margin
+A4 = tuple(float(x) + MARGIN for x in pack_box(210.0, 297.0, MakeOptions())[2:])
+
+
+def _single_net(mesh: Mesh):
+    net, stats = unfold(mesh, seed=1, time_limit=20)
+    assert stats.pieces == 1
+    return net
+
+
+def test_cube_at_a4_150mm_is_six_whole_squares(models_dir):
+    mesh = single_component(models_dir, "cube-12")
+    net = _single_net(mesh)
+    fitted, cuts = split_to_fit(net, model_scale([mesh], 150.0), A4, MARGIN)
+    assert fitted.n_pieces == 6 and cuts == 5
+    for p in range(6):
+        f0, f1 = np.flatnonzero(fitted.piece == p)  # two faces a piece ...
+        np.testing.assert_allclose(mesh.face_normals[f0], mesh.face_normals[f1], atol=1e-12)  # ... one square
+    assert_flat_regions_whole(fitted)
+
+
+def _cylinder() -> Mesh:
+    cyl = trimesh.creation.cylinder(radius=0.5, height=1.2, sections=24)  # caps: flat fans around their centre
+    return Mesh(cyl.vertices, cyl.faces)
+
+
+@pytest.mark.parametrize("name", ["subdivided-box", "cylinder", "dodecahedron-36", "l-prism-div-44", "bad/quad-cube"])
+def test_splits_never_cut_a_merged_edge(models_dir, name):
+    mesh = {"subdivided-box": subdivided_box, "cylinder": _cylinder}.get(name, lambda: single_component(models_dir, name))()
+    net = _single_net(mesh)
+    merged = merged_edges(mesh)
+    fitted, cuts = split_to_fit(net, model_scale([mesh], 150.0), A4, MARGIN)
+    assert cuts > 0 and fitted.n_pieces == cuts + 1
+    cut = net.crease_mask & ~fitted.crease_mask
+    assert cut.sum() == cuts and not (cut & merged).any()
+    assert_flat_regions_whole(fitted)
+
+
+@pytest.mark.parametrize("name, faces", [("cube-12", 2), ("bad/quad-cube", 1)])
+def test_a_flat_polygon_too_large_is_an_error_not_a_cut(models_dir, name, faces):
+    # 260 x 130 mm printable: a 150 mm square (with its tab room) does not fit, its two triangles
+    # would (the hypotenuse along the page) -- the square is not cut in two
+    mesh = single_component(models_dir, name)
+    net = _single_net(mesh)
+    page = (280.0, 150.0)
+    scale = model_scale([mesh], 150.0)
+    with pytest.raises(PieceTooLarge) as info:
+        split_to_fit(net, scale, page, MARGIN)
+    err = info.value
+    assert len(err.faces) == faces and err.face == err.faces[0]
+    polygon = np.flatnonzero(np.isin(mesh.face_source, err.faces))
+    assert len(polygon) == 2 and np.allclose(mesh.face_normals[polygon[0]], mesh.face_normals[polygon[1]])
+    assert ("flat polygon of faces" in str(err)) == (faces > 1)
+    assert 0.5 < err.factor < 1.0
+    fitted, _ = split_to_fit(net, scale * err.factor, page, MARGIN)  # the scale it names fits
+    assert_flat_regions_whole(fitted)
+    with pytest.raises(PieceTooLarge):  # and is the largest that does
+        split_to_fit(net, scale * err.factor * 1.001, page, MARGIN)

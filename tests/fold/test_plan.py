@@ -8,12 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import straight, whole_net
+from conftest import straight, subdivided_box, whole_net
 from fold_checker import check_fold
 from path_checker import FoldNet, check_path
 from polyfold.fold.plan import is_linearly_foldable, plan_fold
 from polyfold.formats.fold import fold_tree, net_to_fold, with_path
 from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.geometry import merged_edges
 from polyfold.unfold.search import unfold
 
 
@@ -103,6 +104,24 @@ def test_every_planner_handles_a_net_without_creases(models_dir, planner):
     path = plan_fold(tree, planner=planner)
     assert path is not None and path.linear and path.frames.shape == (2, tree.n_edges)
     assert np.allclose(path.frames, 0.0)
+
+
+@pytest.mark.parametrize("name, planner", [("cube-12", "auto"), ("cube-12", "sequential"), ("cube-12", "lazy-prm"),
+                                           ("subdivided-box", "auto"), ("subdivided-box", "sequential")])
+def test_flat_regions_stay_flat_along_the_path(models_dir, name, planner):
+    # issue 18: the merged creases inside a flat region (goal angle 0) never move on any planner's
+    # path, and nothing divides by their zero angle; the path passes the independent checker
+    mesh = subdivided_box(1) if name == "subdivided-box" else load_mesh(models_dir / f"{name}.obj").components[0]
+    net, stats = unfold(mesh, seed=1)
+    assert stats.pieces == 1
+    fold = net_to_fold([net])
+    tree = fold_tree(fold)
+    flat = tree.creases[tree.goal[tree.creases] == 0.0]
+    assert len(flat) == int(merged_edges(mesh).sum()) - (0 if name == "cube-12" else 6)  # box: a flat edge per cycle is cut
+    path = plan_fold(tree, planner=planner, time_limit=30)
+    assert path is not None and np.isfinite(path.frames).all()
+    assert (path.frames[:, flat] == 0.0).all()
+    assert check_path(with_path(fold, path, 1.0, 1e-7)).ok
 
 
 def test_sequential_path_of_a_whole_mesh_passes_the_independent_checker(whole_bunny):

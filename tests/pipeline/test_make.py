@@ -62,6 +62,30 @@ def test_unsegmented_bunny_is_one_piece_on_large_paper(models_dir, tmp_path):
     assert len(report["pieces"]) == 1 and report["stages"]["layout"]["splits_for_page"] == 0
 
 
+@pytest.mark.parametrize("paper, n_pieces", [("a4", 6), ("800x800mm", 1)])
+def test_cube_squares_stay_whole(models_dir, tmp_path, paper, n_pieces):
+    # issue 18: 6 square pieces at A4 / 150 mm (not 9: no square is cut along its diagonal), one
+    # piece of 6 squares on paper large enough; each square's diagonal is a flat crease of its piece
+    mesh = load_mesh(models_dir / "cube-12.obj").components[0]
+    out, report = run_make(tmp_path, models_dir / "cube-12.obj", paper=paper)
+    assert len(report["pieces"]) == n_pieces and report["checks"]["paths_verified"] == n_pieces
+    square = {}  # input face -> its square (the direction of its outward normal)
+    for f in range(mesh.n_faces):
+        square[int(mesh.face_source[f])] = tuple(np.round(mesh.face_normals[f]).astype(int))
+    seen = []
+    for row in report["pieces"]:
+        fold = json.loads((out / row["fold_file"]).read_text())
+        faces = fold["polyfold:faces_meshFace"]
+        kind = {frozenset(e): a for e, a in zip(fold["edges_vertices"], fold["edges_assignment"])}
+        by_square = {}
+        for k, f in enumerate(faces):
+            by_square.setdefault(square[f], []).append(set(fold["faces_vertices"][k]))
+        assert len(faces) == 2 * len(by_square) == 12 // n_pieces
+        assert all(kind[frozenset(a & b)] == "F" for a, b in by_square.values())
+        seen += list(by_square)
+    assert sorted(seen) == sorted(set(square.values()))
+
+
 def test_no_tabs(models_dir, tmp_path):
     out, report = run_make(tmp_path, models_dir / "cube-12.obj", tabs=False, fold=False, size=60.0)
     assert report["stages"]["layout"]["tabs"] == 0

@@ -92,9 +92,11 @@ class _Planner:
                     path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
                 except PolyfoldError as exc:
                     path, note = None, str(exc)
-                if path is None and depth < MAX_SPLITS and self.deadline.left() > 0:
+                may_split = path is None and depth < MAX_SPLITS and self.deadline.left() > 0
+                cut = balanced_cut(pnet, 0) if may_split else None  # None: one flat polygon, never cut
+                if cut is not None:
                     self.say("fold", f"no path in {share:.1f} s: split the piece in two")
-                    self._split(pi, faces, pnet, fids, depth)
+                    self._split(pi, faces, pnet, fids, cut, depth)
                     return
                 if path is None and not note:
                     note = "no path within the time limit"
@@ -104,8 +106,8 @@ class _Planner:
         self.pending -= 1
         self.results.append(FoldedPiece(pi, faces, pnet, fids, pattern, path, info))
 
-    def _split(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, depth: int) -> None:
-        halves = cut_creases(pnet, np.array([balanced_cut(pnet, 0)]))
+    def _split(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, cut: int, depth: int) -> None:
+        halves = cut_creases(pnet, np.array([cut]))
         self.splits += 1
         self.pending += 1
         for h in range(2):

@@ -50,14 +50,14 @@ def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[flo
               name: str) -> tuple[list[Part], int]:
     """The parts with their nets split along creases until every piece (with room for its tabs)
     fits `box` (`pack_box`); the number of creases cut. PolyfoldError naming the largest size that
-    fits when a single face does not."""
+    fits when a single face (or flat polygon) does not."""
     fitted, splits = [], 0
     for part in parts:
         try:
             net, cuts = split_to_fit(part.net, scale, *_packer_page(box))
         except PieceTooLarge as exc:
             largest = math.floor(opts.size * exc.factor * 10) / 10
-            raise PolyfoldError(f"{name}: at --size {opts.size:g} mm face {exc.face} alone (with its tabs) does not "
+            raise PolyfoldError(f"{name}: at --size {opts.size:g} mm {exc.what} alone (with its tabs) does not "
                                 f"fit on {opts.paper} paper with {opts.margin:g} mm margins"
                                 f"{' and registration marks' if opts.marks else ''}; the largest size that "
                                 f"fits is {largest:g} mm (or use larger --paper)") from None

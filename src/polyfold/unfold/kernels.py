@@ -241,14 +241,15 @@ def _score(pairs, count, face_edges, edges, hyperbolic):
 
 
 @njit(cache=True)
-def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, face_edges, edges, hyperbolic,
+def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, face_edges, edges, hyperbolic,
                  local, tol, max_pairs, iterations, seed, temperature):
     """Edge-swap local search on the spanning tree (in place on `crease`, a bool mask per edge).
 
-    A move picks an overlapping pair, a crease on the tree path between the two faces, and a cut
-    edge that reconnects the two halves; it is kept when the score (G + 100 L) does not grow, or
-    with probability exp(-delta / temperature). Returns (best score, iterations done); `crease`
-    holds the best tree seen.
+    A move picks an overlapping pair, a crease on the tree path between the two faces that is not
+    merged (merged (E,): edges inside flat regions, never cut), and a cut edge that is not merged
+    and reconnects the two halves; it is kept when the score (G + 100 L) does not grow, or with
+    probability exp(-delta / temperature). Returns (best score, iterations done); `crease` holds
+    the best tree seen.
     """
     np.random.seed(seed)
     n = faces.shape[0]
@@ -274,7 +275,14 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
         g = pairs[r, 1]
         tree_depths(parent, order, depth)
         plen = tree_path(f, g, parent, depth, path, 0)
-        x = path[np.random.randint(plen)]
+        free = 0  # the path's creases that may be cut, moved to its front
+        for k in range(plen):
+            if not merged[parent_edge[path[k]]]:
+                path[free] = path[k]
+                free += 1
+        if free == 0:  # the two faces are in one flat region: no move separates them
+            continue
+        x = path[np.random.randint(free)]
         c = parent_edge[x]
         # faces of the subtree under x
         for idx in range(n):
@@ -288,7 +296,7 @@ def local_search(crease, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, f
         pick = -1
         seen = 0
         for e in range(n_e):
-            if crease[e] or e == c:
+            if crease[e] or e == c or merged[e]:
                 continue
             f0 = edge_faces[e, 0]
             f1 = edge_faces[e, 1]

@@ -1,6 +1,7 @@
 """Nets: a spanning forest of a mesh's dual graph laid out in the plane (the unfold stage's
 result), and the operations on them that never move a face: cutting creases, taking one piece
-as a net of its own, finding the crease that splits a piece most evenly.
+as a net of its own, finding the crease that splits a piece most evenly. The merged creases of
+flat regions (`mesh.geometry.merged_edges`) are never cut: `Net.cuttable` says which creases may be.
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mesh.geometry import merged_edges
 from ..mesh.mesh import Mesh
 from . import kernels as K
 
@@ -41,6 +43,13 @@ class Net:
         pe = self.parent_edge[self.parent_edge >= 0]
         mask[pe] = True
         return mask
+
+    @property
+    def cuttable(self) -> np.ndarray:
+        """(F,) True for faces whose crease to their parent may be cut: it exists and is not a
+        merged edge of a flat region (those keep a flat polygon whole)."""
+        merged = merged_edges(self.mesh)
+        return (self.parent_edge >= 0) & ~merged[self.parent_edge]
 
 
 def cut_creases(net: Net, faces: np.ndarray) -> Net:
@@ -125,11 +134,14 @@ def subtree_areas(net: Net) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return sub_area, tin, tout
 
 
-def balanced_cut(net: Net, piece: int) -> int:
-    """The face of `piece` (two faces or more) whose crease to its parent splits the piece's area
-    most evenly."""
+def balanced_cut(net: Net, piece: int) -> int | None:
+    """The face of `piece` whose crease to its parent (one that may be cut, `Net.cuttable`) splits
+    the piece's area most evenly; None when the piece has no such crease (one face, or one flat
+    polygon)."""
     faces = np.flatnonzero(net.piece == piece)
-    cand = faces[net.parent[faces] >= 0]
+    cand = faces[net.cuttable[faces]]
+    if len(cand) == 0:
+        return None
     sub_area, _, _ = subtree_areas(net)
     root = faces[net.parent[faces] < 0][0]
     return int(cand[np.argmin(np.abs(sub_area[cand] - sub_area[root] / 2))])

@@ -2,7 +2,10 @@
 and the heuristic edge weights that seed the search (ALGORITHMS.md 5.3).
 
 Genome (ALGORITHMS.md 5.1, 5.5): one weight in [0, 1] per mesh edge; Prim's algorithm from the
-base face keeps light edges as creases. Low weight = keep as crease.
+base face keeps light edges as creases. Low weight = keep as crease. The merged edges of flat
+regions (`mesh.geometry.merged_edges`) weigh MERGED_WEIGHT whatever the genome says: lighter than
+every other edge, so Prim's tree grows through a whole flat region as soon as it reaches one of
+its faces, and every net keeps each flat polygon whole.
 """
 
 from __future__ import annotations
@@ -13,10 +16,12 @@ from typing import Callable
 import numpy as np
 
 from ..collide.flat import overlapping_pairs
-from ..mesh.geometry import row_dots, vector_norm
+from ..mesh.geometry import merged_edges, row_dots, vector_norm
 from ..mesh.mesh import Mesh
 from . import kernels as K
 from . import setup_kernels as S
+
+MERGED_WEIGHT = -1.0  # the weight of a merged edge in Prim's tree: below every genome weight (>= 0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -26,7 +31,9 @@ class UnfoldProblem:
     adj_ptr / adj_face / adj_edge: the dual graph (CSR); local (F, 3, 2): `local_frames`;
     hyperbolic (n,): the mesh's hyperbolic vertices; tol: overlap tolerance (1e-9 of the bbox
     diagonal); interior_edges (I,); edge_vec (E, 3) / edge_len (E,): each edge as a vector
-    edges[e, 0] -> edges[e, 1] and its length (for the heuristic weight rules).
+    edges[e, 0] -> edges[e, 1] and its length (for the heuristic weight rules); merged (E,): the
+    edges inside flat regions (`merged_edges`), creases of every tree (`tree_weights`);
+    cut_candidates (C,): the interior edges that are not merged, ascending (the edges a net may cut).
     """
 
     mesh: Mesh
@@ -40,7 +47,9 @@ class UnfoldProblem:
     interior_edges: np.ndarray = field(default=None)  # type: ignore[assignment]
     edge_vec: np.ndarray = field(default=None)  # type: ignore[assignment]
     edge_len: np.ndarray = field(default=None)  # type: ignore[assignment]
-    hyperbolic_candidates: int = 0  # interior half-edges at hyperbolic vertices
+    hyperbolic_candidates: int = 0  # half-edges of cut_candidates at hyperbolic vertices
+    merged: np.ndarray = field(default=None)  # type: ignore[assignment]
+    cut_candidates: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     @classmethod
     def from_mesh(cls, mesh: Mesh, base: int = 0) -> "UnfoldProblem":
@@ -51,6 +60,10 @@ class UnfoldProblem:
             mesh.vertices, mesh.faces, topo.edges, topo.edge_faces, hyperbolic)
         local[:, 2, 0] = row_dots(e2, e1) / local[:, 1, 0]
         diagonal = vector_norm(box) if mesh.n_vertices else mesh.bbox_diagonal
+        merged = merged_edges(mesh)
+        cut_candidates = inner[~merged[inner]]
+        if len(cut_candidates) < len(inner):
+            candidates = S.incident_count(cut_candidates, topo.edges, hyperbolic)
         return cls(
             mesh=mesh,
             adj_ptr=adj_ptr,
@@ -64,22 +77,30 @@ class UnfoldProblem:
             edge_vec=edge_vec,
             edge_len=edge_len,
             hyperbolic_candidates=candidates,
+            merged=merged,
+            cut_candidates=cut_candidates,
         )
+
+    def tree_weights(self, weights: np.ndarray) -> np.ndarray:
+        """The weights Prim's algorithm runs on: genomes (E,) or (B, E) with every merged edge set
+        to MERGED_WEIGHT (float64, C order; the genome itself is not changed)."""
+        return np.where(self.merged, MERGED_WEIGHT, np.asarray(weights, dtype=np.float64))
 
     def evaluate(self, weights: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Overlap counts (G, L) of a batch of genomes (B, E)."""
         mesh = self.mesh
         cap = 4 * mesh.n_faces if max_pairs is None else max_pairs
         return K.evaluate_batch(
-            np.ascontiguousarray(weights, dtype=np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            self.tree_weights(weights), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
             mesh.faces, mesh.topology.face_edges, mesh.topology.edges, self.hyperbolic, self.local, self.tol, cap,
         )
 
     def decode(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Genome -> (parent, parent_edge, order, coords) of the spanning tree."""
+        """Genome -> (parent, parent_edge, order, coords) of the spanning tree (every merged edge
+        joins its flat region's faces, see `tree_weights`)."""
         n = self.mesh.n_faces
         reached, parent, parent_edge, order, coords = K.decode_tree(
-            np.ascontiguousarray(weights, np.float64), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
+            self.tree_weights(weights), self.base, self.adj_ptr, self.adj_face, self.adj_edge,
             self.mesh.faces, self.mesh.topology.face_edges, self.local)
         if reached != n:
             raise ValueError(f"dual graph is not connected ({reached} of {n} faces reached)")
@@ -129,10 +150,12 @@ def max_perimeter_weights(problem: UnfoldProblem, rng: np.random.Generator | Non
 
 
 def _steepest(problem: UnfoldProblem, rng: np.random.Generator, un: bool) -> np.ndarray:
-    """Every vertex but the top one cuts its steepest upward edge (un=True: the least steep)."""
+    """Every vertex but the top one cuts its steepest upward edge (un=True: the least steep) that
+    is not merged (merged edges are never cut: their slope is nan, which loses to any number)."""
     c = _random_direction(rng)
     mesh = problem.mesh
     slope = (problem.edge_vec @ c) / problem.edge_len  # from e0 toward e1
+    slope[problem.merged] = np.nan
     top = int(np.argmax(mesh.vertices @ c))
     return S.steepest_cuts(slope, mesh.topology.edges, mesh.n_vertices, top, un)
 
@@ -150,9 +173,10 @@ def random_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarr
 
 
 def random_edge_weights(problem: UnfoldProblem, rng: np.random.Generator) -> np.ndarray:
-    """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none."""
+    """Two random cuts at every hyperbolic vertex, one at every elliptic vertex that has none,
+    among the edges that may be cut (not merged)."""
     edges = problem.mesh.topology.edges
-    inner = problem.interior_edges
+    inner = problem.cut_candidates
     w = np.full(len(edges), 0.01)
     # one random draw per candidate half-edge (an interior edge at a wanted vertex)
     want, n = S.pick_random_incident(inner, edges, problem.hyperbolic, 2, rng.random(problem.hyperbolic_candidates), w,

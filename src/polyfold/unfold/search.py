@@ -9,6 +9,8 @@ face keeps light edges as creases. Fitness = -(G + 100 L), G = overlapping face 
 at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time (a
 `Deadline`) or the generation budget runs out, the best tree is split into the fewest overlap-free
 pieces found by a set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
+The merged edges of flat regions (`UnfoldProblem.merged`) are creases of every tree; the local
+search and the fallback never cut them (the fallback only when two faces of one region overlap).
 """
 
 from __future__ import annotations
@@ -197,7 +199,7 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
     done_iters, score = 0, 0
     while done_iters < chunk_iters:
         score, it = K.local_search(
-            crease, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
+            crease, problem.merged, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
             mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, max_pairs,
             step, int(rng.integers(2**31)), temperature,
         )
@@ -290,18 +292,25 @@ def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator,
 
 
 def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray,
-                      exact_limit: int = 2000, exact_seconds: float = 5.0) -> np.ndarray:
+                      exact_limit: int = 2000, exact_seconds: float = 5.0,
+                      cuttable: np.ndarray | None = None) -> np.ndarray:
     """Cut the fewest creases so no overlapping pair stays in one piece (ALGORITHMS.md 5.6).
 
     Greedy set cover of the tree paths between overlapping faces (crease on most uncovered paths
     first, numba), refined by an exact ILP when the instance is small (at most `exact_limit`
-    candidate creases). Returns a boolean mask (F,) of faces whose crease to their parent is cut.
+    candidate creases). cuttable (F,): faces whose crease to their parent may be cut (None: all);
+    the others (merged creases of flat regions) are cut only on a path that has no other crease
+    (two faces of one flat region that overlap: a self-overlapping or not quite flat region, where
+    an overlapping net would be worse). Returns a boolean mask (F,) of faces whose crease to their
+    parent is cut.
     """
     n = len(parent)
     cut = np.zeros(n, dtype=bool)
     if len(pairs) == 0:
         return cut
     ptr, members = K.tree_paths(parent, order, np.ascontiguousarray(pairs, dtype=np.int64))
+    if cuttable is not None:
+        ptr, members = _cuttable_paths(ptr, members, cuttable)
     greedy = K.greedy_cover(ptr, members, n)
     chosen = np.flatnonzero(greedy)
     candidates = np.unique(members)
@@ -325,6 +334,17 @@ def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.nda
             pass
     cut[chosen] = True
     return cut
+
+
+def _cuttable_paths(ptr: np.ndarray, members: np.ndarray, cuttable: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tree paths (CSR ptr, members: creases named by their child face) without the creases
+    that may not be cut, except on paths made of such creases only (kept whole)."""
+    rows = np.repeat(np.arange(len(ptr) - 1), np.diff(ptr))
+    ok = cuttable[members]
+    free = np.bincount(rows, weights=ok, minlength=len(ptr) - 1)
+    keep = ok | (free[rows] == 0)
+    counts = np.bincount(rows[keep], minlength=len(ptr) - 1)
+    return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), np.ascontiguousarray(members[keep])
 
 
 def _net_from_tree(problem: UnfoldProblem, parent, parent_edge, order, coords, cut: np.ndarray | None = None) -> Net:
@@ -395,7 +415,9 @@ def unfold(
                 f"no single-piece net found in {time.perf_counter() - t0:.1f} s "
                 f"({generations} generations, best net has {len(pairs)} overlapping face pairs)"
             )
-        cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5))
+        cuttable = (parent_edge >= 0) & ~problem.merged[parent_edge]
+        cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5),
+                                cuttable=cuttable)
     net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
     accepted = None
     if accept is not None:

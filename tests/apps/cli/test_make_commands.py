@@ -94,8 +94,10 @@ def test_too_large_and_bad_options(models_dir, tmp_path):
     proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--size", 150)
     assert proc.returncode == 2
     line = one_line(proc.stderr.strip().splitlines()[-1] + "\n")
-    assert "largest size that fits is 144.4 mm" in line
+    assert "largest size that fits is 144 mm" in line  # and it does (the tab room does not scale):
     assert not out.exists() or not any(out.iterdir())
+    assert run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--size", 144, "--no-fold", "-q").returncode == 0
+    assert run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--size", 144.4, "--no-fold", "-q").returncode == 2
     proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--paper", "b5", "-q")
     assert proc.returncode == 2 and "unknown paper" in one_line(proc.stderr)
     proc = run_cli("make", models_dir / "tetrahedron-4.obj", "-o", out, "--tau", 0.1, "--parts", 2, "-q")
