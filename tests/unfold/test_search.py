@@ -205,6 +205,18 @@ def test_no_single_net_with_flat_regions_whole(models_dir, name):
     assert_flat_regions_whole(net)
 
 
+def test_a_blocked_single_net_is_refused_at_once(models_dir):
+    # star-4split-96: the cuts forced at its hyperbolic midpoints split the dual graph (NO_SINGLE_NET)
+    mesh = single_component(models_dir, "star-4split-96")
+    assert UnfoldProblem.from_mesh(mesh).single_net_blocked()
+    t0 = time.perf_counter()
+    with pytest.raises(NoNetFound, match="flat regions"):
+        unfold(mesh, seed=1, time_limit=60, max_pieces=1)
+    assert time.perf_counter() - t0 < 5
+    for name in ("cube-12", "l-prism-div-44", "torus-8x4-64", "bunny-128"):  # single nets exist
+        assert not UnfoldProblem.from_mesh(single_component(models_dir, name)).single_net_blocked()
+
+
 def test_fallback_cuts_only_cuttable_creases(models_dir):
     mesh = single_component(models_dir, "bumpy-528")
     problem = UnfoldProblem.from_mesh(mesh)

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..collide.flat import overlapping_pairs
 from ..mesh.geometry import merged_edges, row_dots, vector_norm
-from ..mesh.mesh import Mesh
+from ..mesh.mesh import Mesh, face_components
 from . import kernels as K
 from . import setup_kernels as S
 
@@ -80,6 +80,25 @@ class UnfoldProblem:
             merged=merged,
             cut_candidates=cut_candidates,
         )
+
+    def single_net_blocked(self) -> bool:
+        """True when the flat regions kept whole leave no overlap-free single net. An interior
+        hyperbolic vertex needs two cuts (with one, its faces overlap around it); one with at most
+        two edges that may be cut (the others merged) has them all cut: when such a vertex has
+        fewer than two, or those forced cuts split the dual graph, no spanning tree is left."""
+        if not self.merged.any():
+            return False  # every vertex has three edges or more that may be cut
+        topo = self.mesh.topology
+        ends = topo.edges[self.cut_candidates]
+        count = np.bincount(ends.ravel(), minlength=self.mesh.n_vertices)
+        on_boundary = np.zeros(self.mesh.n_vertices, dtype=bool)
+        on_boundary[topo.edges[~topo.interior].ravel()] = True
+        tight = self.hyperbolic & ~on_boundary & (count <= 2)
+        if (tight & (count < 2)).any():
+            return True
+        forced = np.zeros(topo.n_edges, dtype=bool)
+        forced[self.cut_candidates] = tight[ends].any(axis=1)
+        return bool(forced.any()) and face_components(self.mesh.n_faces, topo, ~forced).max() > 0
 
     def tree_weights(self, weights: np.ndarray) -> np.ndarray:
         """The weights Prim's algorithm runs on: genomes (E,) or (B, E) with every merged edge set

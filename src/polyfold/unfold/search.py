@@ -373,7 +373,8 @@ def unfold(
     """Unfold one edge-connected component into a net (one piece when one is found in time).
 
     method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
-    raises `NoNetFound` instead of falling back to several pieces. Deterministic for a given seed
+    raises `NoNetFound` instead of falling back to several pieces (at once when
+    `UnfoldProblem.single_net_blocked`). Deterministic for a given seed
     (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
     within the time limit, for a valid net that also passes this test (e.g. linear foldability);
     `UnfoldStats.accepted` says whether one did. deadline: when given, the search stops there
@@ -388,6 +389,9 @@ def unfold(
         time_limit = deadline.left()
     rng = np.random.default_rng(seed)
     problem = UnfoldProblem.from_mesh(mesh)
+    if max_pieces == 1 and problem.single_net_blocked():  # no search can succeed: say so at once
+        raise NoNetFound("no single-piece net can keep the flat regions whole (hyperbolic vertices on their "
+                         "edges need cuts that split the net)")
     if mesh.n_faces == 1:
         weights = np.zeros(mesh.topology.n_edges)
         fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
