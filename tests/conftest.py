@@ -23,8 +23,6 @@ import pytest
 import shapely
 import trimesh
 from numba import njit
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError
 from shapely.geometry import Polygon
 
@@ -176,21 +174,14 @@ def subdivided_box(times: int = 2) -> Mesh:
     return Mesh(box.vertices, box.faces)
 
 
-def _face_labels(n_faces: int, edge_faces: np.ndarray, join: np.ndarray) -> np.ndarray:
-    """Component label (F,) of every face, faces joined across the edges `join` (E,) bool."""
-    f0, f1 = edge_faces[join, 0], edge_faces[join, 1]
-    return connected_components(coo_matrix((np.ones(len(f0)), (f0, f1)), shape=(n_faces, n_faces)), directed=False)[1]
-
-
 def assert_flat_regions_whole(net: Net) -> None:
     """Every flat region of the net's mesh (faces joined by `merged_edges`) is one polygon of the
     net: its faces are joined by merged creases, and exactly the cycles of its dual graph are left
     out of the tree (one flat edge per cycle, its two sides coincide in the plane)."""
     mesh = net.mesh
     merged = merged_edges(mesh)
-    ef = mesh.topology.edge_faces
-    region = _face_labels(mesh.n_faces, ef, merged)
-    whole = _face_labels(mesh.n_faces, ef, merged & net.crease_mask)
+    region = face_components(mesh.n_faces, mesh.topology, merged)
+    whole = face_components(mesh.n_faces, mesh.topology, merged & net.crease_mask)
     n_regions = region.max() + 1
     assert len(np.unique(np.stack([region, whole]), axis=1).T) == n_regions, "a flat region is cut through"
     assert (merged & ~net.crease_mask).sum() == merged.sum() - mesh.n_faces + n_regions

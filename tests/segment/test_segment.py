@@ -15,10 +15,11 @@ import pytest
 import trimesh
 from scipy.spatial import cKDTree
 
-from conftest import closed_meshes, depth_below_hull
+from conftest import closed_meshes, depth_below_hull, subdivided_box
 from polyfold.deadline import Deadline
 from polyfold.formats.meshes import load_mesh
-from polyfold.mesh.mesh import Mesh
+from polyfold.mesh.geometry import merged_edges
+from polyfold.mesh.mesh import Mesh, face_components
 from polyfold.segment.segment import DEFAULT_TAU, rand_index, segment, surface_samples
 
 
@@ -151,6 +152,24 @@ def test_polygons_of_the_input_stay_whole(tmp_path):
     for src in np.unique(loaded.mesh.face_source):
         assert len(set(seg.labels[loaded.mesh.face_source == src].tolist())) == 1
     check_segmentation(loaded.mesh, seg, 0.0)
+
+
+@pytest.mark.parametrize("name", ["torus-12x6-144", "l-prism-div-44", "star-4split-96", "subdivided-box", "cylinder"])
+@pytest.mark.parametrize("how", [{"tau": 0.0}, {"tau": DEFAULT_TAU}, {"parts": 6}])
+def test_flat_regions_stay_whole(models_dir, name, how):
+    # coplanar faces (merged_edges), like input polygons, are never split between parts: no net cuts them
+    if name == "subdivided-box":
+        mesh = subdivided_box(2)
+    elif name == "cylinder":
+        cyl = trimesh.creation.cylinder(radius=0.5, height=1.2, sections=24)
+        mesh = Mesh(cyl.vertices, cyl.faces)
+    else:
+        mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    region = face_components(mesh.n_faces, mesh.topology, merged_edges(mesh))
+    seg = segment(mesh, **how)
+    assert len(np.unique(np.stack([region, seg.labels]), axis=1).T) == region.max() + 1
+    # star-4split's triangles are flat to 8e-5 rad only: alone they are up to 1.1e-6 deep below their hull
+    check_segmentation(mesh, seg, max(seg.tau, 2e-6))
 
 
 # ----------------------------------------------------------------------------------------------

@@ -8,8 +8,10 @@ patch (`Mesh.submesh`) that `unfold.search.unfold` and the folding planner accep
 Algorithm (ALGORITHMS.md 4.4, hierarchical merging on the dual graph):
 
 1. Seed clusters: faces joined across edges that are convex or nearly flat (rho >= -12 deg). A seed
-   cluster whose concavity exceeds tau falls back to single faces (concavity 0), or to the input's
-   polygons when the file had polygons (they are never split).
+   cluster whose concavity exceeds tau falls back to its flat regions (concavity 0; coplanar
+   faces and the input's polygons, `mesh.geometry.merged_edges`, single faces elsewhere), which
+   are never split (a nearly flat region or a non-planar input polygon may exceed a tau below its
+   own tiny concavity).
 2. Merge: a min-heap of adjacent cluster pairs keyed by
    ``cost = conc(A u B) + W_COMPACT * compactness(A u B) * tau + W_SEAM * seam(A, B) * tau``
    where compactness = perimeter^2 / (4 pi area) - 1 (0 for a disk) and seam = the shared
@@ -48,6 +50,7 @@ from .merge_kernels import merge_run
 from .table_kernels import (face_groups, face_keys, face_lengths, first_face_order, inner_edges, part_concavities, part_tables,
                             sample_points, unit_groups)
 from ..deadline import Deadline
+from ..mesh.geometry import merged_edges
 from ..mesh.mesh import Mesh
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
@@ -198,10 +201,11 @@ class _Merger:
         self.face_key = face_keys(mesh.n_faces)
         self.memo = new_memo(mesh.n_faces)
         # seeds: faces joined across edges with rho >= -SEED_ANGLE_DEG (locally convex regions) and
-        # across the inner edges of triangulated input polygons; polygon: the triangles of one input
-        # polygon (a face of the user's file, never split between parts); components: edge-connected
+        # across merged edges; polygon: the faces of one flat region (coplanar faces, the triangles
+        # of one input polygon: never split between parts, as no net cuts them); components:
+        # edge-connected
         self.seeds, self.polygon, self.components = face_groups(
-            topo.edge_faces, mesh.face_source, mesh.fold_angles, -math.radians(SEED_ANGLE_DEG))
+            topo.edge_faces, merged_edges(mesh), mesh.fold_angles, -math.radians(SEED_ANGLE_DEG), mesh.n_faces)
         self.graph = (self.face_key, self.ef0, self.ef1, self.inner_len, self.inner_conc)
         self._units: dict[bytes, tuple] = {}
 

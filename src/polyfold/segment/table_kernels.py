@@ -116,12 +116,11 @@ def inner_edges(edge_faces, length, fold):
 
 
 @njit(cache=True)
-def face_groups(edge_faces, face_source, fold, min_fold):
-    """Three face labellings by edge-connected components (numbered by smallest face, see
-    `union_labels`): seeds, joined across edges with fold >= min_fold or inside one input polygon
-    (same face_source); polygons, joined inside one input polygon; components, joined across every
-    edge with two faces."""
-    n = face_source.shape[0]
+def face_groups(edge_faces, merged, fold, min_fold, n):
+    """Three labellings of the n faces by edge-connected components (numbered by smallest face, see
+    `union_labels`): seeds, joined across edges with fold >= min_fold or merged (E,) (inside one flat
+    region: `mesh.geometry.merged_edges`); polygons, joined across merged edges (the flat regions,
+    input polygons among them); components, joined across every edge with two faces."""
     m = edge_faces.shape[0]
     s0, s1 = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
     p0, p1 = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
@@ -130,7 +129,7 @@ def face_groups(edge_faces, face_source, fold, min_fold):
     for e in range(m):
         a, b = edge_faces[e, 0], edge_faces[e, 1]
         if a >= 0 and b >= 0:
-            same = face_source[a] == face_source[b]
+            same = merged[e]
             c0[nc], c1[nc] = a, b
             nc += 1
             if same:
