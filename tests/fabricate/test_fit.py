@@ -1,8 +1,9 @@
 """fabricate/fit.py: the smallest printed edge and face of a model at its printed scale, and
-(fabricate/paper.py) the --size that makes the smallest edge buildable; `split_to_fit`: pieces split
-along creases until they fit the page, never through a flat region (coplanar faces, an input
-polygon); a single face or flat polygon too large for the page is a `PieceTooLarge` error with the
-largest scale that fits. (How make splits nets to fit the page: test_sheet.py.)"""
+(fabricate/paper.py) the --size that makes the smallest edge buildable; `split_to_fit` and
+`join_pieces`: pieces split along creases until they fit the page, never through a flat region
+(coplanar faces, an input polygon), and joined back where they fit together; a single face or flat
+polygon too large for the page is a `PieceTooLarge` error with the largest scale that fits. (How
+make splits nets to fit the page: test_sheet.py.)"""
 
 from __future__ import annotations
 
@@ -10,15 +11,20 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
-from conftest import assert_flat_regions_whole, single_component, subdivided_box
-from polyfold.fabricate.fit import PieceTooLarge, model_scale, smallest_printed, split_to_fit
+from conftest import assert_flat_regions_whole, single_component, sorted_side_lengths, subdivided_box
+from polyfold.collide.flat import find_overlaps
+from polyfold.fabricate.fit import PieceTooLarge, join_pieces, model_scale, smallest_printed, split_to_fit
+from polyfold.fabricate.pack import fits_page
 from polyfold.fabricate.paper import BUILDABLE_EDGE_MM, size_for_edge
+from polyfold.fabricate.tabs import TAB_MAX_MM
 from polyfold.mesh.geometry import merged_edges
-from polyfold.mesh.mesh import Mesh
+from polyfold.mesh.mesh import Mesh, face_components
 from polyfold.pipeline.options import MakeOptions
 from polyfold.pipeline.sheets import pack_box
+from polyfold.unfold.net import cut_creases
 from polyfold.unfold.search import unfold
 
 
@@ -71,16 +77,53 @@ def _cylinder() -> Mesh:
     return Mesh(cyl.vertices, cyl.faces)
 
 
+def assert_pieces_fit(net, scale: float, page, margin: float) -> None:
+    """A valid net whose every piece, with room for tabs all round, fits the page in a rotation the
+    packer tries: each crease's two faces share its corners bit for bit (the sheet outlines are unions of
+    faces), no two faces of a piece overlap, every face is congruent to its mesh triangle."""
+    mesh = net.mesh
+    c = net.coords
+    np.testing.assert_allclose(sorted_side_lengths(c), sorted_side_lengths(mesh.vertices[mesh.faces]),
+                               atol=1e-9 * mesh.bbox_diagonal)
+    for f in np.flatnonzero(net.parent >= 0):
+        p, e = net.parent[f], net.parent_edge[f]
+        for v in mesh.topology.edges[e]:
+            assert np.array_equal(c[f][mesh.faces[f] == v], c[p][mesh.faces[p] == v])
+    for k in range(net.n_pieces):
+        idx = np.flatnonzero(net.piece == k)
+        assert len(find_overlaps(c[idx], None, 1e-9 * mesh.bbox_diagonal)) == 0
+        room = shapely.convex_hull(shapely.multipoints(c[idx].reshape(-1, 2) * scale)).buffer(TAB_MAX_MM)  # any tab
+        assert fits_page(room, page, margin, angles=8) >= 1.0
+
+
 @pytest.mark.parametrize("name", ["subdivided-box", "cylinder", "dodecahedron-36", "l-prism-div-44", "bad/quad-cube"])
 def test_splits_never_cut_a_merged_edge(models_dir, name):
     mesh = {"subdivided-box": subdivided_box, "cylinder": _cylinder}.get(name, lambda: single_component(models_dir, name))()
     net = _single_net(mesh)
-    merged = merged_edges(mesh)
-    fitted, cuts = split_to_fit(net, model_scale([mesh], 150.0), A4, MARGIN)
-    assert cuts > 0 and fitted.n_pieces == cuts + 1
-    cut = net.crease_mask & ~fitted.crease_mask
-    assert cut.sum() == cuts and not (cut & merged).any()
+    scale = model_scale([mesh], 150.0)
+    fitted, added = split_to_fit(net, scale, A4, MARGIN)
+    assert added > 0 and fitted.n_pieces == added + 1
     assert_flat_regions_whole(fitted)
+    assert_pieces_fit(fitted, scale, A4, MARGIN)
+
+
+@pytest.mark.parametrize("name", ["cylinder", "subdivided-box"])
+def test_join_pieces_puts_pieces_back_together(name):
+    # every flat region a piece of its own (the cylinder's 24 sides and 2 caps, the box's 6 sides),
+    # then joined back along shared edges wherever the two pieces still fit the page, overlap-free
+    mesh = _cylinder() if name == "cylinder" else subdivided_box(2)
+    net = _single_net(mesh)
+    apart = cut_creases(net, np.flatnonzero(net.cuttable))
+    assert apart.n_pieces == face_components(mesh.n_faces, mesh.topology, merged_edges(mesh)).max() + 1
+    scale = model_scale([mesh], 150.0)
+    for page in (A4, (800.0, 800.0)):
+        joined, joins = join_pieces(apart, scale, page, MARGIN)
+        assert joins > 0 and joined.n_pieces == apart.n_pieces - joins
+        assert joined.n_pieces == 1 or page == A4  # on a large page all of it is one piece again
+        assert_flat_regions_whole(joined)
+        assert_pieces_fit(joined, scale, page, MARGIN)
+    joined, joins = join_pieces(apart, scale, A4, MARGIN, limit=2)
+    assert joins == 2
 
 
 @pytest.mark.parametrize("name, faces", [("cube-12", 2), ("bad/quad-cube", 1)])

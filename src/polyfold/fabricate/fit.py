@@ -15,11 +15,15 @@ import numpy as np
 from ..errors import PolyfoldError
 from ..mesh.geometry import face_areas
 from ..mesh.mesh import Mesh
+from ..unfold import kernels as K
 from ..unfold.net import Net, cut_creases, subtree_areas
-from .pack import fits_page
+from .pack import _best_fit
 from .tabs import TAB_MAX_MM
 
 MAX_PEEL_TRIES = 64
+# Rotations (degrees) `pack.pack_outlines` tries for every outline whatever its shape: the evenly
+# spaced ones of `pack.fits_page` (its default 8), whose best rotation the packer always keeps.
+PACK_ANGLES = np.arange(8) * 45.0
 
 
 class PieceTooLarge(PolyfoldError):
@@ -43,11 +47,14 @@ class PieceTooLarge(PolyfoldError):
 
 
 def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> float:
-    """Largest scale at which the convex hull of the points, grown by `pad` mm, fits the page."""
+    """Largest scale at which the convex hull of the points, grown by `pad` mm, fits the page in
+    one of the PACK_ANGLES rotations. The packer tries those for every outline whatever its shape,
+    and a piece's real outline (its tabs included) lies inside the grown hull: so the packer finds
+    the fit too (a better rotation of the hull alone need not be one it tries for the outline)."""
     import shapely
 
     hull = shapely.convex_hull(shapely.multipoints(points_mm)).buffer(pad, quad_segs=2)
-    return fits_page(hull, page_size, margin)
+    return _best_fit(shapely.get_coordinates(hull), PACK_ANGLES, page_size[0] - 2 * margin, page_size[1] - 2 * margin)[0]
 
 
 def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
@@ -62,21 +69,20 @@ def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
 
 def _model_factor(points_mm: np.ndarray, page_size, margin: float, pad: float) -> float:
     """Largest factor of the model's scale at which the convex hull of the points, grown by `pad` mm
-    (the tab room does not scale with the model), fits the page as `split_to_fit` checks it.
+    (the tab room does not scale with the model), fits the page as `_hull_scale` checks it.
 
-    Bisection between the hull alone in the page less the pad (a lower bound: the grown hull is
-    inside the hull's round `pad` neighbourhood) and the grown hull's own scale (an upper bound
-    when below 1: the pad shrinks with it there)."""
+    Bisection between the bare hull in the page less the pad on every side (a lower bound: in any
+    rotation the grown hull's extents are the bare hull's plus at most 2 pad) and the grown hull's
+    own scale (an upper bound when below 1: the pad shrinks with it there)."""
     import shapely
 
     def fits(factor: float) -> bool:
         return _hull_scale(points_mm * factor, page_size, margin, pad) >= 1.0
 
-    lo = fits_page(shapely.convex_hull(shapely.multipoints(points_mm)), page_size, margin + pad)
-    for _ in range(100):  # rotations tried for the bare and the grown hull may differ a little
-        if lo <= 0 or fits(lo):
-            break
-        lo *= 0.999
+    hull = shapely.get_coordinates(shapely.convex_hull(shapely.multipoints(points_mm)))
+    lo = _best_fit(hull, PACK_ANGLES, page_size[0] - 2 * (margin + pad), page_size[1] - 2 * (margin + pad))[0]
+    while lo > 0 and not fits(lo):  # rounding only
+        lo *= 1 - 1e-9
     hi = _hull_scale(points_mm, page_size, margin, pad)
     for _ in range(30):
         if hi - lo <= 1e-6 * hi:
@@ -92,9 +98,21 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
 
     Greedy: peel off a subtree that fits (the largest whose rest also fits, else the largest),
     until the rest fits; only subtrees whose crease to their parent may be cut (`Net.cuttable`:
-    not inside a flat polygon). Returns the new net and the number of creases cut. Raises
-    PieceTooLarge (a PolyfoldError) when a single face or flat polygon is too large, with the
-    scale factor that would fit."""
+    not inside a flat polygon). Then pieces are joined back where they fit together elsewhere
+    (`join_pieces`: a subtree peeled off a flat polygon's rim alone, say). Returns the new net and
+    the number of pieces added (creases cut less pieces joined). Raises PieceTooLarge (a
+    PolyfoldError) when a single face or flat polygon is too large, with the scale factor that
+    would fit."""
+    net, cuts = _peel_to_fit(net, scale, page_size, margin, pad)
+    if cuts == 0:
+        return net, 0
+    net, joins = join_pieces(net, scale, page_size, margin, pad, limit=cuts)
+    return net, cuts - joins
+
+
+def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin: float,
+                 pad: float) -> tuple[Net, int]:
+    """`split_to_fit`'s peeling: (net, creases cut)."""
     xy = net.coords * scale
     cuts = 0
     cuttable = net.cuttable  # cutting a crease changes no other crease's
@@ -137,6 +155,123 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
         cuttable[chosen] = False
         cuts += 1
     return net, cuts
+
+
+def join_pieces(net: Net, scale: float, page_size: tuple[float, float], margin: float,
+                pad: float = TAB_MAX_MM + 1.0, limit: int | None = None) -> tuple[Net, int]:
+    """Join pieces of `net` along the mesh edges they share, at most `limit` times (None: no limit):
+    a piece is moved rigidly to hinge on its neighbour's side of the edge (the edge becomes a
+    crease) when the two stay overlap-free (`collide.flat`, the unfolder's tolerance) and, grown by
+    `pad` mm, fit the page at `scale` mm per unit (`_hull_scale`). Smallest pieces (by area)
+    first, each along its longest shared edge first. Returns the new net and the number of joins."""
+    mesh = net.mesh
+    topo = mesh.topology
+    parent, parent_edge, coords = net.parent.copy(), net.parent_edge.copy(), net.coords.copy()
+    piece = net.piece.copy()
+    e1, e2 = coords[:, 1] - coords[:, 0], coords[:, 2] - coords[:, 0]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    tol = 1e-9 * max(mesh.bbox_diagonal, 1e-300)
+    ef = topo.edge_faces
+    inner = np.flatnonzero((ef >= 0).all(axis=1))
+    length = np.linalg.norm(mesh.vertices[topo.edges[inner, 1]] - mesh.vertices[topo.edges[inner, 0]], axis=1)
+    failed: set[int] = set()
+    joins = 0
+    while limit is None or joins < limit:
+        p0, p1 = piece[ef[inner, 0]], piece[ef[inner, 1]]
+        piece_area = np.bincount(piece, weights=area)
+        small = np.minimum(piece_area[p0], piece_area[p1])
+        cand = [int(i) for i in np.lexsort((-length, small)) if p0[i] != p1[i] and int(inner[i]) not in failed]
+        for i in cand:
+            e = int(inner[i])
+            f, g = int(ef[e, 0]), int(ef[e, 1])
+            if piece_area[piece[f]] < piece_area[piece[g]]:
+                f, g = g, f  # g's piece moves
+            moved = _hinged(coords, mesh.faces, topo.edges[e], f, g, piece, tol)
+            fixed, moving = np.flatnonzero(piece == piece[f]), np.flatnonzero(piece == piece[g])
+            both = np.concatenate([coords[fixed], moved])
+            hinge = (int(np.searchsorted(fixed, f)), len(fixed) + int(np.searchsorted(moving, g)))
+            if (_hull_scale(both.reshape(-1, 2) * scale, page_size, margin, pad) < 1.0
+                    or _overlap(both, len(fixed), hinge, tol)):
+                failed.add(e)
+                continue
+            coords[moving] = moved
+            _reroot(parent, parent_edge, g)
+            parent[g], parent_edge[g] = f, e
+            order = _parents_first(parent)
+            piece = K.piece_labels(order, parent)
+            joined = np.flatnonzero(piece == piece[f])
+            failed -= set(topo.face_edges[joined].ravel().tolist())  # the joined piece is new
+            joins += 1
+            break
+        else:
+            break
+    if joins == 0:
+        return net, 0
+    return Net(mesh=mesh, parent=parent, parent_edge=parent_edge, order=order, coords=coords, piece=piece), joins
+
+
+def _hinged(coords: np.ndarray, faces: np.ndarray, edge: np.ndarray, f: int, g: int, piece: np.ndarray,
+            tol: float) -> np.ndarray:
+    """The faces of g's piece (F_g, 3, 2) moved rigidly so g's copy of `edge` (two mesh vertex
+    ids) lies on f's: g then lies across the edge from f, both outer side up. A moved corner within
+    `tol` of a corner of f's piece at the same mesh vertex (the edge's ends at least) takes its
+    coordinates bit for bit, as the unfolder's layout copies a parent's corners: the sheet outlines
+    are unions of the faces and need shared corners equal."""
+    moving = piece == piece[g]
+    pts = coords[moving]
+    fa, fb = (coords[f][faces[f] == v][0] for v in edge)
+    ga, gb = (coords[g][faces[g] == v][0] for v in edge)
+    r = complex(*(fb - fa)) / complex(*(gb - ga))
+    r /= abs(r)
+    z = (pts[..., 0] + 1j * pts[..., 1] - complex(*ga)) * r + complex(*fa)
+    moved = np.stack([z.real, z.imag], axis=-1)
+    fixed = piece == piece[f]
+    at: dict[int, list[np.ndarray]] = {}
+    for v, xy in zip(faces[fixed].ravel().tolist(), coords[fixed].reshape(-1, 2)):
+        at.setdefault(v, []).append(xy)
+    flat = moved.reshape(-1, 2)
+    for k, v in enumerate(faces[moving].ravel().tolist()):
+        for xy in at.get(v, ()):
+            if abs(flat[k, 0] - xy[0]) <= tol and abs(flat[k, 1] - xy[1]) <= tol:
+                flat[k] = xy
+                break
+    return moved
+
+
+def _overlap(tris: np.ndarray, n_fixed: int, hinge: tuple[int, int], tol: float) -> bool:
+    """True when a triangle of tris[:n_fixed] overlaps one of tris[n_fixed:] (each set is
+    overlap-free on its own), the two triangles of the new crease `hinge` excepted."""
+    from ..collide.flat import overlapping_pairs
+
+    parent = np.full(len(tris), -1, dtype=np.int64)
+    parent[hinge[1]] = hinge[0]
+    count, pairs = overlapping_pairs(np.ascontiguousarray(tris), parent, tol, len(tris))
+    return count > len(pairs) or bool(((pairs[:, 0] < n_fixed) != (pairs[:, 1] < n_fixed)).any())
+
+
+def _reroot(parent: np.ndarray, parent_edge: np.ndarray, g: int) -> None:
+    """Make face g the root of its tree, in place (the creases on its path to the old root turn round)."""
+    path = [g]
+    while parent[path[-1]] >= 0:
+        path.append(int(parent[path[-1]]))
+    edges = [int(parent_edge[x]) for x in path[:-1]]
+    for k in range(len(path) - 1, 0, -1):
+        parent[path[k]], parent_edge[path[k]] = path[k - 1], edges[k - 1]
+    parent[g], parent_edge[g] = -1, -1
+
+
+def _parents_first(parent: np.ndarray) -> np.ndarray:
+    """An order of the faces of a forest with every parent before its children (roots in face order)."""
+    children: list[list[int]] = [[] for _ in range(len(parent))]
+    for f, p in enumerate(parent.tolist()):
+        if p >= 0:
+            children[p].append(f)
+    order = [int(f) for f in np.flatnonzero(parent < 0)]
+    k = 0
+    while k < len(order):
+        order.extend(children[order[k]])
+        k += 1
+    return np.asarray(order, dtype=np.int64)
 
 
 def model_scale(meshes: Sequence[Mesh], size_mm: float) -> float:

@@ -49,8 +49,8 @@ def _packer_page(box: tuple[float, float, float, float]) -> tuple[tuple[float, f
 def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[float, float, float, float],
               name: str) -> tuple[list[Part], int]:
     """The parts with their nets split along creases until every piece (with room for its tabs)
-    fits `box` (`pack_box`); the number of creases cut. PolyfoldError naming the largest size that
-    fits when a single face (or flat polygon) does not."""
+    fits `box` (`pack_box`); the number of pieces that added (`split_to_fit`). PolyfoldError naming
+    the largest size that fits when a single face (or flat polygon) does not."""
     fitted, splits = [], 0
     for part in parts:
         try:
