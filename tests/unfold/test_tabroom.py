@@ -8,11 +8,14 @@ import math
 
 import numpy as np
 import pytest
+import trimesh
 
+from conftest import assert_flat_regions_whole
 from fold_checker import check_fold
 from polyfold.formats.fold import net_to_fold, write_fold
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.geometry import corner_angles
+from polyfold.mesh.mesh import Mesh
 from polyfold.unfold.search import unfold
 from polyfold.unfold.tabroom import NOTCH_DEG, open_notches
 
@@ -65,3 +68,17 @@ def test_kept_creases_are_never_cut(models_dir):
     keep = net.crease_mask.copy()
     opened, stats = open_notches(net, keep=keep)
     assert stats.swaps == 0 and np.array_equal(opened.crease_mask, net.crease_mask)
+
+
+@pytest.mark.parametrize("name", ["fish-472", "l-prism-div-44", "cylinder"])
+def test_flat_regions_are_never_cut(models_dir, name):
+    # issue 18: the merged edges of flat regions stay creases whatever `keep` says
+    if name == "cylinder":
+        cyl = trimesh.creation.cylinder(radius=0.5, height=1.2, sections=24)
+        mesh = Mesh(cyl.vertices, cyl.faces)
+    else:
+        mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    net, _ = unfold(mesh, seed=1, time_limit=20, max_pieces=1)
+    opened, stats = open_notches(net)
+    assert opened.n_pieces == 1
+    assert_flat_regions_whole(opened)

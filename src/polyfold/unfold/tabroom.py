@@ -7,8 +7,8 @@ room for the glue tab of either edge beside it. `open_notches` swaps tree edges 
 the notch's vertex that halves its angle, glue a cut edge that reconnects the two halves) while
 the net stays overlap-free and the notches' total shortfall (`corner_penalty`) falls.
 
-In: a single-piece `Net` of a closed or open mesh, the creases that must stay (`keep`, e.g. flat
-regions), a `Deadline`. Out: a `Net` of the same faces (one piece, overlap-free, re-laid out) and
+In: a single-piece `Net` of a closed or open mesh, the creases that must stay (`keep`; the merged
+edges of flat regions, `mesh.geometry.merged_edges`, always stay), a `Deadline`. Out: a `Net` of the same faces (one piece, overlap-free, re-laid out) and
 `TabRoomStats`. Multi-piece nets are returned unchanged.
 """
 
@@ -21,7 +21,7 @@ import numpy as np
 
 from ..collide.flat import overlapping_pairs
 from ..deadline import Deadline
-from ..mesh.geometry import corner_angles
+from ..mesh.geometry import corner_angles, merged_edges
 from . import kernels as K
 from .net import Net, _dfs_intervals
 from .problem import UnfoldProblem
@@ -109,7 +109,7 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
 def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = Deadline.never()
                  ) -> tuple[Net, TabRoomStats]:
     """The net with fewer narrow corners (see the module docstring); `keep` (E,) bool: creases no
-    swap may cut."""
+    swap may cut, besides the merged edges of flat regions (never cut)."""
     crease = net.crease_mask.copy()
     fans = _Fans(net)
     n_v = net.mesh.n_vertices
@@ -121,7 +121,8 @@ def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = 
     edges = net.mesh.topology.edges
     edge_faces = net.mesh.topology.edge_faces
     inner = (edge_faces >= 0).all(axis=1)
-    keep = np.zeros(len(crease), bool) if keep is None else keep
+    merged = merged_edges(net.mesh)  # flat polygons stay whole
+    keep = merged if keep is None else keep | merged
     swaps, timed_out = 0, False
     for _ in range(MAX_PASSES):  # a swap can open room for another: pass again while one helps
         done = swaps
