@@ -16,7 +16,7 @@ import trimesh
 
 from conftest import assert_flat_regions_whole, single_component, sorted_side_lengths, subdivided_box
 from polyfold.collide.flat import find_overlaps
-from polyfold.fabricate.fit import PieceTooLarge, join_pieces, model_scale, smallest_printed, split_to_fit
+from polyfold.fabricate.fit import PieceTooLarge, _encloses, join_pieces, model_scale, smallest_printed, split_to_fit
 from polyfold.fabricate.pack import fits_page
 from polyfold.fabricate.paper import BUILDABLE_EDGE_MM, size_for_edge
 from polyfold.fabricate.tabs import TAB_MAX_MM
@@ -146,3 +146,17 @@ def test_a_flat_polygon_too_large_is_an_error_not_a_cut(models_dir, name, faces)
     assert_flat_regions_whole(fitted)
     with pytest.raises(PieceTooLarge):  # and is the largest that does
         split_to_fit(net, scale * err.factor * 1.001, page, MARGIN)
+
+
+def test_a_join_that_would_close_a_hole_is_refused():
+    # a U of three unit squares (two triangles each) and a bar closing its mouth: joined, they would
+    # enclose the square hole between the U's arms; the same bar beside the U encloses nothing
+    def square(x, y):
+        return [[(x, y), (x + 1, y), (x + 1, y + 1)], [(x, y), (x + 1, y + 1), (x, y + 1)]]
+
+    u = np.array(square(0, 0) + square(1, 0) + square(2, 0) + square(0, 1) + square(2, 1), dtype=float) * 10
+    closing = np.array(square(0, 2) + square(1, 2) + square(2, 2), dtype=float) * 10
+    beside = np.array(square(3, 0) + square(4, 0), dtype=float) * 10
+    assert _encloses(u, closing) and not _encloses(u, beside)
+    nearly = closing + [0.0, 0.01]  # 0.01 mm off: still closes the loop for a cutter
+    assert _encloses(u, nearly)

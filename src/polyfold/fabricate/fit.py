@@ -24,7 +24,7 @@ MAX_PEEL_TRIES = 64
 # Rotations (degrees) `pack.pack_outlines` tries for every outline whatever its shape: the evenly
 # spaced ones of `pack.fits_page` (its default 8), whose best rotation the packer always keeps.
 PACK_ANGLES = np.arange(8) * 45.0
-TOUCH_MM = 0.05  # pieces joined back (`join_pieces`) keep at least this far apart beside their hinge
+TOUCH_MM = 0.05  # pieces nearer than this count as touching when `join_pieces` looks for enclosed holes
 
 
 class PieceTooLarge(PolyfoldError):
@@ -162,9 +162,9 @@ def join_pieces(net: Net, scale: float, page_size: tuple[float, float], margin: 
                 pad: float = TAB_MAX_MM + 1.0, limit: int | None = None) -> tuple[Net, int]:
     """Join pieces of `net` along the mesh edges they share, at most `limit` times (None: no limit):
     a piece is moved rigidly to hinge on its neighbour's side of the edge (the edge becomes a
-    crease) when the two stay overlap-free (`collide.flat`, the unfolder's tolerance), come no
-    nearer than TOUCH_MM anywhere but along that edge (`_touch_beside`) and, grown by `pad` mm, fit
-    the page at `scale` mm per unit (`_hull_scale`). Smallest pieces (by area) first, each along
+    crease) when the two stay overlap-free (`collide.flat`, the unfolder's tolerance), enclose no
+    hole together (`_encloses`) and, grown by `pad` mm, fit the page at `scale` mm per unit
+    (`_hull_scale`). Smallest pieces (by area) first, each along
     its longest shared edge first. Returns the new net and the number of joins."""
     mesh = net.mesh
     topo = mesh.topology
@@ -194,7 +194,7 @@ def join_pieces(net: Net, scale: float, page_size: tuple[float, float], margin: 
             hinge = (int(np.searchsorted(fixed, f)), len(fixed) + int(np.searchsorted(moving, g)))
             if (_hull_scale(both.reshape(-1, 2) * scale, page_size, margin, pad) < 1.0
                     or _overlap(both, len(fixed), hinge, tol)
-                    or _touch_beside(coords[fixed] * scale, moved * scale, coords[f][np.isin(mesh.faces[f], topo.edges[e])] * scale)):
+                    or _encloses(coords[fixed] * scale, moved * scale)):
                 failed.add(e)
                 continue
             coords[moving] = moved
@@ -241,17 +241,21 @@ def _hinged(coords: np.ndarray, faces: np.ndarray, edge: np.ndarray, f: int, g: 
     return moved
 
 
-def _touch_beside(fixed_mm: np.ndarray, moved_mm: np.ndarray, hinge_mm: np.ndarray) -> bool:
-    """True when the faces moved_mm (k, 3, 2) come within TOUCH_MM of the faces fixed_mm anywhere
-    but along the hinge segment (2, 2): a join must not pinch the outline (a hole touching the rim,
-    which cutters and the sheet check cannot tell from an overlap) nor leave a notch narrower
-    than 30 degrees at the hinge's ends (closer than TOUCH_MM beyond 2 TOUCH_MM from it)."""
+def _encloses(fixed_mm: np.ndarray, moved_mm: np.ndarray) -> bool:
+    """True when the faces fixed_mm and moved_mm (k, 3, 2), each grown by TOUCH_MM, enclose a hole
+    together that neither does alone: joined, they would close (or nearly close, within TOUCH_MM)
+    a loop around paper that is not theirs, a hole that may touch the outline's rim. Slits and
+    narrow notches are no holes: they open to the outside."""
     import shapely
 
-    near = shapely.intersection(shapely.union_all(shapely.polygons(fixed_mm)),
-                                shapely.union_all(shapely.polygons(moved_mm)).buffer(TOUCH_MM, quad_segs=2))
-    beside = shapely.difference(near, shapely.linestrings(hinge_mm).buffer(2 * TOUCH_MM, quad_segs=2))
-    return shapely.area(beside) > 1e-3 * TOUCH_MM ** 2
+    def grown(tris: np.ndarray):
+        return shapely.union_all(shapely.polygons(tris)).buffer(TOUCH_MM, quad_segs=2)
+
+    def holes(geom) -> int:
+        return sum(len(g.interiors) for g in getattr(geom, "geoms", [geom]))
+
+    a, b = grown(fixed_mm), grown(moved_mm)
+    return holes(shapely.union(a, b)) > holes(a) + holes(b)
 
 
 def _overlap(tris: np.ndarray, n_fixed: int, hinge: tuple[int, int], tol: float) -> bool:
