@@ -1,5 +1,4 @@
-"""Page packing benchmark (not a test): `polyfold.pack.pack_outlines` against bounding-box shelves,
-and (`--models`) the pages `polyfold make` needs for real meshes.
+"""Page packing benchmark (not a test): `polyfold.pack.pack_outlines` against bounding-box shelves.
 
 Generates net-like pieces deterministically (triangle strips that wander like unfolded bands,
 with glue tabs on some cut edges; L shapes; combs; a mix) and packs every set onto A4 (210 x 297
@@ -9,24 +8,15 @@ left to right in rows), written here only as the baseline. Both results go throu
 `check_packing` with the gap. Prints pieces | pages ours / shelf | utilisation ours / shelf |
 seconds ours / shelf; seconds are wall-clock, the numba kernel already compiled.
 
-    .venv/bin/python bench/bench_pack.py [--seed 0] [--angles 16] [--png out/pack]
+    .venv/bin/python bench/bench_pack.py [--seed 0] [--angles 16] [--tries 2] [--png out/pack]
 
-`--models`: `make` at the defaults (A4, 150 mm, seed 1) on every closed shared model and on
-generated meshes (noisy icospheres; shared models after one or two steps of Loop subdivision,
-500-2000 faces), printing pages, utilisation (outline area, tabs included, over the printable area
-of the pages used), pieces, glue edges, creases cut (to fit a page / to save pages) and seconds,
-then the mean utilisation and the pages against Blender's paper-model export at the same paper and
-size. `--no-fold` skips path planning (pages do not depend on it unless a piece is split to fold).
-
-    .venv/bin/python bench/bench_pack.py --models [--no-fold] [--only bunny]
+(The pages `polyfold make` needs for real meshes, splitting included: bench/bench_build.py.)
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import os
-import tempfile
 import time
 from pathlib import Path
 
@@ -39,9 +29,6 @@ from polyfold.fabricate.pack import check_packing, fits_page, pack_outlines, Pac
 
 A4 = (210.0, 297.0)
 MARGIN, GAP = 10.0, 2.0
-MODELS = Path(os.environ.get("POLYFOLD_MODELS", Path(__file__).resolve().parents[1].parent / "shared" / "models"))
-# A4 pages of Blender's paper-model export (io_export_paper_model) at 150 mm, issue 18
-BLENDER_PAGES = {"bunny-128": 3, "horse-302": 3, "fish-472": 2, "bunny-348": 5, "bumpy-528": 5}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -197,81 +184,13 @@ def draw(path: Path, outlines: list[Polygon], packing: Packing) -> None:
     plt.close(fig)
 
 
-# ----------------------------------------------------------------------------------------------
-# make on real meshes
-
-
-def generated_meshes():
-    """(name, Mesh) of the generated closed meshes: seeded noisy icospheres and shared models after
-    Loop subdivision (smooth, so no two faces are coplanar), 500-2000 faces."""
-    import trimesh
-
-    from polyfold.formats.meshes import load_mesh
-    from polyfold.mesh.mesh import Mesh
-
-    out = []
-    for sub, noise, seed in ((3, 0.03, 0), (3, 0.08, 1)):
-        s = trimesh.creation.icosphere(subdivisions=sub)
-        rng = np.random.default_rng(seed)
-        v = s.vertices * (1 + noise * rng.standard_normal((len(s.vertices), 1)))
-        out.append((f"noisy-icosphere-{len(s.faces)}-{seed}", Mesh(np.asarray(v, float), np.asarray(s.faces, np.int64))))
-    for name, steps in (("bunny-128", 1), ("moneybox-128", 1), ("torus-12x6-144", 1), ("hull-ellipsoid-rand-236", 1),
-                        ("horse-302", 1), ("sphere-deformed-320", 1), ("bunny-348", 1), ("fish-472", 1)):
-        m = load_mesh(MODELS / f"{name}.obj").mesh
-        v, f = trimesh.remesh.subdivide_loop(m.vertices, m.faces, iterations=steps)
-        out.append((f"{name}-loop{steps}-{len(f)}", Mesh(np.asarray(v, float), np.asarray(f, np.int64))))
-    return out
-
-
-def bench_models(fold: bool, only: str | None) -> None:
-    from polyfold.errors import PolyfoldError
-    from polyfold.pipeline.make import make
-    from polyfold.pipeline.options import MakeOptions
-
-    shared = [(p.stem, p) for p in sorted(MODELS.glob("*.obj"))]
-    groups = [("shared", shared), ("generated", generated_meshes())]
-    opts = MakeOptions(fold=fold)
-    print(f"make at the defaults (A4, 150 mm, seed {opts.seed}){'' if fold else ', --no-fold'}; utilisation = outline "
-          "area (tabs included) / printable area of the pages used")
-    head = (f"{'mesh':<34} {'faces':>5} {'pages':>5} {'util':>5} {'pieces':>6} {'glue':>5} {'cut fit':>7} "
-            f"{'cut pack':>8} {'blender':>7} {'s':>6}")
-    with tempfile.TemporaryDirectory() as tmp:
-        make(MODELS / "tetrahedron-4.obj", Path(tmp) / "warm", MakeOptions(size=50.0, fold=fold))  # compile / load
-        for group, meshes in groups:
-            print(f"\n{group}\n{head}\n{'-' * len(head)}")
-            utils = []
-            for name, src in meshes:
-                if only and only not in name:
-                    continue
-                t0 = time.perf_counter()
-                try:
-                    rep = make(src, Path(tmp) / name, opts, name=name).report
-                except PolyfoldError as exc:
-                    print(f"{name:<34} {str(exc)[:100]}")
-                    continue
-                dt = time.perf_counter() - t0
-                lay = rep.stages.layout
-                utils.append(lay.utilisation)
-                print(f"{name:<34} {rep.input.faces:>5} {lay.pages:>5} {lay.utilisation:>5.2f} {len(rep.pieces):>6} "
-                      f"{lay.glue_edges:>5} {lay.splits_for_page:>7} {getattr(lay, 'splits_for_packing', 0):>8} "
-                      f"{BLENDER_PAGES.get(name, ''):>7} {dt:>6.2f}", flush=True)
-            if utils:
-                print(f"{'mean utilisation':<34} {'':>5} {'':>5} {np.mean(utils):>5.2f}   ({len(utils)} meshes)")
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--angles", type=int, default=16)
     ap.add_argument("--tries", type=int, default=2, help="piece orders pack_outlines fills")
     ap.add_argument("--png", type=Path, default=None, help="write one PNG per case (ours and shelf) here")
-    ap.add_argument("--models", action="store_true", help="make on real and generated meshes instead")
-    ap.add_argument("--no-fold", action="store_true")
-    ap.add_argument("--only", default=None, help="--models: only meshes whose name contains this")
     args = ap.parse_args()
-    if args.models:
-        bench_models(not args.no_fold, args.only)
-        return
 
     pack_outlines([shapely.box(0, 0, 10, 10)], A4)  # compile (or load) the numba kernel outside the timings
     print(f"A4, margin {MARGIN:g} mm, gap {GAP:g} mm, {args.angles} angles, seed {args.seed}")
