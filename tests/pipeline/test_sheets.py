@@ -14,12 +14,13 @@ from sheet_reader import read_svg
 from polyfold.deadline import Deadline
 from polyfold.fabricate.fit import model_scale
 from polyfold.fabricate.paper import FOOTER_MM
+from polyfold.fabricate.pieces import build_sheet_pieces
 from polyfold.formats.meshes import load_mesh
 from polyfold.pipeline.folding import fold_pieces
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions, paper_size
 from polyfold.pipeline.parts import make_parts
-from polyfold.pipeline.sheets import fit_parts, lay_out, pack_box, split_for_pages
+from polyfold.pipeline.sheets import fit_parts, lay_out, pack_box, piece_inputs, split_for_pages
 
 # A4 pages of Blender's paper-model export at 150 mm (issue 18)
 BLENDER_PAGES = {"bunny-128": 3, "horse-302": 3, "fish-472": 2, "bunny-348": 5, "bumpy-528": 5}
@@ -74,6 +75,9 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     folded, _ = fold_pieces(split.parts, opts, deadline, lambda *a: None)
     sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
     assert len(sheets.pieces) == split.pieces and sheets.packing.n_pages == split.pages
+    # the pieces drawn before folding, laid out again, are what drawing the folded pieces gives
+    fresh, _, _ = build_sheet_pieces(piece_inputs(mesh, folded), scale, min_label_mm=opts.min_label_mm)
+    assert [p.footprint.equals_exact(q.footprint, 0.0) for p, q in zip(split.drawn[0], fresh)] == [True] * len(fresh)
     # and without the split the same pieces need more pages
     unsplit, _ = fold_pieces(fitted, opts, deadline, lambda *a: None)
     assert lay_out(mesh, unsplit, scale, opts, w, h, deadline, lambda *a: None).packing.n_pages > split.pages

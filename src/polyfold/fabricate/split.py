@@ -10,10 +10,12 @@ a subtree of the piece's tree or what is left of the piece without one, so only 
 no face moves: the parts stay overlap-free. Only creases the net allows to be cut are cut
 (`_cuttable`).
 
-The outline of a part is estimated before anything is redrawn: its faces with the tabs the whole
-piece has on them, plus room for a full-size tab on both sides of every crease cut (the tab goes on
-one of them, `tabs.choose_tab`). The caller redraws the split pieces and packs their real outlines
-(`pipeline.sheets.split_for_pages`): the plan only says where to cut.
+What is packed is a piece's footprint (outline and labels printed off its faces). The footprint of
+a part is estimated before anything is redrawn: its faces with the tabs and labels the whole piece
+has on them, plus room for a full-size tab on both sides of every crease cut (the tab goes on one
+of them, `tabs.choose_tab`). The caller redraws the split pieces and packs their real footprints
+(`pipeline.sheets.split_for_pages`): the plan only says where to cut. Glue strips (pieces without
+a net) are placed whole.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from .pieces import SheetPiece
 from .tabs import CutSide, full_depth, tab_polygon
 
 # smallest part split off (either side), as a fraction of the printable area of a page (245 mm^2 on
-# A4, a triangle of 22 mm sides): 0.01 gave 2 pages more and 29 pieces fewer over the 45 benchmark meshes
+# A4, a triangle of 22 mm sides): 0.01 gave 2 pages more and 29 pieces fewer over 45 benchmark meshes
 MIN_PART = 0.005
 SPLIT_TRIES = 8  # candidate parts weighed per page before a finer look between the last two
 

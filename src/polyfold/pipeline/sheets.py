@@ -111,15 +111,22 @@ class PageSplit:
     order: tuple[int, ...]
     rank: np.ndarray
     ran_out: bool
+    drawn: tuple[list[SheetPiece], list[GlueEdge], LayoutStats]  # build_sheet_pieces of `parts`' pieces
+    inputs: list[PieceInput]  # what was drawn
 
-    def hint(self, folded: list[FoldedPiece], n_pieces: int) -> tuple[list[int], bool]:
+    def same_pieces(self, folded: list[FoldedPiece]) -> bool:
+        """Whether the folded pieces are the very pieces planned (folding split none)."""
+        return len(folded) == len(self.inputs) and all(
+            np.array_equal(f.mesh_faces, inp.face_ids) for f, inp in zip(folded, self.inputs))
+
+    def hint(self, folded: list[FoldedPiece], n_pieces: int) -> list[int]:
         """The order to pack `n_pieces` pieces in, the first `folded` ones drawn from the folded
-        pieces (glue strips after them), and whether they are the very pieces planned (folding
-        split none): then this order is the planned packing."""
-        if len(folded) == self.net_pieces and n_pieces == self.pieces:
-            return list(self.order), True
+        pieces (glue strips after them): the planned packing's order for the planned pieces, else
+        the order of the planned pieces they come from."""
+        if self.same_pieces(folded) and n_pieces == self.pieces:
+            return list(self.order)
         rank = [int(self.rank[f.mesh_faces[0]]) for f in folded] + [len(self.order)] * (n_pieces - len(folded))
-        return sorted(range(n_pieces), key=lambda i: rank[i]), False
+        return sorted(range(n_pieces), key=lambda i: rank[i])
 
 
 def _cut_plan(parts: list[Part], inputs: list[PieceInput], plan: PagePlan) -> tuple[list[Part], int]:
@@ -154,26 +161,28 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
                     say: Callable[[str, str], None]) -> PageSplit:
     """Cut creases where that puts the pieces on fewer pages (`fabricate.split`), before folding.
 
-    The pieces are drawn (tabs included) and packed as they are. Then for every page count from the
-    fewest they could fill to MAX_FILL up to one fewer than that packing: `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and
-    planned again, up to PLAN_ROUNDS times, until a plan needs no cut: then packing the redrawn
-    pieces in the plan's order gives its pages. Kept: fewest pages, then fewest pieces; the first
-    count met ends the search. `box`: `pack_box`. Time: `pack_budget`."""
+    The pieces are drawn (tabs and labels included) and packed as they are. Then, for each page
+    count from the fewest whose area they could fill to MAX_FILL up to one fewer than that packing:
+    `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and planned
+    again, up to PLAN_ROUNDS times, until a plan needs no cut; the redrawn pieces are packed in the
+    plan's order. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
+    search. `box`: `pack_box`. Time: `pack_budget`."""
     budget = deadline.within(pack_budget(deadline))
     page, margin = _packer_page(box)
 
-    def draw(inputs: list[PieceInput]) -> list[SheetPiece]:
-        return build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm)[0]
+    def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+        pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm)
+        return pieces, glue, stats
 
     def pack(pcs: list[SheetPiece], hint: list[int] | None) -> Packing:
         return pack_outlines([p.footprint for p in pcs], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                              time_limit=max(0.5, budget.left()), hint=hint)
 
     inputs = part_piece_inputs(mesh, parts)
-    pieces = draw(inputs)
-
+    drawn = draw(inputs)
+    pieces = drawn[0]
     packing = pack(pieces, None)
-    best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0)
+    best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
     ran_out = packing.ran_out
@@ -182,9 +191,9 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             ran_out = True
             break
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
-        cur_parts, cur_inputs, cur_pieces, cuts, hint = parts, inputs, pieces, 0, None
+        cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
         for _ in range(PLAN_ROUNDS):
-            plan = plan_pages(cur_pieces, [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
+            plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
                               budget.at, seed=opts.seed)
             if plan is None:
                 ran_out |= budget.expired()
@@ -199,20 +208,21 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
             cuts += n_cut
             cur_inputs = cut_inputs
-            cur_pieces = draw(cur_inputs)
+            cur_drawn = draw(cur_inputs)
         if hint is not None:
-            cut_packing = pack(cur_pieces, hint)
+            cut_packing = pack(cur_drawn[0], hint)
             ran_out |= cut_packing.ran_out
-            if (cut_packing.n_pages, len(cur_pieces)) < best[:2]:
-                best = (cut_packing.n_pages, len(cur_pieces), cur_parts, cur_inputs, cut_packing.order, cuts)
+            if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
+                best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
+                        cur_drawn)
             if cut_packing.n_pages <= n_pages:
                 break
-    n_pages, n_pieces, parts, inputs, order, cuts = best
+    n_pages, n_pieces, parts, inputs, order, cuts, drawn = best
     rank = np.full(mesh.n_faces, len(order), dtype=np.int64)
     for pos, i in enumerate(order):
         if i < len(inputs):  # glue strips come after the net pieces and have no faces
             rank[inputs[i].face_ids] = pos
-    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out)
+    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs)
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,18 +253,20 @@ def piece_inputs(mesh: Mesh, folded: list[FoldedPiece]) -> list[PieceInput]:
 def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptions, width: float, height: float,
             deadline: Deadline, say: Callable[[str, str], None], planned: PageSplit | None = None) -> Sheets:
     """Tabs and labels for every piece, then the pieces packed onto as few pages as possible. With
-    the `planned` split, its packing order goes first; when folding split no piece that order was
-    the best of the orders tried on these very pieces, and is the only one tried."""
+    the `planned` split, its packing order goes first; when folding split no piece, the pieces it
+    drew are the ones laid out and its order, the best of those tried on them, the only one tried."""
     tl = time.perf_counter()
-    say("layout", f"tabs and labels for {len(folded)} pieces")
-    pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
-                                             min_label_mm=opts.min_label_mm)
+    same = planned is not None and planned.same_pieces(folded)
+    if same:  # drawn before folding: the same inputs draw the same pieces
+        pieces, glue, stats = planned.drawn
+    else:
+        say("layout", f"tabs and labels for {len(folded)} pieces")
+        pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
+                                                 min_label_mm=opts.min_label_mm)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     page, margin = _packer_page(pack_box(width, height, opts))
-    hint, tries = None, ORDER_TRIES
-    if planned is not None:
-        hint, same = planned.hint(folded, len(pieces))
-        tries = 1 if same else ORDER_TRIES
+    hint = None if planned is None else planned.hint(folded, len(pieces))
+    tries = 1 if same else ORDER_TRIES
     packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                             time_limit=pack_budget(deadline), hint=hint, tries=tries)
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
