@@ -14,7 +14,7 @@ from polyfold.fabricate.fit import model_scale
 from polyfold.fabricate.pack import pack_outlines
 from polyfold.fabricate.paper import GAP_MM
 from polyfold.fabricate.pieces import build_sheet_pieces
-from polyfold.fabricate.split import MIN_PART, plan_pages
+from polyfold.fabricate.split import MIN_PART, MIN_PART_FACES, plan_pages
 from polyfold.formats.meshes import load_mesh
 from polyfold.pipeline.options import MakeOptions, paper_size
 from polyfold.pipeline.parts import make_parts
@@ -71,9 +71,9 @@ def test_plan_cuts_only_creases_and_names_every_part_once(bunny):
         roots = {root for t, root in p.order if bunny["inputs"][t] is inp}
         assert roots == set(np.flatnonzero(cut.parent < 0).tolist())  # each part placed once, by its root
         n_parts += cut.n_pieces
-        for k in range(cut.n_pieces):  # no sliver: every part at least MIN_PART of a page (faces and tabs)
-            faces = piece_net(cut, k)[1]
-            assert faces_area(piece, faces) >= lo * (1 - 1e-9)
+        for k in range(cut.n_pieces):  # no sliver: every part at least MIN_PART of a page (faces and
+            faces = piece_net(cut, k)[1]  # tabs), and at least two faces
+            assert faces_area(piece, faces) >= lo * (1 - 1e-9) and len(faces) >= MIN_PART_FACES
     assert n_parts == len(p.order) == len(bunny["pieces"]) + sum(len(c) for c in p.cuts)
 
 

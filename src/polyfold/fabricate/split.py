@@ -37,6 +37,7 @@ from .tabs import CutSide, full_depth, tab_polygon
 # smallest part split off (either side), as a fraction of the printable area of a page (245 mm^2 on
 # A4, a triangle of 22 mm sides): 0.01 gave 2 pages more and 29 pieces fewer over 45 benchmark meshes
 MIN_PART = 0.005
+MIN_PART_FACES = 2  # nor a single face (more glue per paper, and make's FOLD file of one has no path)
 SPLIT_TRIES = 8  # candidate parts weighed per page before a finer look between the last two
 
 
@@ -131,17 +132,19 @@ class _Tree:
 
     def sides(self, mask: np.ndarray, lo: float, hi: float) -> list[tuple[float, int, bool]]:
         """The parts one cut of a crease inside the part `mask` makes, as (area, face, below): the
-        subtree below the face (below=True) or the rest, with area in [lo, hi] and the other side
-        at least lo; largest first."""
-        w = np.where(mask, self.area, 0.0)[self.by_tin]
-        pre = np.concatenate([[0.0], np.cumsum(w)])
-        total = pre[-1]
+        subtree below the face (below=True) or the rest, with area in [lo, hi], the other side at
+        least lo, and MIN_PART_FACES faces or more on both sides; largest first."""
+        pre = np.zeros((2, len(mask) + 1))
+        pre[:, 1:] = np.cumsum(np.stack([np.where(mask, self.area, 0.0), mask])[:, self.by_tin], axis=1)
+        total, n_total = pre[0, -1], pre[1, -1]
         fs = np.flatnonzero(mask & self.cuttable & mask[np.maximum(self.parent, 0)])
-        sub = pre[self.tout[fs]] - pre[self.tin[fs]]
+        sub, n_sub = pre[:, self.tout[fs]] - pre[:, self.tin[fs]]
         area = np.concatenate([sub, total - sub])
+        n = np.concatenate([n_sub, n_total - n_sub])
         face = np.concatenate([fs, fs])
         below = np.repeat([True, False], len(fs))
-        keep = (area >= lo) & (area <= hi) & (total - area >= lo)
+        keep = ((area >= lo) & (area <= hi) & (total - area >= lo)
+                & (n >= MIN_PART_FACES) & (n_total - n >= MIN_PART_FACES))
         o = np.argsort(-area[keep], kind="stable")
         return list(zip(area[keep][o].tolist(), face[keep][o].tolist(), below[keep][o].tolist()))
 
