@@ -4,11 +4,11 @@ A piece that `fit.split_to_fit` left as large as a page is usually a sprawling n
 enclose space that no other piece fits into, so most of its page stays empty. `plan_pages` packs
 the pieces onto a given number of pages, larger first, each onto the first page with room (the
 bottom-left fill of `pack.PageFiller`). A piece that fits on no page is split along one crease:
-the largest of its two sides that fits on some page (the emptiest first) goes there and the other
-side goes back into the queue; when nothing of it fits anywhere, the plan fails (None). A side is
-a subtree of the piece's tree or what is left of the piece without one, so only creases are cut and
-no face moves: the parts stay overlap-free. Only creases the net allows to be cut are cut
-(`_cuttable`).
+the largest of its two sides that fits on some page (the emptiest first, or the first) goes there
+and the other side goes back into the queue; when nothing of it fits anywhere, the plan fails
+(None). A side is a subtree of the piece's tree or what is left of the piece without one, so only
+creases are cut and no face moves: the parts stay overlap-free. Only creases the net allows to be
+cut are cut (`_cuttable`).
 
 What is packed is a piece's footprint (outline and labels printed off its faces). The footprint of
 a part is estimated before anything is redrawn: its faces with the tabs and labels the whole piece
@@ -80,22 +80,25 @@ class _Tree:
         self.parent_edge = np.asarray(net.parent_edge)
         self.face_edges = net.mesh.topology.face_edges
         faces = shapely.polygons(xy)
-        extras: list[list] = [[] for _ in range(len(xy))]
+        extra, owner = [], []  # what the piece has beside its faces, and the face it goes with
         # each tab (or part of a split tab) to the face side under its fold line
         folds = np.asarray(piece.tab_folds, dtype=float).reshape(-1, 2, 2)
         if len(folds):
             sides = shapely.linestrings(np.stack([xy, np.roll(xy, -1, axis=1)], axis=2).reshape(-1, 2, 2))
             _, side = shapely.STRtree(sides).query_nearest(shapely.points(folds.mean(axis=1)), all_matches=False)
-            for t, k in enumerate(side):
-                extras[k // 3].append(Polygon(piece.tabs[t]))
+            extra += [Polygon(t) for t in piece.tabs]
+            owner += (side // 3).tolist()
         # labels printed off the faces (the footprint beyond the outline) to the nearest face
         off = [g for g in shapely.get_parts(shapely.difference(piece.footprint, piece.outline)) if g.area > 0]
         if off:
-            _, near = shapely.STRtree(faces).query_nearest(off, all_matches=False)
-            for g, f in zip(off, near):
-                extras[f].append(g)
-        self.polys = np.array([shapely.union_all([faces[f], *extras[f]]) if extras[f] else faces[f]
-                               for f in range(len(xy))], dtype=object)
+            extra += off
+            owner += shapely.STRtree(faces).query_nearest(off, all_matches=False)[1].tolist()
+        beside: dict[int, list] = {}
+        for g, f in zip(extra, owner):
+            beside.setdefault(f, []).append(g)
+        self.polys = faces.copy()
+        for f, gs in beside.items():
+            self.polys[f] = shapely.union_all([faces[f], *gs])
         self.area = shapely.area(self.polys)
         _, self.tin, self.tout = subtree_areas(net)
         self.by_tin = np.argsort(self.tin)
@@ -114,8 +117,8 @@ class _Tree:
             g = f if side == 0 else int(self.parent[f])
             k = int(np.argmax(self.face_edges[g] == self.parent_edge[f]))
             xy = self.xy
-            side = CutSide(0, g, k, xy[g, k], xy[g, (k + 1) % 3], xy[g])
-            poly = tab_polygon(side, full_depth(side.length), 45.0)
+            cut = CutSide(0, g, k, xy[g, k], xy[g, (k + 1) % 3], xy[g])
+            poly = tab_polygon(cut, full_depth(cut.length), 45.0)
             self._room[key] = None if poly is None else Polygon(poly)
         return self._room[key]
 
@@ -189,11 +192,12 @@ def _split_onto(filler: PageFiller, page: int, tree: _Tree, t: int, mask: np.nda
 
 def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tuple[float, float], margin: float,
                gap: float, n_pages: int, deadline: float, angles: int = ANGLES, seed: int = 0,
-               min_part: float = MIN_PART, tries: int = SPLIT_TRIES) -> PagePlan | None:
+               emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES) -> PagePlan | None:
     """Cut creases so that the pieces fit on `n_pages` pages (see the module docstring). pieces[i]
     is drawn from the single-piece net nets[i] (same faces, same order); pieces after the last net
     (glue strips) are placed whole. Packed: the pieces' footprints. page_size (width, height mm),
-    margin, gap, angles and seed as `pack.pack_outlines`. A side split off, and the rest,
+    margin, gap, angles and seed as `pack.pack_outlines`. A part split off goes onto the page with
+    the most room that takes one (`emptiest_first`), else the first. A side split off, and the rest,
     cover at least `min_part` of a page's printable area. None when the plan finds no way, or at
     `deadline` (`time.perf_counter()` seconds). A plan without cuts is pack_outlines' first fit in
     the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages."""
@@ -216,7 +220,8 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
             filler.put(spot)
             placed.append((t, tree.root(mask)))
             continue
-        for pg in sorted(range(n_pages), key=lambda p: -filler.free_area(p)):
+        pages = sorted(range(n_pages), key=lambda p: -filler.free_area(p)) if emptiest_first else range(n_pages)
+        for pg in pages:
             hit = _split_onto(filler, pg, tree, t, mask, lo, tries)
             if hit is not None:
                 break

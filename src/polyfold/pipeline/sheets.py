@@ -74,6 +74,9 @@ def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[flo
 
 
 PLAN_ROUNDS = 3  # plans of the cuts for one page count, each on the pieces the last one cut
+# where a plan puts a part it splits off: on the emptiest page that takes one, then (when that fails)
+# on the first; the plans are greedy, and which of the two meets a page count varies from model to model
+PAGE_CHOICES = (True, False)
 # page counts at which the outlines would fill more than this of the printable area are not tried:
 # on the benchmark models no plan above 0.60 succeeded, and failing plans take the longest
 MAX_FILL = 0.75
@@ -165,58 +168,65 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     count from the fewest whose area they could fill to MAX_FILL up to one fewer than that packing:
     `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and planned
     again, up to PLAN_ROUNDS times, until a plan needs no cut; the redrawn pieces are packed in the
-    plan's order. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
-    search. `box`: `pack_box`. Time: `pack_budget`."""
-    budget = deadline.within(pack_budget(deadline))
+    plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
+    other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
+    search. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
+    it when folding splits nothing); a plan is only started with time left to draw what it cuts."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
         pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm)
         return pieces, glue, stats
 
-    def pack(pcs: list[SheetPiece], hint: list[int] | None) -> Packing:
+    def pack(pcs: list[SheetPiece], hint: list[int] | None, seconds: float) -> Packing:
         return pack_outlines([p.footprint for p in pcs], page, margin=margin, gap=GAP_MM, seed=opts.seed,
-                             time_limit=max(0.5, budget.left()), hint=hint)
+                             time_limit=seconds, hint=hint)
 
     inputs = part_piece_inputs(mesh, parts)
-    drawn = draw(inputs)
+    t0 = time.perf_counter()
+    drawn = draw(inputs)  # lay_out's drawing when folding splits nothing: not this stage's cost
+    draw_seconds = time.perf_counter() - t0
     pieces = drawn[0]
-    packing = pack(pieces, None)
+    packing = pack(pieces, None, pack_budget(deadline))
+    budget = deadline.within(pack_budget(deadline))
     best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
     ran_out = packing.ran_out
     for n_pages in range(fewest, packing.n_pages):
-        if budget.expired():
-            ran_out = True
-            break
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
-        cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
-        for _ in range(PLAN_ROUNDS):
-            plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
-                              budget.at, seed=opts.seed)
-            if plan is None:
-                ran_out |= budget.expired()
+        for emptiest_first in PAGE_CHOICES:
+            cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
+            for _ in range(PLAN_ROUNDS):
+                if budget.left() < draw_seconds:  # no time to draw what this plan would cut
+                    ran_out = True
+                    break
+                plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
+                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first)
+                if plan is None:
+                    ran_out |= budget.expired()
+                    break
+                if not any(len(c) for c in plan.cuts):
+                    hint = [t for t, _ in plan.order]
+                    break
+                cur_parts, n_cut = _cut_plan(cur_parts, cur_inputs, plan)
+                cut_inputs = part_piece_inputs(mesh, cur_parts)
+                owner = _owner(cut_inputs, mesh.n_faces)
+                # the plan's order (glue strips are drawn anew: after the net pieces)
+                hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
+                cuts += n_cut
+                cur_inputs = cut_inputs
+                cur_drawn = draw(cur_inputs)
+            if hint is not None:
+                cut_packing = pack(cur_drawn[0], hint, max(0.5, budget.left()))
+                ran_out |= cut_packing.ran_out
+                if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
+                    best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
+                            cur_drawn)
+            if best[0] <= n_pages or ran_out:
                 break
-            if not any(len(c) for c in plan.cuts):
-                hint = [t for t, _ in plan.order]
-                break
-            cur_parts, n_cut = _cut_plan(cur_parts, cur_inputs, plan)
-            cut_inputs = part_piece_inputs(mesh, cur_parts)
-            owner = _owner(cut_inputs, mesh.n_faces)
-            # the plan's order (glue strips are drawn anew: after the net pieces)
-            hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
-            cuts += n_cut
-            cur_inputs = cut_inputs
-            cur_drawn = draw(cur_inputs)
-        if hint is not None:
-            cut_packing = pack(cur_drawn[0], hint)
-            ran_out |= cut_packing.ran_out
-            if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
-                best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
-                        cur_drawn)
-            if cut_packing.n_pages <= n_pages:
-                break
+        if best[0] <= n_pages or ran_out:
+            break
     n_pages, n_pieces, parts, inputs, order, cuts, drawn = best
     rank = np.full(mesh.n_faces, len(order), dtype=np.int64)
     for pos, i in enumerate(order):
