@@ -8,7 +8,9 @@ left to right in rows), written here only as the baseline. Both results go throu
 `check_packing` with the gap. Prints pieces | pages ours / shelf | utilisation ours / shelf |
 seconds ours / shelf; seconds are wall-clock, the numba kernel already compiled.
 
-    .venv/bin/python bench/bench_pack.py [--seed 0] [--angles 8] [--png out/pack]
+    .venv/bin/python bench/bench_pack.py [--seed 0] [--angles 16] [--tries 2] [--png out/pack]
+
+(The pages `polyfold make` needs for real meshes, splitting included: bench/bench_build.py.)
 """
 
 from __future__ import annotations
@@ -185,7 +187,8 @@ def draw(path: Path, outlines: list[Polygon], packing: Packing) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--angles", type=int, default=8)
+    ap.add_argument("--angles", type=int, default=16)
+    ap.add_argument("--tries", type=int, default=2, help="piece orders pack_outlines fills")
     ap.add_argument("--png", type=Path, default=None, help="write one PNG per case (ours and shelf) here")
     args = ap.parse_args()
 
@@ -197,7 +200,7 @@ def main() -> None:
     tot = np.zeros(2)
     for name, outlines in cases(args.seed):
         t = time.perf_counter()
-        ours = pack_outlines(outlines, A4, MARGIN, GAP, angles=args.angles, seed=args.seed)
+        ours = pack_outlines(outlines, A4, MARGIN, GAP, angles=args.angles, seed=args.seed, tries=args.tries)
         t_ours = time.perf_counter() - t
         t = time.perf_counter()
         shelf = shelf_pack(outlines, A4, MARGIN, GAP)

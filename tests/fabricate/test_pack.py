@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -11,7 +12,8 @@ from shapely import affinity
 from shapely.geometry import LineString, Polygon, box
 
 from polyfold.errors import PolyfoldError
-from polyfold.fabricate.pack import check_packing, fits_page, pack_outlines, Packing, placed_outline, Placement
+from polyfold.fabricate.pack import (check_packing, fits_page, pack_outlines, Packing, PageFiller, placed_outline,
+                                     Placement)
 
 A4 = (210.0, 297.0)
 
@@ -198,6 +200,37 @@ def test_two_combs_interlock_on_one_page():
     packing = pack_outlines(combs, (140.0, 95.0), margin=10.0, gap=2.0)
     assert packing.n_pages == 1
     assert_valid(combs, packing, 2.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# piece orders, and the filler planners use
+
+
+def test_the_hint_goes_first_and_larger_first_is_kept_when_better(snakes):
+    larger_first = pack_outlines(snakes, A4, gap=2.0, seed=4)
+    assert larger_first.orders_tried == 1 and not larger_first.ran_out
+    areas = [g.area for g in snakes]
+    assert all(areas[a] >= areas[b] for a, b in zip(larger_first.order, larger_first.order[1:]))
+    smaller_first = sorted(range(len(snakes)), key=lambda i: areas[i])
+    alone = pack_outlines(snakes, A4, gap=2.0, seed=4, hint=smaller_first, tries=1)
+    assert list(alone.order) == smaller_first and alone.orders_tried == 1
+    assert_valid(snakes, alone, 2.0)
+    both = pack_outlines(snakes, A4, gap=2.0, seed=4, hint=smaller_first)
+    assert both.n_pages == min(alone.n_pages, larger_first.n_pages)
+    assert both.orders_tried == (1 if alone.n_pages == math.ceil(sum(areas) / (190 * 277)) else 2)
+    assert_valid(snakes, both, 2.0)
+    partial = pack_outlines(snakes, A4, gap=2.0, seed=4, hint=[3, 1], tries=1)
+    assert list(partial.order[:2]) == [3, 1] and sorted(partial.order) == list(range(len(snakes)))
+
+
+def test_page_filler_puts_outlines_where_pack_outlines_does(snakes):
+    order = list(np.random.default_rng(5).permutation(len(snakes)))
+    packing = pack_outlines(snakes, A4, margin=10.0, gap=2.0, seed=3, hint=order, tries=1)
+    filler = PageFiller(A4, 10.0, 2.0, len(snakes), seed=3)
+    for i in order:
+        spot = next(s for pg in range(len(snakes)) if (s := filler.spot(pg, snakes[i], i)) is not None)
+        assert filler.put(spot) == packing.placements[i]
+    assert filler.free_area(packing.n_pages) == filler.free_area(len(snakes) - 1)  # later pages stay empty
 
 
 # ----------------------------------------------------------------------------------------------

@@ -60,7 +60,9 @@ def test_pieces_are_in_mm_where_printed(bunny: Path) -> None:
         for code, where in (("M", sheet.folds["mountain"]), ("V", sheet.folds["valley"]), ("B", sheet.lines())):
             ends = page[edges[kinds == code]].reshape(-1, 2)
             mids = page[edges[kinds == code]].mean(axis=1)
-            assert len(ends) and _on_segments(np.concatenate([ends, mids]), where).max() < ON_LINE_MM, (row, code)
+            assert len(ends) or code != "B", row  # a small piece may have no mountain or no valley crease
+            if len(ends):
+                assert _on_segments(np.concatenate([ends, mids]), where).max() < ON_LINE_MM, (row, code)
         assert (page >= 0).all() and (page <= [sheet.width, sheet.height]).all()
         # printed faces are the model's faces at the printed scale, not mirrored (CCW in FOLD's y up)
         tri = xy[np.asarray(fold["faces_vertices"])]

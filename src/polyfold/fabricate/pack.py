@@ -6,6 +6,11 @@ lowest, then leftmost, among the free positions of a page (bottom-left fill with
 y = 0), so a piece slides into the concavities and holes of pieces already placed. Larger pieces
 go first; each piece goes onto the first open page that takes it, and a new page is opened only
 when none does (first-fit decreasing). Pieces are never mirrored: the printed side must stay up.
+First fit depends on the order of the pieces: a caller may give an order to fill first (a plan's,
+`split.plan_pages`); larger first is filled too unless that order reached the area bound (no fewer
+pages can hold the outlines' area), and the one with fewer pages is kept. (Seeded shuffles of
+near-equal sizes, 8 orders in all, found no page fewer on the benchmark models or bench_pack's
+sets, so they are not tried.)
 
 Free positions are found on an occupancy grid (about 600 cells along the page's long side): every
 piece is grown by half the gap plus half a cell diagonal and rasterised by cell centres, which
@@ -17,6 +22,9 @@ the obstacle it hits, so no loop visits every cell.
 
 `shelves.shelf_offsets` puts bounding boxes on plain shelves: the fallback when the time budget runs out,
 and the layout of the one sheet of `polyfold unfold --svg` (`sheet.py`).
+
+`PageFiller` is the same bottom-left fill one outline at a time, for planners that try many
+candidate outlines before they commit to one (`split.plan_pages` splits pieces to fill pages).
 """
 
 from __future__ import annotations
@@ -36,6 +44,8 @@ from ..shelves import shelf_offsets
 _CELLS = 600  # grid cells along the long printable side: ~0.46 mm on A4
 _QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
 _TOL = 1e-9  # mm: float noise allowed by check_packing
+ANGLES = 16  # rotations tried per piece (every 22.5 degrees), plus its minimum-rectangle ones
+ORDER_TRIES = 2  # piece orders pack_outlines fills: a caller's hint, then larger first
 
 
 @dataclass(frozen=True)
@@ -67,7 +77,12 @@ class Packing:
     n_pages: int
     page_size: tuple[float, float]  # (width, height) mm
     margin: float
-    utilisation: float  # total outline area / (n_pages * printable area)
+    # what is cut out (the outlines: faces and tabs) over the printable area of the pages used:
+    # total outline area / (n_pages * (width - 2 margin) * (height - 2 margin))
+    utilisation: float
+    order: tuple[int, ...] = ()  # the piece order whose first fit gave these placements
+    orders_tried: int = 0
+    ran_out: bool = False  # the time limit stopped the fill (shelves for the rest) or the orders
 
 
 def placed_outline(outline: Polygon | MultiPolygon, placement: Placement) -> Polygon | MultiPolygon:
@@ -124,6 +139,12 @@ def _angles(outline: Polygon | MultiPolygon, angles: int, phase: float) -> np.nd
     return np.asarray(keep)
 
 
+def _hull_xy(outline) -> np.ndarray:
+    """(n, 2) corners of the outline's convex hull: the same extents in every rotation as all its
+    points (they are some of them), from far fewer points."""
+    return shapely.get_coordinates(shapely.convex_hull(outline))
+
+
 def _extents(xy: np.ndarray, degs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Bounding boxes of the points `xy` rotated by each angle: mins (k, 2), maxs (k, 2)."""
     r = np.einsum("kij,nj->kni", _rots(degs), xy)
@@ -140,13 +161,14 @@ def _best_fit(xy: np.ndarray, degs: np.ndarray, pw: float, ph: float) -> tuple[f
     return float(s[k]), float(degs[k])
 
 
-def fits_page(outline: Polygon | MultiPolygon, page_size: tuple[float, float], margin: float, angles: int = 8) -> float:
+def fits_page(outline: Polygon | MultiPolygon, page_size: tuple[float, float], margin: float,
+              angles: int = ANGLES) -> float:
     """The largest uniform scale s (may be > 1) such that `outline` * s fits the printable area
     (page minus margins) in one of the rotations `pack_outlines` tries with the same `angles`."""
     pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
     if pw <= 0 or ph <= 0:
         return 0.0
-    xy = shapely.get_coordinates(outline)
+    xy = _hull_xy(outline)
     if len(xy) == 0:
         return math.inf
     return _best_fit(xy, _angles(outline, angles, 0.0), pw, ph)[0]
@@ -231,7 +253,7 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, float, float]:
 
 class _Piece:
     def __init__(self, geom, degs: np.ndarray, grow: float, res: float, pad: int, pw: float, ph: float):
-        self.xy = shapely.get_coordinates(geom)
+        self.xy = _hull_xy(geom)
         self.area = float(geom.area)
         self.degs = degs
         self.p0, self.p1 = _ring_edges(geom.buffer(grow, quad_segs=_QUAD_SEGS))
@@ -395,22 +417,37 @@ def _grid(pw: float, ph: float, margin: float, gap: float) -> _Grid:
     return _Grid(res, grow, pad, math.ceil(ph / res) + 2 * pad + 2, math.ceil(pw / res) + 2 * pad + 2, pw, ph, margin)
 
 
+def _phase(seed: int, angles: int, rng: np.random.Generator | None = None) -> float:
+    """The turn (degrees) of the rotations tried: 0 for seed 0, else a random phase drawn first
+    from the seed's generator (`rng`, when the caller draws more from it)."""
+    if seed == 0:
+        return 0.0
+    rng = np.random.default_rng(seed) if rng is None else rng
+    return float(rng.uniform(0.0, 360.0 / max(angles, 1)))
+
+
+def _piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:
+    """A `_Piece` for the outline with the rotations to try, and the largest scale at which it fits
+    the printable area in one of them."""
+    xy = _hull_xy(g)
+    degs = _angles(g, angles, phase)
+    if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too
+        degs = np.append(degs, _best_fit(xy, _angles(g, angles, 0.0), grid.pw, grid.ph)[1])
+    scale, _ = _best_fit(xy, degs, grid.pw, grid.ph)
+    return _Piece(g, degs, grid.grow, grid.res, grid.pad, grid.pw, grid.ph), scale
+
+
 def _pieces(geoms: list, angles: int, phase: float, grid: _Grid, W: float, H: float) -> list[_Piece]:
     """A `_Piece` per outline with the rotations to try; PolyfoldError if one fits in none."""
-    pw, ph, margin = grid.pw, grid.ph, grid.margin
     pieces = []
     for i, g in enumerate(geoms):
-        xy = shapely.get_coordinates(g)
-        degs = _angles(g, angles, phase)
-        if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too
-            degs = np.append(degs, _best_fit(xy, _angles(g, angles, 0.0), pw, ph)[1])
-        scale, _ = _best_fit(xy, degs, pw, ph)
+        piece, scale = _piece(g, angles, phase, grid)
         if scale < 1.0 - 1e-12:  # float noise of the rotation; check_packing allows 1e-9 mm
             raise PolyfoldError(
-                f"piece {i} does not fit a {W:g} x {H:g} mm page with {margin:g} mm margins; "
+                f"piece {i} does not fit a {W:g} x {H:g} mm page with {grid.margin:g} mm margins; "
                 f"the largest scale that fits is {math.floor(scale * 1000) / 1000:.3f}"
             )
-        pieces.append(_Piece(g, degs, grid.grow, grid.res, grid.pad, pw, ph))
+        pieces.append(piece)
     return pieces
 
 
@@ -429,11 +466,13 @@ def _place_alone(p: _Piece, page: _Page, pg: int, grid: _Grid) -> Placement:
 
 
 def _fill_pages(pieces: list[_Piece], order: list[int], grid: _Grid, gap: float,
-                deadline: float) -> dict[int, Placement]:
-    """First-fit decreasing over pages in `order`; shelves for the rest once `deadline` passed."""
+                deadline: float) -> tuple[dict[int, Placement], bool]:
+    """First fit over pages in `order`; shelves for the rest once `deadline` passed. Returns the
+    placements and whether the deadline cut the fill short."""
     res, margin = grid.res, grid.margin
     pages: list[_Page] = []
     place: dict[int, Placement] = {}
+    ran_out = False
     for n_done, i in enumerate(order):
         p, hit, pg = pieces[i], None, len(pages)
         for pg, page in enumerate(pages):  # first fit: the first open page that takes the piece
@@ -446,6 +485,7 @@ def _fill_pages(pieces: list[_Piece], order: list[int], grid: _Grid, gap: float,
             # out of time: shelves on new pages for this piece and the rest (valid, quick)
             rest = [(int(j), pieces[j]) for j in order[n_done:]]
             place.update(_shelf(rest, grid.pw, grid.ph, margin, gap, len(pages)))
+            ran_out = True
             break
         if hit is None:
             pg, page = len(pages), _Page(grid.gh, grid.gw)
@@ -456,8 +496,79 @@ def _fill_pages(pieces: list[_Piece], order: list[int], grid: _Grid, gap: float,
             continue
         s, y, x = hit
         page.stamp(s.mask, y, x)
-        place[i] = Placement(pg, s.angle, (margin + x * res - s.lo[0], margin + y * res - s.lo[1]))
-    return place
+        place[i] = Placement(pg, s.angle, _offset(s, y, x, grid))
+    return place, ran_out
+
+
+class PageFiller:
+    """`n_pages` pages of `page_size` (width, height mm) inside `margin`, filled one outline at a
+    time by the bottom-left fill of `pack_outlines` with the same gap, angles and seed (the same
+    rotations): for planners that try many candidate outlines before committing to one. Whole
+    outlines put in the order pack_outlines is given as its hint land where it puts them. An
+    outline is a valid (Multi)Polygon in mm in its own coordinates; `key` names it so that its
+    rasters are made once (a candidate is often tried on several pages)."""
+
+    def __init__(self, page_size: tuple[float, float], margin: float, gap: float, n_pages: int,
+                 angles: int = ANGLES, seed: int = 0) -> None:
+        pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
+        if pw <= 0 or ph <= 0:
+            raise PolyfoldError(f"page {page_size[0]:g} x {page_size[1]:g} mm has no printable area inside {margin:g} mm margins")
+        self.grid = _grid(pw, ph, margin, gap)
+        self.pages = [_Page(self.grid.gh, self.grid.gw) for _ in range(n_pages)]
+        self.angles = angles
+        self.phase = _phase(seed, angles)
+        self.printable_area = pw * ph
+        self._pieces: dict[object, _Piece] = {}
+
+    def free_area(self, page: int) -> float:
+        """mm^2 of the page's grid not yet covered by placed outlines grown by half the gap (an
+        upper bound of what still fits)."""
+        return self.pages[page].free * self.grid.res**2
+
+    def spot(self, page: int, outline: Polygon | MultiPolygon, key: object) -> Spot | None:
+        """Where the fill would put the outline on `page` (nothing is placed yet), or None when it
+        fits nowhere there."""
+        g = self.grid
+        piece = self._pieces.get(key)
+        if piece is None:
+            piece = self._pieces[key] = _piece(outline, self.angles, self.phase, g)[0]
+        hit = _best_on_page(self.pages[page], piece, g.res)
+        return None if hit is None else Spot(page, *hit)
+
+    def put(self, spot: Spot) -> Placement:
+        """Place an outline at a spot found on the pages as they are now."""
+        self.pages[spot.page].stamp(spot.shape.mask, spot.y, spot.x)
+        return Placement(spot.page, spot.shape.angle, _offset(spot.shape, spot.y, spot.x, self.grid))
+
+
+@dataclass(frozen=True, eq=False)
+class Spot:
+    """A free position found by `PageFiller.spot`: grid cell (y, x) of `page`, the outline in the
+    rotation `shape`."""
+
+    page: int
+    shape: _Shape
+    y: int
+    x: int
+
+
+def _offset(s: _Shape, y: int, x: int, grid: _Grid) -> tuple[float, float]:
+    """The translation (mm) that puts shape `s` at grid cell (y, x) of a page."""
+    return grid.margin + x * grid.res - s.lo[0], grid.margin + y * grid.res - s.lo[1]
+
+
+def _orders(areas: np.ndarray, rng: np.random.Generator, hint: list[int] | None) -> list[list[int]]:
+    """The piece orders to fill: the hint (a caller's order, e.g. a plan's; pieces it leaves out
+    follow, larger first), then larger first (ties in a seeded random order)."""
+    n = len(areas)
+    out = []
+    if hint is not None:
+        head = [int(i) for i in dict.fromkeys(hint) if 0 <= int(i) < n]
+        out.append(head + sorted(set(range(n)) - set(head), key=lambda i: (-areas[i], i)))
+    larger_first = np.lexsort((rng.random(n), -areas)).tolist()
+    if larger_first not in out:
+        out.append(larger_first)
+    return out
 
 
 def pack_outlines(
@@ -465,15 +576,20 @@ def pack_outlines(
     page_size: tuple[float, float],
     margin: float = 10.0,
     gap: float = 2.0,
-    angles: int = 8,
+    angles: int = ANGLES,
     seed: int = 0,
     time_limit: float = 5.0,
+    hint: list[int] | None = None,
+    tries: int = ORDER_TRIES,
 ) -> Packing:
     """Place the outlines (mm, each in its own coordinates) on as few pages of `page_size` (width,
     height mm) as the bottom-left fill finds, inside `margin` and at least `gap` apart. Raises
     PolyfoldError naming a piece (and the largest scale that fits) if one cannot fit an empty page.
-    The same seed gives the same packing; a seed other than 0 turns the tried rotations by a random
-    phase. After `time_limit` seconds the remaining pieces are shelf-packed onto new pages."""
+    The order `hint` (piece indices) is filled first, then larger first (`_orders`; `tries` = 1:
+    only the first of them); the first with the fewest pages is kept. The same seed gives the same
+    packing; a seed other than 0 turns the tried rotations by a random phase. After `time_limit`
+    seconds no further order is tried and the remaining pieces of the one being filled are
+    shelf-packed onto new pages (`Packing.ran_out`)."""
     t0 = time.perf_counter()
     W, H = float(page_size[0]), float(page_size[1])
     pw, ph = W - 2 * margin, H - 2 * margin
@@ -485,14 +601,27 @@ def pack_outlines(
     if pw <= 0 or ph <= 0:
         raise PolyfoldError(f"page {W:g} x {H:g} mm has no printable area inside {margin:g} mm margins")
     rng = np.random.default_rng(seed)
-    phase = 0.0 if seed == 0 else float(rng.uniform(0.0, 360.0 / max(angles, 1)))
+    phase = _phase(seed, angles, rng)
     grid = _grid(pw, ph, margin, gap)
     pieces = _pieces(geoms, angles, phase, grid, W, H)
     areas = np.array([p.area for p in pieces])
-    order = np.lexsort((rng.random(len(pieces)), -areas))  # larger first, seeded ties
-    place = _fill_pages(pieces, order.tolist(), grid, gap, t0 + time_limit)
+    bound = math.ceil(areas.sum() / (pw * ph) - 1e-9)  # no fewer pages can hold the area
+    deadline = t0 + time_limit
+    best, best_pages, best_order, tried, ran_out = None, math.inf, [], 0, False
+    for order in _orders(areas, rng, hint)[:max(1, tries)]:
+        if tried and time.perf_counter() > deadline:
+            ran_out = True
+            break
+        place, cut_short = _fill_pages(pieces, order, grid, gap, deadline)
+        tried += 1
+        ran_out |= cut_short
+        n_pages = max(pl.page for pl in place.values()) + 1
+        if n_pages < best_pages:
+            best, best_pages, best_order = place, n_pages, order
+        if best_pages <= bound:
+            break
 
-    placements = [place[i] for i in range(len(geoms))]
+    placements = [best[i] for i in range(len(geoms))]
     # the grid argument is exact, but never hand out a packing that fails the independent check
     bad = sorted({j for pair in _conflicts(geoms, placements, W, H, margin, gap) for j in pair[1:]})
     if bad:
@@ -503,7 +632,7 @@ def pack_outlines(
     remap = {old: new for new, old in enumerate(used)}
     placements = [Placement(remap[pl.page], pl.angle, pl.offset) for pl in placements]
     util = float(areas.sum()) / (len(used) * pw * ph)
-    return Packing(tuple(placements), len(used), (W, H), float(margin), util)
+    return Packing(tuple(placements), len(used), (W, H), float(margin), util, tuple(best_order), tried, ran_out)
 
 
 def _conflicts(outlines, placements, W, H, margin, gap) -> list[tuple[str, int, ...]]:

@@ -1,6 +1,7 @@
 """The whole job: a mesh in, a folder of printable, assemblable sheets out.
 
-load -> inflate -> segment + unfold (`parts`) -> fit to pages (`sheets.fit_parts`) -> fold
+load -> inflate -> segment + unfold (`parts`) -> fit to pages (`sheets.fit_parts`, then
+`sheets.split_for_pages`) -> fold
 (`folding`) -> tabs, labels, packing (`sheets.lay_out`) -> check (`fabricate.check`) -> export
 (`export`). In: a mesh (a file, or a `Mesh` in memory) and `MakeOptions`. Out: the files of
 `export.py`, moved into place only after every check passed, and a `MakeResult` whose `report` is
@@ -28,7 +29,7 @@ from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
                      PieceReport, StageReports)
-from .sheets import Sheets, fit_parts, lay_out, pack_box
+from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
 
 Progress = Callable[[str, str], None]  # (stage, message)
 
@@ -94,18 +95,21 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     return report
 
 
-def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, splits: int,
+def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, splits: int, split: PageSplit,
                    seconds: float) -> LayoutReport:
     st = sheets.stats
     edge, face = smallest_printed(mesh, scale)
+    x0, y0, x1, y1 = pack_box(sheets.width, sheets.height, opts)
+    cut_area = sum(p.outline.area for p in sheets.pieces)  # faces and tabs (glue strips too), no labels
     return LayoutReport(
         seconds=seconds, scale_mm_per_unit=scale, paper=opts.paper, page_mm=(sheets.width, sheets.height),
         margin_mm=opts.margin, pages=sheets.packing.n_pages,
-        utilisation=sheets.packing.utilisation, splits_for_page=splits, glue_edges=st.glue_edges, tabs=st.tabs,
+        utilisation=cut_area / (sheets.packing.n_pages * (x1 - x0) * (y1 - y0)), splits_for_page=splits, glue_edges=st.glue_edges, tabs=st.tabs,
         tabs_shrunk=st.tabs_shrunk, tabs_moved=st.tabs_moved, untabbed_edges=tuple(st.untabbed),
         small_labels=st.small_labels, open_edges=st.open_edges, smallest_edge_mm=edge, smallest_face_mm=face,
         reduced_tabs=st.reduced_tabs, labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside,
-        min_label_mm=opts.min_label_mm)
+        min_label_mm=opts.min_label_mm, splits_for_packing=split.cuts,
+        packing_ran_out=split.ran_out or sheets.packing.ran_out)
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),
@@ -127,12 +131,15 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
         raise PolyfoldError(f"{name}: {exc}") from None
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
-    fitted, page_splits = fit_parts(parts, scale, opts, pack_box(width, height, opts), name)
+    box = pack_box(width, height, opts)
+    fitted, page_splits = fit_parts(parts, scale, opts, box, name)
+    split = split_for_pages(mesh, fitted, scale, opts, box, deadline, say)
+    fitted = split.parts
     fit_seconds = time.perf_counter() - ts
     folded, fold_report = fold_pieces(fitted, opts, deadline, say)
-    sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say)
+    sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say, planned=split)
     checks = _check(sheets, opts, name, fold_report.verified, say)
-    layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, sheets.seconds + fit_seconds)
+    layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)
     te = time.perf_counter()
     say("export", "writing sheets and files")
 

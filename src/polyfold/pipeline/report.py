@@ -95,7 +95,7 @@ class LayoutReport:
     page_mm: tuple[float, float]
     margin_mm: float
     pages: int
-    utilisation: float
+    utilisation: float  # area cut out (faces and tabs) / (pages x the page area pieces may use)
     splits_for_page: int
     glue_edges: int
     tabs: int
@@ -110,6 +110,8 @@ class LayoutReport:
     labels_on_tabs: int = 0
     labels_outside: int = 0  # beside their edge, with a leader line when further away
     min_label_mm: float = 2.0  # the least cap height asked for
+    splits_for_packing: int = 0  # creases cut so that the pieces fill fewer pages
+    packing_ran_out: bool = False  # the packer's time budget stopped its search
 
 
 @dataclass(frozen=True)

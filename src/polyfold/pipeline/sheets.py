@@ -2,7 +2,10 @@
 anything is written.
 
 Scale: the model's longest bounding-box side becomes `--size` mm. Parts whose pieces (with room
-for their tabs) do not fit a page are split along creases first (`fit_parts`), before folding.
+for their tabs) do not fit a page are split along creases first (`fit_parts`); then pieces are
+split further where that saves pages (`split_for_pages`). Both happen before folding, which plans
+a path for every piece; the layout after folding (`lay_out`) tries the packing order found before
+it first, so unless folding split a piece the pages come out as planned.
 
 Where pieces go on a page (`pack_box`): inside the margins and above the footer strip; with
 `--marks` the top and left margins grow to `paper.MARK_CLEAR_MM` so the registration marks'
@@ -18,14 +21,18 @@ import time
 from dataclasses import dataclass
 from typing import Callable
 
+import numpy as np
+
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fabricate.fit import PieceTooLarge, split_to_fit
-from ..fabricate.pack import Packing, pack_outlines
+from ..fabricate.pack import ORDER_TRIES, Packing, pack_outlines
 from ..fabricate.page import place
 from ..fabricate.paper import FOOTER_MM, GAP_MM, MARK_CLEAR_MM
 from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
+from ..fabricate.split import PagePlan, plan_pages
 from ..mesh.mesh import Mesh
+from ..unfold.net import cut_creases, piece_net
 from .folding import FoldedPiece
 from .options import MakeOptions
 from .parts import Part
@@ -66,6 +73,168 @@ def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[flo
     return fitted, splits
 
 
+PLAN_ROUNDS = 3  # plans of the cuts for one page count, each on the pieces the last one cut
+# where a plan puts a part it splits off: on the emptiest page that takes one, then (when that fails)
+# on the first; the plans are greedy, and which of the two meets a page count varies from model to model
+PAGE_CHOICES = (True, False)
+# page counts at which the outlines would fill more than this of the printable area are not tried:
+# on the benchmark models no plan above 0.60 succeeded, and failing plans take the longest
+MAX_FILL = 0.75
+
+
+def pack_budget(deadline: Deadline) -> float:
+    """Seconds the packer (and the page split) may take: 2 to 10, what is left of the time limit."""
+    return max(2.0, min(10.0, deadline.left()))
+
+
+def part_piece_inputs(mesh: Mesh, parts: list[Part]) -> list[PieceInput]:
+    """What fabricate needs of every piece of the parts' nets, in the order `fold_pieces` makes
+    them (part by part, piece by piece) when it splits none."""
+    out = []
+    for k, part in enumerate(parts):
+        for piece in range(part.net.n_pieces):
+            pnet, fids = piece_net(part.net, piece)
+            faces = part.faces[fids]
+            out.append(piece_input(pnet, k, mesh.faces[faces], faces))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class PageSplit:
+    """`split_for_pages`' result: the parts with the creases it cut (`cuts` of them); the pages and
+    pieces (net pieces and glue strips) of the packing found and its piece order; every mesh face's
+    place in that order (`lay_out` follows it when folding splits a piece); whether the time budget
+    stopped the search."""
+
+    parts: list[Part]
+    cuts: int
+    pages: int
+    pieces: int
+    net_pieces: int
+    order: tuple[int, ...]
+    rank: np.ndarray
+    ran_out: bool
+    drawn: tuple[list[SheetPiece], list[GlueEdge], LayoutStats]  # build_sheet_pieces of `parts`' pieces
+    inputs: list[PieceInput]  # what was drawn
+
+    def same_pieces(self, folded: list[FoldedPiece]) -> bool:
+        """Whether the folded pieces are the very pieces planned (folding split none)."""
+        return len(folded) == len(self.inputs) and all(
+            np.array_equal(f.mesh_faces, inp.face_ids) for f, inp in zip(folded, self.inputs))
+
+    def hint(self, folded: list[FoldedPiece], n_pieces: int) -> list[int]:
+        """The order to pack `n_pieces` pieces in, the first `folded` ones drawn from the folded
+        pieces (glue strips after them): the planned packing's order for the planned pieces, else
+        the order of the planned pieces they come from."""
+        if self.same_pieces(folded) and n_pieces == self.pieces:
+            return list(self.order)
+        rank = [int(self.rank[f.mesh_faces[0]]) for f in folded] + [len(self.order)] * (n_pieces - len(folded))
+        return sorted(range(n_pieces), key=lambda i: rank[i])
+
+
+def _cut_plan(parts: list[Part], inputs: list[PieceInput], plan: PagePlan) -> tuple[list[Part], int]:
+    """The parts with the plan's creases cut (plan.cuts[i] are faces of inputs[i]'s net)."""
+    n_faces = max(int(p.faces.max()) for p in parts) + 1
+    cut_faces: list[list[np.ndarray]] = [[] for _ in parts]
+    for inp, faces in zip(inputs, plan.cuts):
+        cut_faces[inp.part].append(inp.face_ids[faces])
+    out, n = [], 0
+    for part, faces in zip(parts, cut_faces):
+        mesh_faces = np.concatenate(faces) if faces else np.zeros(0, dtype=np.int64)
+        if len(mesh_faces) == 0:
+            out.append(part)
+            continue
+        local = np.full(n_faces, -1, dtype=np.int64)
+        local[part.faces] = np.arange(len(part.faces))
+        out.append(Part(part.faces, cut_creases(part.net, local[mesh_faces])))
+        n += len(mesh_faces)
+    return out, n
+
+
+def _owner(inputs: list[PieceInput], n_faces: int) -> np.ndarray:
+    """(n_faces,) the piece (index into inputs) every mesh face is in; -1 for none."""
+    owner = np.full(n_faces, -1, dtype=np.int64)
+    for i, inp in enumerate(inputs):
+        owner[inp.face_ids] = i
+    return owner
+
+
+def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptions,
+                    box: tuple[float, float, float, float], deadline: Deadline,
+                    say: Callable[[str, str], None]) -> PageSplit:
+    """Cut creases where that puts the pieces on fewer pages (`fabricate.split`), before folding.
+
+    The pieces are drawn (tabs and labels included) and packed as they are. Then, for each page
+    count from the fewest whose area they could fill to MAX_FILL up to one fewer than that packing:
+    `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and planned
+    again, up to PLAN_ROUNDS times, until a plan needs no cut; the redrawn pieces are packed in the
+    plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
+    other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
+    search. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
+    it when folding splits nothing); a plan is only started with time left to draw what it cuts."""
+    page, margin = _packer_page(box)
+
+    def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+        pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm)
+        return pieces, glue, stats
+
+    def pack(pcs: list[SheetPiece], hint: list[int] | None, seconds: float) -> Packing:
+        return pack_outlines([p.footprint for p in pcs], page, margin=margin, gap=GAP_MM, seed=opts.seed,
+                             time_limit=seconds, hint=hint)
+
+    inputs = part_piece_inputs(mesh, parts)
+    t0 = time.perf_counter()
+    drawn = draw(inputs)  # lay_out's drawing when folding splits nothing: not this stage's cost
+    draw_seconds = time.perf_counter() - t0
+    pieces = drawn[0]
+    packing = pack(pieces, None, pack_budget(deadline))
+    budget = deadline.within(pack_budget(deadline))
+    best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
+    box_area = (box[2] - box[0]) * (box[3] - box[1])
+    fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
+    ran_out = packing.ran_out
+    for n_pages in range(fewest, packing.n_pages):
+        say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
+        for emptiest_first in PAGE_CHOICES:
+            cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
+            for _ in range(PLAN_ROUNDS):
+                if budget.left() < draw_seconds:  # no time to draw what this plan would cut
+                    ran_out = True
+                    break
+                plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
+                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first)
+                if plan is None:
+                    ran_out |= budget.expired()
+                    break
+                if not any(len(c) for c in plan.cuts):
+                    hint = [t for t, _ in plan.order]
+                    break
+                cur_parts, n_cut = _cut_plan(cur_parts, cur_inputs, plan)
+                cut_inputs = part_piece_inputs(mesh, cur_parts)
+                owner = _owner(cut_inputs, mesh.n_faces)
+                # the plan's order (glue strips are drawn anew: after the net pieces)
+                hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
+                cuts += n_cut
+                cur_inputs = cut_inputs
+                cur_drawn = draw(cur_inputs)
+            if hint is not None:
+                cut_packing = pack(cur_drawn[0], hint, max(0.5, budget.left()))
+                ran_out |= cut_packing.ran_out
+                if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
+                    best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
+                            cur_drawn)
+            if best[0] <= n_pages or ran_out:
+                break
+        if best[0] <= n_pages or ran_out:
+            break
+    n_pages, n_pieces, parts, inputs, order, cuts, drawn = best
+    rank = np.full(mesh.n_faces, len(order), dtype=np.int64)
+    for pos, i in enumerate(order):
+        if i < len(inputs):  # glue strips come after the net pieces and have no faces
+            rank[inputs[i].face_ids] = pos
+    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs)
+
+
 @dataclass(frozen=True, eq=False)
 class Sheets:
     """The pieces in mm, placed on their pages (pieces[i] is folded[i]), the glue pairs, the
@@ -92,15 +261,23 @@ def piece_inputs(mesh: Mesh, folded: list[FoldedPiece]) -> list[PieceInput]:
 
 
 def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptions, width: float, height: float,
-            deadline: Deadline, say: Callable[[str, str], None]) -> Sheets:
-    """Tabs and labels for every piece, then the pieces packed onto as few pages as possible."""
+            deadline: Deadline, say: Callable[[str, str], None], planned: PageSplit | None = None) -> Sheets:
+    """Tabs and labels for every piece, then the pieces packed onto as few pages as possible. With
+    the `planned` split, its packing order goes first; when folding split no piece, the pieces it
+    drew are the ones laid out and its order, the best of those tried on them, the only one tried."""
     tl = time.perf_counter()
-    say("layout", f"tabs and labels for {len(folded)} pieces")
-    pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
-                                             min_label_mm=opts.min_label_mm)
+    same = planned is not None and planned.same_pieces(folded)
+    if same:  # drawn before folding: the same inputs draw the same pieces
+        pieces, glue, stats = planned.drawn
+    else:
+        say("layout", f"tabs and labels for {len(folded)} pieces")
+        pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
+                                                 min_label_mm=opts.min_label_mm)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     page, margin = _packer_page(pack_box(width, height, opts))
+    hint = None if planned is None else planned.hint(folded, len(pieces))
+    tries = 1 if same else ORDER_TRIES
     packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
-                            time_limit=max(2.0, min(10.0, deadline.left())))
+                            time_limit=pack_budget(deadline), hint=hint, tries=tries)
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
     return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl, scale)

@@ -69,8 +69,11 @@ def make(
                 f"{BUILDABLE_EDGE_MM:g} mm")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
+        if lay.splits_for_packing:
+            say(f"split {lay.splits_for_packing} more crease(s) so the pieces fill fewer pages")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
-             f"page(s), smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
+             f"page(s) ({lay.utilisation:.0%} of their printable area), {lay.glue_edges} glue edges, "
+             f"smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
              f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 

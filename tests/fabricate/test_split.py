@@ -1,0 +1,113 @@
+"""fabricate/split.py: cutting creases so that the pieces of a real net fill fewer pages."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+from shapely import Polygon
+
+from polyfold.deadline import Deadline
+from polyfold.fabricate.fit import model_scale
+from polyfold.fabricate.pack import pack_outlines
+from polyfold.fabricate.paper import GAP_MM
+from polyfold.fabricate.pieces import build_sheet_pieces
+from polyfold.fabricate.split import MIN_PART, MIN_PART_FACES, plan_pages
+from polyfold.formats.meshes import load_mesh
+from polyfold.pipeline.options import MakeOptions, paper_size
+from polyfold.pipeline.parts import make_parts
+from polyfold.pipeline.sheets import _packer_page, fit_parts, pack_box, part_piece_inputs
+from polyfold.unfold.net import cut_creases, piece_net
+
+MARGIN = 10.0
+
+
+@pytest.fixture(scope="module")
+def bunny(models_dir):
+    """bunny-128 at the defaults (A4, 150 mm): its pieces as make draws them before folding."""
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    opts = MakeOptions()
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    box = pack_box(*paper_size(opts.paper), opts)
+    fitted, _ = fit_parts(parts, scale, opts, box, "bunny-128")
+    inputs = part_piece_inputs(mesh, fitted)
+    pieces, _, _ = build_sheet_pieces(inputs, scale)
+    page, margin = _packer_page(box)  # the page the packer is given: `box` inside its margins
+    assert margin == MARGIN
+    return {"mesh": mesh, "inputs": inputs, "pieces": pieces, "page": page, "scale": scale}
+
+
+def plan(bunny, n_pages, **kw):
+    return plan_pages(bunny["pieces"], [inp.net for inp in bunny["inputs"]], bunny["page"], MARGIN, GAP_MM, n_pages,
+                      time.perf_counter() + 60, seed=1, **kw)
+
+
+def printable_area(page) -> float:
+    return (page[0] - 2 * MARGIN) * (page[1] - 2 * MARGIN)
+
+
+def test_bunny_needs_more_than_two_pages_uncut_and_the_plan_fits_two(bunny):
+    pieces, page = bunny["pieces"], bunny["page"]
+    whole = pack_outlines([p.footprint for p in pieces], page, MARGIN, GAP_MM, seed=1)
+    area = sum(p.footprint.area for p in pieces)
+    assert whole.n_pages >= 3 and 1 < area / printable_area(page) < 2
+    p = plan(bunny, 2)
+    assert p is not None and p.pages == 2
+    assert sum(len(c) for c in p.cuts) > 0
+
+
+def test_plan_cuts_only_creases_and_names_every_part_once(bunny):
+    p = plan(bunny, 2)
+    lo = MIN_PART * printable_area(bunny["page"])
+    n_parts = 0
+    for inp, cuts, piece in zip(bunny["inputs"], p.cuts, bunny["pieces"]):
+        net = inp.net
+        assert (net.parent_edge[cuts] >= 0).all()  # a crease of the piece: never through a face
+        cut = cut_creases(net, cuts)
+        np.testing.assert_array_equal(cut.coords, net.coords)  # no face moves
+        roots = {root for t, root in p.order if bunny["inputs"][t] is inp}
+        assert roots == set(np.flatnonzero(cut.parent < 0).tolist())  # each part placed once, by its root
+        n_parts += cut.n_pieces
+        for k in range(cut.n_pieces):  # no sliver: every part at least MIN_PART of a page (faces and
+            faces = piece_net(cut, k)[1]  # tabs), and at least two faces
+            assert faces_area(piece, faces) >= lo * (1 - 1e-9) and len(faces) >= MIN_PART_FACES
+    assert n_parts == len(p.order) == len(bunny["pieces"]) + sum(len(c) for c in p.cuts)
+
+
+def faces_area(piece, faces) -> float:
+    """Area (mm^2) of the piece's faces `faces` with the tabs the whole piece has on their sides."""
+    tri = piece.faces_xy[faces]
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = float(np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum() / 2)
+    mids = ((tri + np.roll(tri, -1, axis=1)) / 2).reshape(-1, 2)
+    for tab, fold in zip(piece.tabs, piece.tab_folds):
+        if np.linalg.norm(mids - fold.mean(axis=0), axis=1).min() < 1e-6:
+            area += Polygon(tab).area
+    return area
+
+
+def test_plan_is_deterministic_and_fails_below_the_area_bound(bunny):
+    a, b = plan(bunny, 2), plan(bunny, 2)
+    assert a.order == b.order and all(np.array_equal(x, y) for x, y in zip(a.cuts, b.cuts))
+    area = sum(p.footprint.area for p in bunny["pieces"]) / printable_area(bunny["page"])
+    assert math.ceil(area) == 2
+    assert plan(bunny, 1) is None  # more outline than one page holds
+
+
+def test_plan_with_room_cuts_nothing_and_is_the_packers_first_fit(bunny):
+    pieces, page = bunny["pieces"], bunny["page"]
+    whole = pack_outlines([q.footprint for q in pieces], page, MARGIN, GAP_MM, seed=1)
+    p = plan(bunny, whole.n_pages)
+    assert p is not None and not any(len(c) for c in p.cuts)
+    order = [t for t, _ in p.order]
+    assert sorted(order) == list(range(len(pieces)))
+    packing = pack_outlines([q.footprint for q in pieces], page, MARGIN, GAP_MM, seed=1, hint=order, tries=1)
+    assert packing.n_pages <= whole.n_pages and list(packing.order) == order
+
+
+def test_plan_gives_up_at_its_deadline(bunny):
+    assert plan_pages(bunny["pieces"], [inp.net for inp in bunny["inputs"]], bunny["page"], MARGIN, GAP_MM, 2,
+                      time.perf_counter() - 1.0) is None
