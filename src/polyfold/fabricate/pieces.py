@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..mesh.geometry import FLAT_EPS  # flat creases are not scored, as in the FOLD files
+from ..mesh.geometry import FLAT_EPS, merged_edges  # flat creases are not scored, as in the FOLD files
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
 from .labels import LabelStats, PieceLabels, label_font, piece_name, text_width
@@ -133,7 +133,8 @@ def _draw(inp: PieceInput, i: int, scale: float) -> _Drawn:
         a, b = inp.vertex_ids[mesh.faces[f, k]], inp.vertex_ids[mesh.faces[f, (k + 1) % 3]]
         key = (int(min(a, b)), int(max(a, b)))
         sides.append((key, CutSide(i, int(f), int(k), xy[f, k], xy[f, (k + 1) % 3], xy[f])))
-    return _Drawn(xy, body, seg[rho > FLAT_EPS], seg[rho < -FLAT_EPS], sides)
+    drawn = ~merged_edges(mesh)[e]  # no line inside a flat polygon (coplanar faces, one input polygon)
+    return _Drawn(xy, body, seg[drawn & (rho > FLAT_EPS)], seg[drawn & (rho < -FLAT_EPS)], sides)
 
 
 def _pair_sides(drawn: list[_Drawn]) -> tuple[list[tuple[tuple[int, int], list[CutSide]]], int]:
@@ -149,17 +150,20 @@ def _pair_sides(drawn: list[_Drawn]) -> tuple[list[tuple[tuple[int, int], list[C
     return pairs, open_edges
 
 
-def seam_fold_angles(inputs: list[PieceInput]) -> dict[tuple[int, int], float]:
+def seam_fold_angles(inputs: list[PieceInput]) -> tuple[dict[tuple[int, int], float], set[tuple[int, int]]]:
     """Signed fold angle rho (radians, + convex) of every edge of the model the pieces make, keyed
-    by its whole-mesh vertex ids (low, high): the pieces' faces put back together in 3D, so a seam
-    between two pieces gets the angle of its two faces in the model."""
+    by its whole-mesh vertex ids (low, high), and the edges inside a flat polygon of it
+    (`merged_edges`): the pieces' faces put back together in 3D, so a seam between two pieces gets
+    the angle of its two faces in the model."""
     n = max(int(inp.vertex_ids.max()) for inp in inputs) + 1
     vertices = np.zeros((n, 3))
     for inp in inputs:
         vertices[inp.vertex_ids] = inp.net.mesh.vertices
-    whole = Mesh(vertices, np.concatenate([inp.vertex_ids[inp.net.mesh.faces] for inp in inputs]))
-    keys = np.sort(whole.topology.edges, axis=1)
-    return {(int(a), int(b)): float(r) for (a, b), r in zip(keys, whole.fold_angles)}
+    whole = Mesh(vertices, np.concatenate([inp.vertex_ids[inp.net.mesh.faces] for inp in inputs]),
+                 np.concatenate([inp.net.mesh.face_source for inp in inputs]))
+    keys = [(int(a), int(b)) for a, b in np.sort(whole.topology.edges, axis=1)]
+    merged = merged_edges(whole)
+    return dict(zip(keys, whole.fold_angles.tolist())), {k for k, m in zip(keys, merged) if m}
 
 
 @dataclass
@@ -263,7 +267,10 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     drawn = [_draw(inp, i, scale) for i, inp in enumerate(inputs)]
     pairs, open_edges = _pair_sides(drawn)
     rooms = [Room(shapely.polygons(d.faces_xy)) for d in drawn]
-    rho = seam_fold_angles(inputs)
+    rho, flat = seam_fold_angles(inputs)
+    # a flat polygon whose faces close a cycle keeps one edge out of its tree: both sides lie on
+    # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
+    pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
     g, chosen = _glue(pairs, drawn, rooms, tabs, rho)
     placed, label_stats = _labels(pairs, drawn, rooms, chosen, min_label_mm)
     pieces = []
