@@ -34,7 +34,7 @@ def test_tab_moves_to_the_other_side_when_the_first_is_blocked():
     assert choose_tab((SIDE0, SIDE1), _rooms([TRI0], [TRI1])).side == 0
     # a tab already there blocks as a face does
     rooms = _rooms([TRI0], [TRI1])
-    rooms[0].extra.append(Polygon([(0, 0), (20, 0), (20, -3), (0, -3)]))
+    rooms[0].add([Polygon([(0, 0), (20, 0), (20, -3), (0, -3)])])
     assert choose_tab((SIDE0, SIDE1), rooms).side == 1
     # both sides blocked right at the edge: no tab
     blocker1 = blocker + [40.0, 0.0]

@@ -18,7 +18,7 @@ from ..mesh.mesh import Mesh
 from ..unfold import kernels as K
 from ..unfold.net import Net, cut_creases, subtree_areas
 from .pack import _best_fit
-from .tabs import TAB_MAX_MM
+from .tabs import TAB_ROOM_MM
 
 MAX_PEEL_TRIES = 64
 # Rotations (degrees) `pack.pack_outlines` tries for every outline whatever its shape: the evenly
@@ -94,7 +94,7 @@ def _model_factor(points_mm: np.ndarray, page_size, margin: float, pad: float) -
 
 
 def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin: float,
-                 pad: float = TAB_MAX_MM + 1.0) -> tuple[Net, int]:
+                 pad: float = TAB_ROOM_MM) -> tuple[Net, int]:
     """Cut creases of `net` until every piece, grown by `pad` mm (room for tabs), fits the page.
 
     Greedy: peel off a subtree that fits (the largest whose rest also fits, else the largest),
@@ -159,7 +159,7 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
 
 
 def join_pieces(net: Net, scale: float, page_size: tuple[float, float], margin: float,
-                pad: float = TAB_MAX_MM + 1.0, limit: int | None = None) -> tuple[Net, int]:
+                pad: float = TAB_ROOM_MM, limit: int | None = None) -> tuple[Net, int]:
     """Join pieces of `net` along the mesh edges they share, at most `limit` times (None: no limit):
     a piece is moved rigidly to hinge on its neighbour's side of the edge (the edge becomes a
     crease) when the two stay overlap-free (`collide.flat`, the unfolder's tolerance), enclose no

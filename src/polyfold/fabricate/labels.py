@@ -10,7 +10,9 @@ label goes, in order:
 3. just outside the edge (beyond the tab on the side that has one), clear of the piece's faces,
    tabs and labels, else a little further in a free spot with a leader line to the edge, else
    up to FAR_STEPS_MM away in any direction, its leader crossing the piece's lines if it must: an
-   off-face label, which the packer keeps clear of other pieces (`SheetPiece.footprint`);
+   off-face label, which the packer keeps clear of other pieces (`SheetPiece.footprint`), never
+   further out than the tab room around the piece's convex hull (`tabs.TAB_ROOM_MM`), which
+   fitting pieces to the page reserves;
 4. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
 """
@@ -24,7 +26,7 @@ import numpy as np
 
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT, CHAR_EM
-from .tabs import TAB_CLEAR_MM, CutSide, Room
+from .tabs import TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
 
 PIECE_FONT_MAX_MM = 6.0  # a piece's name may be larger, up to this, where its face has room
 LABEL_PAD_MM = 0.25  # gap between a label's glyph box and any line or other label
@@ -160,7 +162,11 @@ class PieceLabels:
     docstring). `room` is the piece's `tabs.Room`: off-face labels are added to it."""
 
     def __init__(self, room: Room, size: float) -> None:
+        import shapely
+
         self.room = room
+        # off-face labels stay in the room fitting a piece to the page leaves for its tabs
+        self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
         self.size = size
         self.boxes = _Boxes()
         self.items: list[TextItem] = []
@@ -242,7 +248,7 @@ class PieceLabels:
         for center, w, leader in spots + far:
             box = text_box(center, u, text, self.size)
             poly = Polygon(box)
-            if self.room.blocked(poly, None, TAB_CLEAR_MM) or self.boxes.hits(box):
+            if not self.allowed.contains(poly) or self.boxes.hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
                 continue
             extra = [poly]
             if leader:
@@ -255,7 +261,7 @@ class PieceLabels:
                 self.leaders.append(np.array([start, end]))
                 extra.append(LineString([start, end]).buffer(LEADER_HALF_MM))
             self._put(text, center, u, self.size, "edge-label", box)
-            self.room.extra.extend(extra)
+            self.room.add(extra)
             self.outside.extend(extra)
             return True
         return False

@@ -209,7 +209,7 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
             out.tabs[piece].append(poly)
             out.tab_folds[piece].append(fold)
             out.tab_mountain[piece].append(rho[key] > 0)
-            rooms[piece].extra.append(Polygon(poly))
+            rooms[piece].add([Polygon(poly)])
         out.n_tabs += 1
         out.moved += tab.side == 1
         if tab.reason != "full":
@@ -276,9 +276,10 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     pieces = []
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
         tab_polys = [shapely.Polygon(t) for t in g.tabs[i]]
-        # snapped to a 1e-6 mm grid: a clipped tab meets its face mid-edge, where float noise would
-        # leave a hair-thin gap or sliver instead of one outline
-        outline = shapely.union_all([d.body, *tab_polys], grid_size=1e-6) if tab_polys else d.body
+        # a clipped tab meets its face mid-edge, where float noise would leave a hair-thin gap:
+        # each tab is grown by 10 nm (invisible) so it overlaps its face, then all is unioned on a grid
+        grown = [t.buffer(1e-5, join_style="mitre") for t in tab_polys]
+        outline = shapely.union_all([d.body, *grown], grid_size=1e-6) if tab_polys else d.body
         footprint = shapely.union_all([outline, *placed[i].outside]) if placed[i].outside else outline
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 TAB_MAX_MM = 6.0  # full tab depth on long edges
+TAB_ROOM_MM = TAB_MAX_MM + 1.0  # room left around a piece's convex hull for its tabs and off-face labels
 TAB_REL = 0.4  # full tab depth as a fraction of its edge length, between TAB_MIN_MM and TAB_MAX_MM
 TAB_MIN_MM = 3.0  # a lowered tab: the least depth that still takes a finger and glue
 TAB_MIN_DEPTH_MM = 2.0  # a clipped (tapered) tab must reach this far from its fold line somewhere
@@ -96,25 +97,32 @@ def tab_polygon(side: CutSide, depth: float, side_deg: float) -> np.ndarray | No
 @dataclass(eq=False)
 class Room:
     """What is on one piece, for the tabs and labels still to place: its face polygons (shapely,
-    in an STRtree) and the tabs and off-face label boxes placed so far (`extra`)."""
+    in an STRtree) and the tabs and off-face label boxes placed so far (`add`, `extra`)."""
 
     faces: np.ndarray  # shapely Polygons, one per face
     tree: object = field(init=False)
     extra: list = field(default_factory=list)
+    _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
 
     def __post_init__(self) -> None:
         import shapely
 
         self.tree = shapely.STRtree(self.faces)
 
+    def add(self, geoms) -> None:
+        """Place shapely geometries (tabs, label boxes, leaders) on the piece."""
+        for g in geoms:
+            self.extra.append(g)
+            self._bounds.append(g.bounds)
+
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
         near = [self.faces[i] for i in self.tree.query(region) if i != skip_face]
-        x0, y0, x1, y1 = region.bounds
-        for g in self.extra:
-            a0, b0, a1, b1 = g.bounds
-            if a0 <= x1 and x0 <= a1 and b0 <= y1 and y0 <= b1:
-                near.append(g)
+        if self._bounds:
+            x0, y0, x1, y1 = region.bounds
+            b = np.asarray(self._bounds)
+            hit = np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
+            near += [self.extra[i] for i in hit]
         return near
 
     def blocked(self, poly, skip_face: int | None = None, clear: float = 0.0, keep_free: list | None = None) -> bool:
@@ -126,13 +134,16 @@ class Room:
         near = self.obstacles(grown, skip_face)
         if not near:
             return False
-        others = shapely.union_all(near)
-        if shapely.area(shapely.intersection(poly, others)) > OVERLAP_MM2:
+        # faces, tabs and labels never overlap one another: areas against each of them add up
+        others = np.array(near, dtype=object)
+        if shapely.area(shapely.intersection(poly, others)).sum() > OVERLAP_MM2:
             return True
+        if not clear:
+            return False
         hit = shapely.intersection(grown, others)
         if keep_free:
             hit = shapely.difference(hit, shapely.union_all(keep_free))
-        return shapely.area(hit) > OVERLAP_MM2
+        return shapely.area(hit).sum() > OVERLAP_MM2
 
 
 def _fold_of(part, side: CutSide) -> np.ndarray | None:
