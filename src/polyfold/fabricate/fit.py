@@ -1,8 +1,10 @@
-"""Splitting a net to fit a page: cut creases until every piece, with room for its tabs, fits.
+"""Splitting a net to fit a page: cut creases until every piece, with room for its tabs, fits,
+then join pieces back where two fit together.
 
-Cutting creases never moves a face, so the pieces stay overlap-free. The merged creases of a flat
-region (`mesh.geometry.merged_edges`) are never cut: a flat polygon too large for the page is an
-error, like a single face.
+Cutting creases never moves a face, so the pieces stay overlap-free; a join moves a whole piece
+and checks the two again. The merged creases of a flat region (`mesh.geometry.merged_edges`) are
+never cut: a flat polygon too large for the page is an error, like a single face. A piece "fits"
+in one of the rotations the packer tries for any outline (PACK_ANGLES), so it always packs.
 """
 
 from __future__ import annotations
@@ -55,7 +57,8 @@ def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> 
     import shapely
 
     hull = shapely.convex_hull(shapely.multipoints(points_mm)).buffer(pad, quad_segs=2)
-    return _best_fit(shapely.get_coordinates(hull), PACK_ANGLES, page_size[0] - 2 * margin, page_size[1] - 2 * margin)[0]
+    pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
+    return _best_fit(shapely.get_coordinates(hull), PACK_ANGLES, pw, ph)[0]
 
 
 def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
@@ -130,7 +133,8 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
             return net, cuts
         cand = todo[cuttable[todo]]
         if len(cand) == 0:  # one face, or one flat polygon
-            raise PieceTooLarge(net.mesh.face_source[todo], _model_factor(xy[todo].reshape(-1, 2), page_size, margin, pad))
+            factor = _model_factor(xy[todo].reshape(-1, 2), page_size, margin, pad)
+            raise PieceTooLarge(net.mesh.face_source[todo], factor)
         cand = cand[np.argsort(-sub_area[cand], kind="stable")]
         # Peel a subtree that fits; best one whose rest fits too (two pieces instead of three),
         # else the largest that fits. Only the MAX_PEEL_TRIES largest fitting subtrees are weighed.

@@ -8,8 +8,9 @@ the notch's vertex that halves its angle, glue a cut edge that reconnects the tw
 the net stays overlap-free and the notches' total shortfall (`corner_penalty`) falls.
 
 In: a single-piece `Net` of a closed or open mesh, the creases that must stay (`keep`; the merged
-edges of flat regions, `mesh.geometry.merged_edges`, always stay), a `Deadline`. Out: a `Net` of the same faces (one piece, overlap-free, re-laid out) and
-`TabRoomStats`. Multi-piece nets are returned unchanged.
+edges of flat regions, `mesh.geometry.merged_edges`, always stay), a `Deadline`. Out: a `Net` of
+the same faces (one piece, overlap-free, re-laid out) and `TabRoomStats`. Multi-piece nets are
+returned unchanged.
 """
 
 from __future__ import annotations
