@@ -49,7 +49,7 @@ import shapely
 
 from sheet_reader import FOLD_KINDS, Sheet, read_dxf, read_pdf, read_svg
 
-FLAT_DEG = 0.5  # seams flatter than this count as flat (coplanar faces)
+FLAT_DEG = math.degrees(1e-3)  # "coplanar": within 1e-3 rad (0.057 degrees), the tolerance polyfold states (README)
 LABEL_MIN_MM = 2.0  # smallest readable cap height
 FULL_TAB_MM = 6.0  # today's full tab: min(FULL_TAB_REL x edge, FULL_TAB_MM) deep
 FULL_TAB_REL = 0.4
