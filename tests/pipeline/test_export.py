@@ -154,7 +154,7 @@ def test_scale_bar_in_the_svg(folder):
         sheet = read_sheet(svg)
         assert 297 - 10 - 6 <= segs[..., 1].min() and segs[..., 1].max() <= 297 - 10
         assert 10 <= segs[..., 0].min() and segs[..., 0].max() <= 210 - 10
-        pieces = shapely.union_all([Polygon(c) for c in sheet["cuts"]])
+        pieces = shapely.union_all([shapely.make_valid(Polygon(c)) for c in sheet["cuts"]])
         assert shapely.union_all([LineString(s) for s in segs]).distance(pieces) > 1.0
 
 
@@ -222,7 +222,7 @@ def test_marks_on_print_pages_not_in_cut_files(marked, folder, tmp_path):
         assert all(float(c.get("stroke-width")) == 0.5 for c in corners)
         # pieces clear of the three marked corners (30 mm squares; a piece may touch one's side, the
         # margin line), and of the marks themselves
-        pieces = shapely.union_all([Polygon(c) for c in read_sheet(svg)["cuts"]])
+        pieces = shapely.union_all([shapely.make_valid(Polygon(c)) for c in read_sheet(svg)["cuts"]])
         for x0, y0 in ((0, 0), (180, 0), (0, 267)):
             assert not pieces.relate_pattern(shapely.box(x0, y0, x0 + 30, y0 + 30), "T********")  # interiors
     for cut in marked.glob("cut-*.svg"):
