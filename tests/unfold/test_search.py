@@ -45,6 +45,22 @@ def assert_valid_net(net, n_pieces=1):
     assert net.n_pieces == n_pieces
 
 
+def _tree_path(parent: np.ndarray, order: np.ndarray, f: int, g: int) -> list[int]:
+    """The faces whose crease to their parent lies on the tree path between faces f and g."""
+    depth = np.zeros(len(parent), int)
+    for x in order[1:]:
+        depth[x] = depth[parent[x]] + 1
+    on_path = []
+    while f != g:
+        if depth[f] >= depth[g]:
+            on_path.append(f)
+            f = parent[f]
+        else:
+            on_path.append(g)
+            g = parent[g]
+    return on_path
+
+
 @pytest.mark.parametrize("name", PLATONIC)
 def test_platonic_solids_single_net(models_dir, name):
     net, stats = unfold(single_component(models_dir, name), seed=1)
@@ -105,17 +121,8 @@ def test_fallback_splits_into_overlap_free_pieces(models_dir):
     assert len(pairs) > 0  # a plain flat tree of this bumpy mesh overlaps
     cut = split_into_pieces(parent, parent_edge, order, pairs)
     # every overlapping pair is separated: some crease on its tree path is cut
-    depth = np.zeros(len(parent), int)
-    for f in order[1:]:
-        depth[f] = depth[parent[f]] + 1
     for f, g in pairs:
-        on_path = []
-        while f != g:
-            if depth[f] >= depth[g]:
-                on_path.append(f); f = parent[f]
-            else:
-                on_path.append(g); g = parent[g]
-        assert cut[on_path].any()
+        assert cut[_tree_path(parent, order, f, g)].any()
 
 
 def test_time_limit_fallback_and_max_pieces(models_dir):
@@ -225,17 +232,9 @@ def test_fallback_cuts_only_cuttable_creases(models_dir):
     pairs = problem.overlaps(coords, parent)
     cuttable = (parent >= 0) & (rng.random(len(parent)) < 0.5)
     cut = split_into_pieces(parent, parent_edge, order, pairs, cuttable=cuttable)
-    depth = np.zeros(len(parent), int)
-    for f in order[1:]:
-        depth[f] = depth[parent[f]] + 1
     allowed = cuttable.copy()
     for f, g in pairs:
-        on_path = []
-        while f != g:
-            if depth[f] >= depth[g]:
-                on_path.append(f); f = parent[f]
-            else:
-                on_path.append(g); g = parent[g]
+        on_path = _tree_path(parent, order, f, g)
         assert cut[on_path].any()  # still separated
         if not cuttable[on_path].any():
             allowed[on_path] = True  # the only way to separate this pair

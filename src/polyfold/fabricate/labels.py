@@ -36,12 +36,6 @@ LEADER_HALF_MM = 0.1  # half the width of a leader line (clearance it needs)
 FAR_STEPS_MM = (8.0, 14.0, 20.0, 28.0)  # the last resort: a label this far away, its leader may cross the piece
 
 
-def shapely_point(p: np.ndarray):
-    from shapely.geometry import Point
-
-    return Point(float(p[0]), float(p[1]))
-
-
 def label_font(min_cap_mm: float) -> float:
     """Font size (em, mm) of every glue label: the one whose cap height is `min_cap_mm` (larger
     labels would take room that smaller faces need)."""
@@ -96,6 +90,7 @@ class _Boxes:
     """Label boxes placed on one piece, in a spatial hash of CELL_MM cells."""
 
     cells: dict = field(default_factory=dict)
+    count: int = 0  # boxes placed (their ids)
 
     def _keys(self, box: np.ndarray):
         (x0, y0), (x1, y1) = box.min(axis=0) // CELL_MM, box.max(axis=0) // CELL_MM
@@ -125,7 +120,8 @@ class _Boxes:
     def add(self, box: np.ndarray) -> None:
         from shapely.geometry import Polygon
 
-        item = (sum(len(v) for v in self.cells.values()), Polygon(box))
+        item = (self.count, Polygon(box))
+        self.count += 1
         for key in self._keys(box):
             self.cells.setdefault(key, []).append(item)
 
@@ -231,7 +227,7 @@ class PieceLabels:
     def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float) -> bool:
         """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it, else up to
         LEADER_MAX_MM away in a free spot with a leader line to the middle of the edge (or tab)."""
-        from shapely.geometry import LineString, Polygon
+        from shapely.geometry import LineString, Point, Polygon
 
         d = side.p1 - side.p0
         start = side.p0 + 0.5 * d + n_out * beyond
@@ -252,7 +248,7 @@ class PieceLabels:
                 continue
             extra = [poly]
             if leader:
-                end = np.asarray(poly.exterior.interpolate(poly.exterior.project(shapely_point(start))).coords[0])
+                end = np.asarray(poly.exterior.interpolate(poly.exterior.project(Point(*start))).coords[0])
                 line = LineString([start + (end - start) * min(1.0, TAB_CLEAR_MM / max(np.linalg.norm(end - start), 1e-9)), end])
                 if self.boxes.hits_geom(line.buffer(LEADER_HALF_MM)):
                     continue

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import PolyfoldError
 from ..shelves import shelf_offsets
 from ..unfold.net import Net, piece_net
-from .labels import CHAR_EM
+from .labels import text_width
 from .fit import model_scale
 from .pack import Placement
 from .paper import FOOTER_FONT_MM, FOOTER_MM, GAP_MM
@@ -89,7 +89,7 @@ def net_sheet(nets: Sequence[Net], size_mm: float, *, labels: bool = True, tabs:
     placed = [place(p, pl) for p, pl in zip(pieces, placements)]
     n = len(placed)
     footer = f"{title + ' - ' if title else ''}{n} piece{'s' if n != 1 else ''} - {size_mm:g} mm - polyfold"
-    width = max(used_w, CHAR_EM * FOOTER_FONT_MM * len(footer)) + 2 * MARGIN_MM
+    width = max(used_w, text_width(footer, FOOTER_FONT_MM)) + 2 * MARGIN_MM
     height = used_h + FOOTER_MM + 2 * MARGIN_MM
     page = page_of(placed, width, height, footer, height - MARGIN_MM - FOOTER_MM / 2)
     return NetSheet(page, tuple(placed), tuple(glue), stats, scale)

@@ -166,9 +166,9 @@ def _depth(poly: np.ndarray, side: CutSide) -> float:
     return float(np.max((poly - side.p0) @ side.outward()))
 
 
-def _clipped(side: CutSide, room: Room) -> Tab | None:
-    """The full tab minus everything within TAB_CLEAR_MM of the piece's other faces and extras;
-    None when less than the minimum glue area or depth stays."""
+def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
+    """The full tab on sides[s] minus everything within TAB_CLEAR_MM of the piece's other faces and
+    extras; None when less than the minimum glue area or depth stays."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -200,7 +200,7 @@ def _clipped(side: CutSide, room: Room) -> Tab | None:
     depth = max(_depth(p, side) for p in parts)
     if area < MIN_GLUE_FRAC * whole.area or depth < min(TAB_MIN_DEPTH_MM, full_depth(side.length)) - 1e-9:
         return None
-    return Tab(-1, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
+    return Tab(s, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
 
 
 def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
@@ -209,6 +209,8 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
     docstring). A tab may touch the faces beside its fold line at the corners, nothing else."""
     from shapely.geometry import Point, Polygon
 
+    # where a tab's fold line meets the neighbouring faces: near contact expected there
+    corners = [[Point(side.p0).buffer(2 * TAB_CLEAR_MM), Point(side.p1).buffer(2 * TAB_CLEAR_MM)] for side in sides]
     for depth_kind, side_deg, reason in TAB_VARIANTS:
         for s, side in enumerate(sides):
             depth = full_depth(side.length) if depth_kind == "full" else TAB_MIN_MM
@@ -218,15 +220,10 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
             if poly is None:
                 continue
             tab = Polygon(poly)
-            corners = [Point(side.p0).buffer(2 * TAB_CLEAR_MM), Point(side.p1).buffer(2 * TAB_CLEAR_MM)]
-            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, corners):
+            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, corners[s]):
                 return Tab(s, (poly,), np.array([[side.p0, side.p1]]), depth, reason)
-    best = None
-    for s, side in enumerate(sides):
-        tab = _clipped(side, rooms[side.piece])
-        if tab is not None and (best is None or _area(tab) > _area(best)):
-            best = Tab(s, tab.polygons, tab.folds, tab.depth, tab.reason)
-    return best
+    clipped = [tab for s, side in enumerate(sides) if (tab := _clipped(s, side, rooms[side.piece])) is not None]
+    return max(clipped, key=_area, default=None)
 
 
 def _area(tab: Tab) -> float:
