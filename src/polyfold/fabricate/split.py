@@ -192,7 +192,8 @@ def _split_onto(filler: PageFiller, page: int, tree: _Tree, t: int, mask: np.nda
 
 def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tuple[float, float], margin: float,
                gap: float, n_pages: int, deadline: float, angles: int = ANGLES, seed: int = 0,
-               emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES) -> PagePlan | None:
+               emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES,
+               rasters: dict | None = None) -> PagePlan | None:
     """Cut creases so that the pieces fit on `n_pages` pages (see the module docstring). pieces[i]
     is drawn from the single-piece net nets[i] (same faces, same order); pieces after the last net
     (glue strips) are placed whole. Packed: the pieces' footprints. page_size (width, height mm),
@@ -200,8 +201,10 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
     the most room that takes one (`emptiest_first`), else the first. A side split off, and the rest,
     cover at least `min_part` of a page's printable area. None when the plan finds no way, or at
     `deadline` (`time.perf_counter()` seconds). A plan without cuts is pack_outlines' first fit in
-    the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages."""
-    filler = PageFiller(page_size, margin, gap, n_pages, angles, seed)
+    the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages.
+    `rasters`: a dict kept across plans of these very pieces (same page, gap, angles, seed), so that
+    a part tried by one is not rasterised again by the next."""
+    filler = PageFiller(page_size, margin, gap, n_pages, angles, seed, rasters)
     lo = min_part * filler.printable_area
     trees = [_Tree(p, nets[i] if i < len(nets) else None) for i, p in enumerate(pieces)]
     # the queue: (-area, sequence number, piece, faces); larger first, ties in input order

@@ -193,6 +193,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
     ran_out = packing.ran_out
+    rasters: dict[int, tuple] = {}  # per drawing: (the drawing, kept alive so its id stays its own, rasters)
     for n_pages in range(fewest, packing.n_pages):
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
         for emptiest_first in PAGE_CHOICES:
@@ -202,7 +203,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
                     ran_out = True
                     break
                 plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
-                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first)
+                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first,
+                                  rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1])
                 if plan is None:
                     ran_out |= budget.expired()
                     break
