@@ -77,8 +77,9 @@ class Packing:
     n_pages: int
     page_size: tuple[float, float]  # (width, height) mm
     margin: float
-    # what is cut out (the outlines: faces and tabs) over the printable area of the pages used:
-    # total outline area / (n_pages * (width - 2 margin) * (height - 2 margin))
+    # the outlines' area over the printable area of the pages used: total outline area / (n_pages *
+    # (width - 2 margin) * (height - 2 margin)); make packs footprints (labels beside pieces too) and
+    # reports the cut-out area instead (pipeline.make)
     utilisation: float
     order: tuple[int, ...] = ()  # the piece order whose first fit gave these placements
     orders_tried: int = 0

@@ -8,7 +8,7 @@ the largest of its two sides that fits on some page (the emptiest first, or the 
 and the other side goes back into the queue; when nothing of it fits anywhere, the plan fails
 (None). A side is a subtree of the piece's tree or what is left of the piece without one, so only
 creases are cut and no face moves: the parts stay overlap-free. Only creases the net allows to be
-cut are cut (`_cuttable`).
+cut are cut (`Net.cuttable`: never inside a flat polygon).
 
 What is packed is a piece's footprint (outline and labels printed off its faces). The footprint of
 a part is estimated before anything is redrawn: its faces with the tabs and labels the whole piece
@@ -39,12 +39,6 @@ from .tabs import CutSide, full_depth, tab_polygon
 MIN_PART = 0.005
 MIN_PART_FACES = 2  # nor a single face (more glue per paper, and make's FOLD file of one has no path)
 SPLIT_TRIES = 8  # candidate parts weighed per page before a finer look between the last two
-
-
-def _cuttable(net: Net) -> np.ndarray:
-    """(F,) True for faces whose crease to their parent may be cut (every crease, for now; with flat
-    regions kept whole this is `Net.cuttable`)."""
-    return net.parent_edge >= 0
 
 
 @dataclass(frozen=True)
@@ -102,7 +96,7 @@ class _Tree:
         self.area = shapely.area(self.polys)
         _, self.tin, self.tout = subtree_areas(net)
         self.by_tin = np.argsort(self.tin)
-        self.cuttable = _cuttable(net)
+        self.cuttable = net.cuttable
 
     def root(self, mask: np.ndarray) -> int:
         """The face of a part (a connected set of the tree's faces) whose parent is not in it."""
