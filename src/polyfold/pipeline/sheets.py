@@ -171,7 +171,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
     search. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
-    it when folding splits nothing); a plan is only started with twice that drawing's time left."""
+    it when folding splits nothing); a plan is only started with that drawing's time left."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
@@ -199,8 +199,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
         for emptiest_first in PAGE_CHOICES:
             cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
             for _ in range(PLAN_ROUNDS):
-                if budget.left() < 2 * draw_seconds:  # no time to plan and draw the cut pieces (on
-                    ran_out = True  # 1000+ faces one drawing takes 5-10 s)
+                if budget.left() < draw_seconds:  # no time to draw the pieces this plan would cut
+                    ran_out = True
                     break
                 plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
                                   budget.at, seed=opts.seed, emptiest_first=emptiest_first,
