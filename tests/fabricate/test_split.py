@@ -14,8 +14,9 @@ from polyfold.fabricate.fit import model_scale
 from polyfold.fabricate.pack import pack_outlines
 from polyfold.fabricate.paper import GAP_MM
 from polyfold.fabricate.pieces import build_sheet_pieces
-from polyfold.fabricate.split import MIN_PART, MIN_PART_FACES, plan_pages
+from polyfold.fabricate.split import MIN_PART, MIN_PART_FACES, _Tree, plan_pages
 from polyfold.formats.meshes import load_mesh
+from polyfold.mesh.geometry import merged_edges
 from polyfold.pipeline.options import MakeOptions, paper_size
 from polyfold.pipeline.parts import make_parts
 from polyfold.pipeline.sheets import _packer_page, fit_parts, pack_box, part_piece_inputs
@@ -24,20 +25,24 @@ from polyfold.unfold.net import cut_creases, piece_net
 MARGIN = 10.0
 
 
-@pytest.fixture(scope="module")
-def bunny(models_dir):
-    """bunny-128 at the defaults (A4, 150 mm): its pieces as make draws them before folding."""
-    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+def drawn(models_dir, name: str) -> dict:
+    """A model at the defaults (A4, 150 mm): its pieces as make draws them before folding."""
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
     opts = MakeOptions()
     parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
     scale = model_scale([mesh], opts.size)
     box = pack_box(*paper_size(opts.paper), opts)
-    fitted, _ = fit_parts(parts, scale, opts, box, "bunny-128")
+    fitted, _ = fit_parts(parts, scale, opts, box, name)
     inputs = part_piece_inputs(mesh, fitted)
     pieces, _, _ = build_sheet_pieces(inputs, scale)
     page, margin = _packer_page(box)  # the page the packer is given: `box` inside its margins
     assert margin == MARGIN
     return {"mesh": mesh, "inputs": inputs, "pieces": pieces, "page": page, "scale": scale}
+
+
+@pytest.fixture(scope="module")
+def bunny(models_dir):
+    return drawn(models_dir, "bunny-128")
 
 
 def plan(bunny, n_pages, **kw):
@@ -111,3 +116,25 @@ def test_plan_with_room_cuts_nothing_and_is_the_packers_first_fit(bunny):
 def test_plan_gives_up_at_its_deadline(bunny):
     assert plan_pages(bunny["pieces"], [inp.net for inp in bunny["inputs"]], bunny["page"], MARGIN, GAP_MM, 2,
                       time.perf_counter() - 1.0) is None
+
+
+def test_flat_polygons_are_never_cut(models_dir):
+    # torus-12x6-144's quads are flat polygons of two triangles each: their diagonals are merged
+    # creases, which the plan must leave alone however it cuts
+    torus = drawn(models_dir, "torus-12x6-144")
+    whole = pack_outlines([q.footprint for q in torus["pieces"]], torus["page"], MARGIN, GAP_MM, seed=1)
+    p = plan(torus, whole.n_pages - 1)
+    assert p is not None and sum(len(c) for c in p.cuts) > 0
+    for inp, cuts in zip(torus["inputs"], p.cuts):
+        merged = merged_edges(inp.net.mesh)
+        assert merged.any() and not merged[inp.net.parent_edge[cuts]].any()
+    # nor offered: no cut a plan weighs is a merged crease (there are some to offer without the rule)
+    offered, merged_creases = set(), set()
+    for piece, inp in zip(torus["pieces"], torus["inputs"]):
+        net = inp.net
+        tree = _Tree(piece, net)
+        sides = tree.sides(np.ones(len(net.parent), dtype=bool), 0.0, np.inf)
+        offered |= {(inp.face_ids[f], below) for _, f, below in sides}
+        is_merged = (net.parent_edge >= 0) & merged_edges(net.mesh)[net.parent_edge]
+        merged_creases |= {(inp.face_ids[f], below) for f in np.flatnonzero(is_merged) for below in (True, False)}
+    assert offered and merged_creases and not offered & merged_creases

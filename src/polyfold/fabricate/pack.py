@@ -77,8 +77,9 @@ class Packing:
     n_pages: int
     page_size: tuple[float, float]  # (width, height) mm
     margin: float
-    # what is cut out (the outlines: faces and tabs) over the printable area of the pages used:
-    # total outline area / (n_pages * (width - 2 margin) * (height - 2 margin))
+    # the outlines' area over the printable area of the pages used: total outline area / (n_pages *
+    # (width - 2 margin) * (height - 2 margin)); make packs footprints (labels beside pieces too) and
+    # reports the cut-out area instead (pipeline.make)
     utilisation: float
     order: tuple[int, ...] = ()  # the piece order whose first fit gave these placements
     orders_tried: int = 0
@@ -258,6 +259,7 @@ class _Piece:
         self.degs = degs
         self.p0, self.p1 = _ring_edges(geom.buffer(grow, quad_segs=_QUAD_SEGS))
         self.res, self.pad, self.pw, self.ph = res, pad, pw, ph
+        self.rots = _rots(degs)
         self.lo, self.hi = _extents(self.xy, degs)
         self._shapes: dict[int, _Shape | None] = {}
 
@@ -275,7 +277,7 @@ class _Piece:
         if xmax < 0 or ymax < 0:
             return None
         w, h = (np.ceil(ext / res).astype(int) + 2 * pad + 1).tolist()
-        rot = _rot(self.degs[k]).T
+        rot = self.rots[k].T
         origin = lo - pad * res
         mask = _raster((self.p0 @ rot - origin) / res, (self.p1 @ rot - origin) / res, h, w)
         runs, cy, cx = _runs(mask)
@@ -509,7 +511,7 @@ class PageFiller:
     rasters are made once (a candidate is often tried on several pages)."""
 
     def __init__(self, page_size: tuple[float, float], margin: float, gap: float, n_pages: int,
-                 angles: int = ANGLES, seed: int = 0) -> None:
+                 angles: int = ANGLES, seed: int = 0, rasters: dict | None = None) -> None:
         pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
         if pw <= 0 or ph <= 0:
             raise PolyfoldError(f"page {page_size[0]:g} x {page_size[1]:g} mm has no printable area inside {margin:g} mm margins")
@@ -518,7 +520,9 @@ class PageFiller:
         self.angles = angles
         self.phase = _phase(seed, angles)
         self.printable_area = pw * ph
-        self._pieces: dict[object, _Piece] = {}
+        # key -> rasters of the outline; a dict shared by fillers with the same page, gap, angles and
+        # seed keeps them across fillers (each key naming one outline)
+        self._pieces: dict[object, _Piece] = {} if rasters is None else rasters
 
     def free_area(self, page: int) -> float:
         """mm^2 of the page's grid not yet covered by placed outlines grown by half the gap (an

@@ -8,7 +8,7 @@ the largest of its two sides that fits on some page (the emptiest first, or the 
 and the other side goes back into the queue; when nothing of it fits anywhere, the plan fails
 (None). A side is a subtree of the piece's tree or what is left of the piece without one, so only
 creases are cut and no face moves: the parts stay overlap-free. Only creases the net allows to be
-cut are cut (`_cuttable`).
+cut are cut (`Net.cuttable`: never inside a flat polygon).
 
 What is packed is a piece's footprint (outline and labels printed off its faces). The footprint of
 a part is estimated before anything is redrawn: its faces with the tabs and labels the whole piece
@@ -39,12 +39,6 @@ from .tabs import CutSide, full_depth, tab_polygon
 MIN_PART = 0.005
 MIN_PART_FACES = 2  # nor a single face (more glue per paper, and make's FOLD file of one has no path)
 SPLIT_TRIES = 8  # candidate parts weighed per page before a finer look between the last two
-
-
-def _cuttable(net: Net) -> np.ndarray:
-    """(F,) True for faces whose crease to their parent may be cut (every crease, for now; with flat
-    regions kept whole this is `Net.cuttable`)."""
-    return net.parent_edge >= 0
 
 
 @dataclass(frozen=True)
@@ -102,7 +96,7 @@ class _Tree:
         self.area = shapely.area(self.polys)
         _, self.tin, self.tout = subtree_areas(net)
         self.by_tin = np.argsort(self.tin)
-        self.cuttable = _cuttable(net)
+        self.cuttable = net.cuttable
 
     def root(self, mask: np.ndarray) -> int:
         """The face of a part (a connected set of the tree's faces) whose parent is not in it."""
@@ -192,7 +186,8 @@ def _split_onto(filler: PageFiller, page: int, tree: _Tree, t: int, mask: np.nda
 
 def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tuple[float, float], margin: float,
                gap: float, n_pages: int, deadline: float, angles: int = ANGLES, seed: int = 0,
-               emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES) -> PagePlan | None:
+               emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES,
+               rasters: dict | None = None) -> PagePlan | None:
     """Cut creases so that the pieces fit on `n_pages` pages (see the module docstring). pieces[i]
     is drawn from the single-piece net nets[i] (same faces, same order); pieces after the last net
     (glue strips) are placed whole. Packed: the pieces' footprints. page_size (width, height mm),
@@ -200,8 +195,10 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
     the most room that takes one (`emptiest_first`), else the first. A side split off, and the rest,
     cover at least `min_part` of a page's printable area. None when the plan finds no way, or at
     `deadline` (`time.perf_counter()` seconds). A plan without cuts is pack_outlines' first fit in
-    the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages."""
-    filler = PageFiller(page_size, margin, gap, n_pages, angles, seed)
+    the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages.
+    `rasters`: a dict kept across plans of these very pieces (same page, gap, angles, seed), so that
+    a part tried by one is not rasterised again by the next."""
+    filler = PageFiller(page_size, margin, gap, n_pages, angles, seed, rasters)
     lo = min_part * filler.printable_area
     trees = [_Tree(p, nets[i] if i < len(nets) else None) for i, p in enumerate(pieces)]
     # the queue: (-area, sequence number, piece, faces); larger first, ties in input order

@@ -171,7 +171,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
     search. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
-    it when folding splits nothing); a plan is only started with time left to draw what it cuts."""
+    it when folding splits nothing); a plan is only started with that drawing's time left."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
@@ -193,16 +193,18 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
     ran_out = packing.ran_out
+    rasters: dict[int, tuple] = {}  # per drawing: (the drawing, kept alive so its id stays its own, rasters)
     for n_pages in range(fewest, packing.n_pages):
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
         for emptiest_first in PAGE_CHOICES:
             cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
             for _ in range(PLAN_ROUNDS):
-                if budget.left() < draw_seconds:  # no time to draw what this plan would cut
+                if budget.left() < draw_seconds:  # no time to draw the pieces this plan would cut
                     ran_out = True
                     break
                 plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
-                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first)
+                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first,
+                                  rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1])
                 if plan is None:
                     ran_out |= budget.expired()
                     break
