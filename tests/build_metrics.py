@@ -70,13 +70,23 @@ NOT_LABELS = ("title", "footer", "scale", "legend")  # text classes that are not
 class Model:
     """A mesh file at its printed scale: vertices (model units), faces (F, 3), scale (mm per
     unit), per undirected edge (a, b), a < b: its fold angle in degrees (+ convex, - concave,
-    None when not between exactly two faces) and whether it is a diagonal of an input polygon."""
+    None when not between exactly two faces), the corners opposite it in its faces and whether
+    it is a diagonal of an input polygon."""
 
     vertices: np.ndarray
     faces: np.ndarray
     scale: float
     fold_deg: dict[tuple[int, int], float | None]
     diagonals: frozenset[tuple[int, int]]
+    opposite: dict[tuple[int, int], tuple[int, ...]] = field(default_factory=dict)
+
+    def corners(self, a: int, b: int) -> list[tuple[float, float]]:
+        """Per face on edge (a, b): the printed distances (mm) from a and from b to the face's
+        third corner."""
+        key = (min(a, b), max(a, b))
+        v = self.vertices
+        return [(float(np.linalg.norm(v[c] - v[a])) * self.scale, float(np.linalg.norm(v[c] - v[b])) * self.scale)
+                for c in self.opposite.get(key, ())]
 
 
 def _obj_polygons(path: Path) -> list[list[int]]:
@@ -129,7 +139,8 @@ def load_model(mesh_path: str | Path, size_mm: float) -> Model:
             for i in range(n):
                 for j in range(i + 2, n - (1 if i == 0 else 0)):
                     diagonals.add((min(poly[i], poly[j]), max(poly[i], poly[j])))
-    return Model(v, f, scale, fold_deg, frozenset(diagonals))
+    opposite = {key: tuple(c for _, c in owners) for key, owners in sides.items()}
+    return Model(v, f, scale, fold_deg, frozenset(diagonals), opposite)
 
 
 def smallest_sizes(model: Model) -> tuple[float, float]:
@@ -211,10 +222,14 @@ class _Page:
         shapely.prepare(self.paper)
         shapely.prepare(self.faces)
 
-    def locate(self, label_xy: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray] | None:
+    def locate(self, label_xy: np.ndarray, length: float,
+               corners: list[tuple[float, float]] = ()) -> tuple[np.ndarray, np.ndarray] | None:
         """The printed face edge of `length` mm nearest the label: two corner points that far apart
         (within LENGTH_TOL_MM; failing that, within 10 times as much: a corner merged with a
-        tab corner close by) with a face all along one side (when the page has preview faces)."""
+        tab corner close by) with a face all along one side (when the page has preview faces).
+        `corners` (`Model.corners`): an edge whose face's third corner is printed where the mesh
+        puts it is taken first (an edge of the same length nearer the label, e.g. of a sliver face
+        beside it, is not the one)."""
         d = np.linalg.norm(self.points - label_xy, axis=1)
         near = self.points[d <= length + 20.0]
         if len(near) < 2:
@@ -229,10 +244,22 @@ class _Page:
             ab = b - a
             t = np.clip(np.einsum("ij,ij->i", label_xy - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
             dist = np.linalg.norm(a + t[:, None] * ab - label_xy, axis=1)
-            for k in np.argsort(dist, kind="stable"):
-                if not self.has_faces or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0)):
-                    return a[k], b[k]
+            order = np.argsort(dist, kind="stable")
+            faced = [k for k in order if not self.has_faces
+                     or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0))]
+            cornered = [k for k in faced if self._cornered(a[k], b[k], corners, 10 * tol)]
+            if cornered or faced:
+                k = (cornered or faced)[0]
+                return a[k], b[k]
         return None
+
+    def _cornered(self, a: np.ndarray, b: np.ndarray, corners, tol: float) -> bool:
+        """True when a printed point lies at one of the (from a, from b) distance pairs of
+        `corners` (either way round: which end is which is not known)."""
+        da = np.linalg.norm(self.points - a, axis=1)
+        db = np.linalg.norm(self.points - b, axis=1)
+        return any(bool(((np.abs(da - x) <= tol) & (np.abs(db - y) <= tol)).any()
+                        or ((np.abs(da - y) <= tol) & (np.abs(db - x) <= tol)).any()) for x, y in corners)
 
     def side(self, a: np.ndarray, b: np.ndarray, sign: float) -> list[str]:
         """What lies at PROBE_MM on one side (sign +1: left of a->b in page coordinates) of the
@@ -385,7 +412,7 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
             miscounted += 1
         copies = []
         for page, xy in spots:
-            seg = pages[page].locate(xy, length)
+            seg = pages[page].locate(xy, length, model.corners(a, b))
             if seg is None:
                 unlocated += 1
                 continue

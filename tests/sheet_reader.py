@@ -23,9 +23,10 @@ colour: pure red mountain, pure blue valley, black undashed cut (SVG, PDF). Anyt
 "no-cut", or named for a scale bar or registration marks ("scale", "mark", "legend"), is not a
 cut or fold line; strokes of other colours are ignored.
 
-Label boxes are estimates (the writers' fonts are not embedded): width 0.62 em per character,
-height the cap height 0.72 em above the baseline, placed by the text's anchor (SVG text-anchor;
-DXF alignment; PDF: the drawn string's start) and turned by its rotation.
+Label boxes are estimates (the writers' fonts are not embedded): width the advance widths of
+Helvetica (the font the SVG names first and the PDF uses; Arial's are the same) from the font
+metrics reportlab ships, height the cap height 0.72 em above the baseline, placed by the text's
+anchor (SVG text-anchor; DXF alignment; PDF: the drawn string's start) and turned by its rotation.
 """
 
 from __future__ import annotations
@@ -40,7 +41,6 @@ import numpy as np
 import shapely
 
 MM_PER_PT = 25.4 / 72.0
-EM_WIDTH = 0.62  # estimated advance width of one character, in em
 CAP = 0.72  # cap height, in em
 FOLD_KINDS = ("mountain", "valley")
 _KINDS = ("mountain", "valley", "cut")
@@ -70,7 +70,9 @@ class Label:
 
     @property
     def width(self) -> float:
-        return EM_WIDTH * self.size * len(self.text)
+        from reportlab.pdfbase.pdfmetrics import stringWidth
+
+        return float(stringWidth(self.text, "Helvetica", self.size))
 
     def box(self) -> shapely.Polygon:
         """The estimated box of the text on the page (see the module docstring)."""
@@ -105,20 +107,20 @@ class Sheet:
         return np.concatenate([p.reshape(-1, 2, 2) for p in parts]) if parts else np.zeros((0, 2, 2))
 
     def pieces(self) -> list[shapely.Polygon]:
-        """The paper pieces: outlines not inside another outline, with the ones inside as holes."""
+        """The paper pieces: outlines inside an even number of other outlines (none: the outer
+        ring of a piece; two: a piece placed in another's hole), each with the outlines directly
+        inside it as holes."""
         polys = [shapely.make_valid(shapely.Polygon(r)) for r in self.outlines if len(r) >= 3]
         polys = [p for p in polys if p.area > 0]
-        order = sorted(range(len(polys)), key=lambda i: -polys[i].area)
-        outer: list[int] = []
-        holes: dict[int, list] = {}
-        for i in order:
-            host = next((o for o in outer if polys[o].contains(polys[i].representative_point())), None)
-            if host is None:
-                outer.append(i)
-                holes[i] = []
-            else:
+        inside = [[j for j in range(len(polys)) if j != i and polys[j].area > polys[i].area
+                   and polys[j].contains(polys[i].representative_point())] for i in range(len(polys))]
+        depth = [len(c) for c in inside]
+        holes: dict[int, list] = {i: [] for i in range(len(polys)) if depth[i] % 2 == 0}
+        for i in range(len(polys)):
+            if depth[i] % 2:
+                host = min((j for j in inside[i] if depth[j] == depth[i] - 1), key=lambda j: polys[j].area)
                 holes[host].append(polys[i])
-        return [shapely.difference(polys[o], shapely.union_all(holes[o])) if holes[o] else polys[o] for o in outer]
+        return [shapely.difference(polys[o], shapely.union_all(h)) if h else polys[o] for o, h in holes.items()]
 
 
 def _kind_of(names: list[str]) -> str | None:

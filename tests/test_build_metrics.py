@@ -189,9 +189,9 @@ def test_label_box() -> None:
     up = Label("12", (10.0, 20.0), 90.0, 2.0, 0.72 * 2.0)  # read bottom to top
     x0, y0, x1, y1 = up.box().bounds
     assert (x0, x1) == pytest.approx((10.0 - 1.44, 10.0))  # the letters' tops point left
-    assert (y0, y1) == pytest.approx((20.0 - 1.24, 20.0 + 1.24))
+    assert (y0, y1) == pytest.approx((20.0 - 1.112, 20.0 + 1.112))  # Helvetica's digits: 0.556 em
     flat = Label("A", (0.0, 0.0), 0.0, 10.0, 7.2, align="start")
-    assert flat.box().bounds == pytest.approx((0.0, -7.2, 6.2, 0.0))
+    assert flat.box().bounds == pytest.approx((0.0, -7.2, 6.67, 0.0))
 
 
 def test_pdf_and_dxf_readers_on_hand_made_files(tmp_path: Path) -> None:

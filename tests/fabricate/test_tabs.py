@@ -8,7 +8,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from polyfold.fabricate.tabs import MIN_GLUE_FRAC, TAB_CLEAR_MM, TAB_VARIANTS, CutSide, Room, choose_tab, full_depth
+from polyfold.fabricate.tabs import MIN_FOLD_FRAC, MIN_GLUE_FRAC, TAB_CLEAR_MM, TAB_VARIANTS, CutSide, Room, choose_tab, full_depth
 
 
 def _rooms(*faces_per_piece):
@@ -58,3 +58,17 @@ def test_a_tab_is_clipped_around_a_face_in_its_way_and_keeps_its_distance():
     # every part sits on the edge: its fold is a stretch of the edge
     for fold in tab.folds:
         assert np.allclose(fold[:, 1], 0.0) and fold[:, 0].min() >= -1e-9 and fold[:, 0].max() <= 20 + 1e-9
+
+
+def test_a_clipped_tab_hinged_on_a_stub_is_no_tab():
+    # a thin face along most of the edge, just beyond it: the tab's body below it keeps plenty of
+    # glue area, but it would hang on the last 5 mm of a 20 mm edge (a flap that twists)
+    bar = np.array([(0.5, -0.6), (14.0, -0.6), (14.0, -0.8), (0.5, -0.8)])
+    rooms = _rooms([TRI0, bar], [TRI1, bar + [40.0, 0.0]])
+    assert choose_tab((SIDE0, SIDE1), rooms) is None
+    # shorter, the bar leaves half the edge free: a tapered tab, hinged along that half
+    short = np.array([(0.5, -0.6), (8.0, -0.6), (8.0, -0.8), (0.5, -0.8)])
+    tab = choose_tab((SIDE0, SIDE1), _rooms([TRI0, short], [TRI1, short + [40.0, 0.0]]))
+    assert tab is not None and tab.reason == "tapered"
+    hinged = sum(float(np.linalg.norm(f[1] - f[0])) for f in tab.folds)
+    assert MIN_FOLD_FRAC * 20.0 <= hinged < 20.0 - 8.0

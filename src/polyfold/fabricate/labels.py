@@ -8,12 +8,13 @@ label goes, in order:
    face's incentre);
 2. on the side's glue tab, when this side carries it;
 3. just outside the edge (beyond the tab on the side that has one), clear of the piece's faces,
-   tabs and labels, else a little further in a free spot with a leader line to the edge, else
-   up to FAR_STEPS_MM away in any direction, its leader crossing the piece's lines if it must: an
+   tabs and labels, else a little further in a free spot with a leader line from the edge: an
    off-face label, which the packer keeps clear of other pieces (`SheetPiece.footprint`), never
    further out than the tab room around the piece's convex hull (`tabs.TAB_ROOM_MM`), which
    fitting pieces to the page reserves;
-4. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
+4. else the free spot nearest the edge, up to ELSEWHERE_MM away: off the faces as in 3, or inside
+   any face of the piece, its leader line crossing the piece's lines if it must;
+5. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
 """
 
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .page import TextItem, upright
-from .paper import CAP_HEIGHT, CHAR_EM
+from .paper import CAP_HEIGHT
 from .tabs import TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
 
 PIECE_FONT_MAX_MM = 6.0  # a piece's name may be larger, up to this, where its face has room
@@ -33,7 +34,13 @@ LABEL_PAD_MM = 0.25  # gap between a label's glyph box and any line or other lab
 CELL_MM = 10.0  # cell size of the label boxes' spatial hash
 LEADER_STEPS_MM = (2.0, 5.0, 9.0, 14.0)  # how far an off-face label with a leader may sit from its edge
 LEADER_HALF_MM = 0.1  # half the width of a leader line (clearance it needs)
-FAR_STEPS_MM = (8.0, 14.0, 20.0, 28.0)  # the last resort: a label this far away, its leader may cross the piece
+ELSEWHERE_MM = 30.0  # the last resort: a label this far from its edge, its leader crossing the piece
+FREE_CELL_MM = 0.2  # cell of the raster of what is taken on a piece, which finds those spots
+ELSEWHERE_TRIES = 40  # most spots checked exactly per label (nearest first)
+LEADER_STEP_MM = 0.4  # a leader is looked up in the raster at points this far apart
+LEADER_TRIES = 1000  # most spots whose leader is checked against the raster (nearest first)
+LEADER_BATCH = 200  # spots whose leaders are checked at once
+ELSEWHERE_GIVE_UP = 20  # a piece where this many labels found no spot is too crowded to look further
 
 
 def label_font(min_cap_mm: float) -> float:
@@ -52,12 +59,13 @@ def piece_name(i: int) -> str:
     return s
 
 
-DIGIT_EM = 0.556  # Helvetica's advance width of every digit, in em
-
-
 def text_width(text: str, size: float) -> float:
-    """Printed width (mm) of `text` at font `size`: DIGIT_EM per digit, CHAR_EM per other character."""
-    return size * sum(DIGIT_EM if ch.isdigit() else CHAR_EM for ch in text)
+    """Printed width (mm) of `text` at font `size` (mm) in Helvetica, the font of the PDF and the
+    first of the SVG's (Arial, the usual stand-in, has the same widths): the advance widths of
+    the font's metrics as reportlab, which draws the PDF, has them."""
+    from reportlab.pdfbase.pdfmetrics import stringWidth
+
+    return float(stringWidth(text, "Helvetica", size))
 
 
 def text_box(center: np.ndarray, u: np.ndarray, text: str, size: float) -> np.ndarray:
@@ -120,10 +128,23 @@ class _Boxes:
     def add(self, box: np.ndarray) -> None:
         from shapely.geometry import Polygon
 
-        item = (self.count, Polygon(box))
+        self.add_geom(Polygon(box))
+
+    def add_geom(self, geom) -> None:
+        """Place a shapely geometry (a label box, a leader line's strip)."""
+        x0, y0, x1, y1 = geom.bounds
+        item = (self.count, geom)
         self.count += 1
-        for key in self._keys(box):
+        for key in self._keys(np.array([[x0, y0], [x1, y1]])):
             self.cells.setdefault(key, []).append(item)
+
+    def near(self, corners: np.ndarray) -> list:
+        """The placed geometries in the cells that the box `corners` (2, 2) covers."""
+        seen = {}
+        for key in self._keys(corners):
+            for i, other in self.cells.get(key, ()):
+                seen[i] = other
+        return list(seen.values())
 
 
 @dataclass
@@ -153,6 +174,116 @@ def _reading(u: np.ndarray) -> np.ndarray:
     return np.array([math.cos(a), -math.sin(a)])
 
 
+class _Taken:
+    """A raster (FREE_CELL_MM cells) of what a label may not touch on one piece, for finding free
+    spots fast: every face side (outline, creases and the sides inside flat polygons alike),
+    labels and leaders grown by LABEL_PAD_MM, the piece's tabs and off-face labels grown by
+    TAB_CLEAR_MM, and everything outside `PieceLabels.allowed`. Cells are taken by their
+    centres, so a box clear of them all is only likely to fit: the caller checks it exactly
+    (inside one face, or off the faces by TAB_CLEAR_MM)."""
+
+    def __init__(self, labels: "PieceLabels") -> None:
+        import shapely
+        from scipy import ndimage
+
+        x0, y0, x1, y1 = labels.allowed.bounds
+        self.origin = np.array([x0, y0])
+        nx, ny = int(math.ceil((x1 - x0) / FREE_CELL_MM)) + 1, int(math.ceil((y1 - y0) / FREE_CELL_MM)) + 1
+        cx = x0 + (np.arange(nx) + 0.5) * FREE_CELL_MM
+        cy = y0 + (np.arange(ny) + 0.5) * FREE_CELL_MM
+        # outside `allowed` (convex): per row of cell centres, left and right of where it crosses
+        ring = np.asarray(labels.allowed.exterior.coords)
+        a, b = ring[:-1], ring[1:]
+        span = (np.minimum(a[:, 1], b[:, 1])[None, :] <= cy[:, None]) & (cy[:, None] <= np.maximum(a[:, 1], b[:, 1])[None, :])
+        t = (cy[:, None] - a[None, :, 1]) / np.where(b[:, 1] == a[:, 1], 1.0, b[:, 1] - a[:, 1])[None, :]
+        x = a[None, :, 0] + np.clip(t, 0.0, 1.0) * (b - a)[None, :, 0]
+        lo, hi = np.where(span, x, np.inf).min(axis=1), np.where(span, x, -np.inf).max(axis=1)
+        self.grid = (cx[None, :] < lo[:, None]) | (cx[None, :] > hi[:, None])  # (ny, nx), True = taken
+        self.texts = np.zeros_like(self.grid)  # the labels alone (a leader may not cross them)
+        self._last = np.array([nx - 1, ny - 1], dtype=np.int32)
+        # face sides: points every half cell along them, then grown by a disc
+        tri = shapely.get_coordinates(np.asarray(labels.room.faces, dtype=object)).reshape(-1, 4, 2)[:, :3]
+        a, b = tri.reshape(-1, 2), np.roll(tri, -1, axis=1).reshape(-1, 2)
+        steps = np.maximum(np.ceil(np.linalg.norm(b - a, axis=1) / (0.5 * FREE_CELL_MM)).astype(int), 1)
+        t = np.concatenate([np.linspace(0.0, 1.0, k + 1) for k in steps])
+        which = np.repeat(np.arange(len(a)), steps + 1)
+        pts = a[which] + t[:, None] * (b - a)[which]
+        lines = np.zeros_like(self.grid)
+        ij = self._cells(pts)
+        lines[ij[:, 1], ij[:, 0]] = True
+        r = int(round(LABEL_PAD_MM / FREE_CELL_MM))
+        disc = np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r
+        lines = ndimage.binary_dilation(lines, structure=disc)
+        self.grid |= lines
+        # inside the faces: the cells the face sides enclose (not joined to the raster's border)
+        parts, n_parts = ndimage.label(~lines)
+        outer = np.zeros(n_parts + 1, dtype=bool)
+        outer[np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])] = True
+        self.in_faces = ~lines & ~outer[parts]
+        for g in labels.room.extra:
+            self.mark(g, TAB_CLEAR_MM)
+        everywhere = np.array([[x0, y0], [x1, y1]])
+        for g in labels.boxes.near(everywhere):
+            self.mark(g, LABEL_PAD_MM, text=True)
+        for g in labels.strips.near(everywhere):
+            self.mark(g, LABEL_PAD_MM)
+
+    def _cells(self, pts: np.ndarray) -> np.ndarray:
+        """(k, 2) column, row of the cells holding points (clipped to the raster)."""
+        ij = ((pts - self.origin) * (1.0 / FREE_CELL_MM)).astype(np.int32)  # truncation: points sit right of origin
+        return np.clip(ij, 0, self._last, out=ij)
+
+    def mark(self, geom, grow: float, text: bool = False) -> None:
+        """Mark the cells whose centres lie in `geom` grown by `grow` mm (a label's box, `text`:
+        also in `texts`, grown as much as a leader looked up there needs)."""
+        import shapely
+
+        # texts: grown by half the step between a leader's points and half a cell's diagonal too,
+        # as a leader is looked up at the cells of its points
+        reach = LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM
+        for where, by in ((self.grid, grow),) + (((self.texts, reach),) if text else ()):
+            g = geom.buffer(by, quad_segs=2)
+            x0, y0, x1, y1 = g.bounds
+            (c0, r0), (c1, r1) = self._cells(np.array([[x0, y0], [x1, y1]]))
+            cx = self.origin[0] + (np.arange(c0, c1 + 1) + 0.5) * FREE_CELL_MM
+            cy = self.origin[1] + (np.arange(r0, r1 + 1) + 0.5) * FREE_CELL_MM
+            gx, gy = np.meshgrid(cx, cy)
+            where[r0:r1 + 1, c0:c1 + 1] |= shapely.contains_xy(g, gx, gy)
+
+    def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
+        """Centres (up to want, 2) of level w x h mm boxes that touch no taken cell and whose
+        leader from p crosses no label, within ELSEWHERE_MM of p, nearest first; centred in a
+        face (`inside`) or off the faces."""
+        (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
+        sub = self.grid[r0:r1 + 1, c0:c1 + 1]
+        hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
+        if sub.shape[0] <= 2 * hh or sub.shape[1] <= 2 * hw or sub.all():
+            return np.zeros((0, 2))
+        # taken cells in every window of (2 hh + 1) x (2 hw + 1) cells, by a summed-area table
+        s = np.pad(np.cumsum(np.cumsum(sub, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
+        kh, kw = 2 * hh + 1, 2 * hw + 1
+        count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
+        rows, cols = np.nonzero((count == 0) & (self.in_faces[r0 + hh:r1 + 1 - hh, c0 + hw:c1 + 1 - hw] == inside))
+        centres = self.origin + (np.stack([cols + c0 + hw, rows + r0 + hh], axis=1) + 0.5) * FREE_CELL_MM
+        d2 = ((centres - p) ** 2).sum(axis=1)
+        near = np.flatnonzero(d2 <= ELSEWHERE_MM ** 2)
+        if len(near) > LEADER_TRIES:
+            near = near[np.argpartition(d2[near], LEADER_TRIES)[:LEADER_TRIES]]
+        centres = centres[near[np.argsort(d2[near], kind="stable")]]
+        # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
+        # most) are free; looked at in batches, nearest first, until `want` are found
+        t = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
+        found = []
+        for k in range(0, len(centres), LEADER_BATCH):
+            batch = centres[k:k + LEADER_BATCH]
+            ij = self._cells((p + t[None, :, None] * (batch - p)[:, None, :]).reshape(-1, 2))
+            crossed = self.texts[ij[:, 1], ij[:, 0]].reshape(len(batch), len(t)).any(axis=1)
+            found.append(batch[~crossed])
+            if sum(len(f) for f in found) >= want:
+                break
+        return np.concatenate(found)[:want] if found else np.zeros((0, 2))
+
+
 class PieceLabels:
     """The labels of one piece, placed one by one so none overlaps another (see the module
     docstring). `room` is the piece's `tabs.Room`: off-face labels are added to it."""
@@ -165,13 +296,24 @@ class PieceLabels:
         self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
         self.size = size
         self.boxes = _Boxes()
+        self.strips = _Boxes()  # leader lines drawn across the piece (`_elsewhere`)
         self.items: list[TextItem] = []
         self.outside: list = []  # shapely geometries of off-face labels and their leaders
         self.leaders: list[np.ndarray] = []  # (2, 2) leader lines from an edge to its label
         self.stats = LabelStats()
+        self._taken = None  # `_Taken` raster of the piece, made at the first `_elsewhere`
+        self._no_spot = 0  # labels `_elsewhere` found no spot for
+
+    def _hits(self, box: np.ndarray) -> bool:
+        """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
+        return self.boxes.hits(box) or self.strips.hits(box)
 
     def _put(self, text: str, center: np.ndarray, u: np.ndarray, size: float, kind: str, box: np.ndarray) -> None:
         self.boxes.add(box)
+        if self._taken is not None:
+            from shapely.geometry import Polygon
+
+            self._taken.mark(Polygon(box), LABEL_PAD_MM, text=True)
         self.items.append(TextItem(text, float(center[0]), float(center[1]), _angle(u), size, kind))
 
     def piece(self, faces_xy: np.ndarray, text: str) -> None:
@@ -198,8 +340,11 @@ class PieceLabels:
         self._put(text, center, u, self.size, "piece-label", text_box(center, u, text, self.size))
 
     def edge(self, side: CutSide, text: str, tab_parts: tuple[np.ndarray, ...] = (),
-             tab_folds: np.ndarray | None = None) -> None:
-        """The glue label of one side of a glued edge (see the module docstring for the order)."""
+             tab_folds: np.ndarray | None = None, partner: CutSide | None = None) -> None:
+        """The glue label of one side of a glued edge (see the module docstring for the order).
+        `partner`: the edge's other side when it is on this piece too; a label without a leader
+        is then placed nearer its own side than the partner's, or a reader takes both labels for
+        one edge (they often face each other across a notch, the tab between them)."""
         s = self.size
         d = side.p1 - side.p0
         length = max(side.length, 1e-12)
@@ -210,27 +355,29 @@ class PieceLabels:
         inside = [side.p0 + t * d - n_out * (1.2 * LABEL_PAD_MM + h / 2) for t in ts] + [_incentre(side.tri)]
         for center in inside:  # 1. inside the face
             box = text_box(center, u, text, s)
-            if _inside_triangle(side.tri, box, LABEL_PAD_MM) and not self.boxes.hits(box):
+            if _inside_triangle(side.tri, box, LABEL_PAD_MM) and not self._hits(box):
                 self._put(text, center, u, s, "edge-label", box)
                 return
         if self._on_tab(text, u, tab_parts, tab_folds, n_out, h):
             self.stats.on_tabs += 1
             return
         beyond = max((float(np.max((p - side.p0) @ n_out)) for p in tab_parts), default=0.0)
-        if self._outside(text, side, u, n_out, beyond, h):
+        if self._outside(text, side, u, n_out, beyond, h, partner) or self._elsewhere(text, side):
             self.stats.outside += 1
             return
         center = side.tri.mean(axis=0)  # 4. nowhere readable: said in the stats
         self.stats.unplaced += 1
         self._put(text, center, u, s, "edge-label", text_box(center, u, text, s))
 
-    def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float) -> bool:
+    def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float,
+                 partner: CutSide | None) -> bool:
         """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it, else up to
-        LEADER_MAX_MM away in a free spot with a leader line to the middle of the edge (or tab)."""
+        LEADER_STEPS_MM away in a free spot with a leader line from the middle of the edge."""
         from shapely.geometry import LineString, Point, Polygon
 
         d = side.p1 - side.p0
-        start = side.p0 + 0.5 * d + n_out * beyond
+        mid = side.p0 + 0.5 * d
+        start = mid + n_out * beyond
         near = beyond + TAB_CLEAR_MM + LABEL_PAD_MM + h / 2
         spots = [(side.p0 + t * d + n_out * near, n_out, False) for t in (0.5, 0.35, 0.65, 0.2, 0.8)]
         for dist in LEADER_STEPS_MM:
@@ -238,28 +385,79 @@ class PieceLabels:
                 a = math.radians(turn)
                 w = np.array([n_out[0] * math.cos(a) - n_out[1] * math.sin(a), n_out[0] * math.sin(a) + n_out[1] * math.cos(a)])
                 spots.append((start + w * (dist + h / 2 + TAB_CLEAR_MM), w, True))
-        # last: any direction, further away, the leader crossing the piece's own lines if it must
-        far = [(start + np.array([math.cos(a), math.sin(a)]) * dist, None, "across")
-               for dist in FAR_STEPS_MM for a in np.radians(np.arange(0.0, 360.0, 30.0))]
-        for center, w, leader in spots + far:
+        own = LineString([side.p0, side.p1])
+        other = LineString([partner.p0, partner.p1]) if partner is not None else None
+        for center, w, leader in spots:
             box = text_box(center, u, text, self.size)
             poly = Polygon(box)
-            if not self.allowed.contains(poly) or self.boxes.hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
+            if not leader and other is not None and other.distance(poly.centroid) <= own.distance(poly.centroid):
+                continue
+            if not self.allowed.contains(poly) or self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
                 continue
             extra = [poly]
             if leader:
                 end = np.asarray(poly.exterior.interpolate(poly.exterior.project(Point(*start))).coords[0])
                 line = LineString([start + (end - start) * min(1.0, TAB_CLEAR_MM / max(np.linalg.norm(end - start), 1e-9)), end])
-                if self.boxes.hits_geom(line.buffer(LEADER_HALF_MM)):
+                # drawn from the edge itself, over its own tab: a leader ending at the tab's tip
+                # points at whatever edge lies beyond it (the partner's, in a notch)
+                drawn = LineString([mid, end])
+                if self.boxes.hits_geom(drawn.buffer(LEADER_HALF_MM)):
                     continue
-                if leader != "across" and self.room.blocked(line.buffer(LEADER_HALF_MM), None):
+                if self.room.blocked(line.buffer(LEADER_HALF_MM), None):
                     continue
-                self.leaders.append(np.array([start, end]))
-                extra.append(LineString([start, end]).buffer(LEADER_HALF_MM))
+                self.leaders.append(np.array([mid, end]))
+                extra.append(line.buffer(LEADER_HALF_MM))
             self._put(text, center, u, self.size, "edge-label", box)
             self.room.add(extra)
             self.outside.extend(extra)
+            if self._taken is not None:
+                for g in extra:
+                    self._taken.mark(g, TAB_CLEAR_MM)
             return True
+        return False
+
+    def _elsewhere(self, text: str, side: CutSide) -> bool:
+        """4. The free spot nearest the middle of the edge (failing that, a quarter of the way
+        along it from either end), up to ELSEWHERE_MM away, the label level (failing that,
+        upright): inside a face of the piece (LABEL_PAD_MM from its sides) or off the faces (as in
+        3), with a leader line from there on the edge that may cross the piece's lines but no
+        label. Candidates come from the piece's `_Taken` raster, nearest first; each is checked
+        exactly. After ELSEWHERE_GIVE_UP labels without a spot the piece is not searched again (a
+        mesh that dense needs a larger --size)."""
+        from shapely.geometry import LineString, Point, Polygon
+
+        if self._no_spot >= ELSEWHERE_GIVE_UP:
+            return False
+        if self._taken is None:
+            self._taken = _Taken(self)
+        w, h = text_width(text, self.size), CAP_HEIGHT * self.size
+        level, upward = np.array([1.0, 0.0]), _reading(np.array([0.0, 1.0]))
+        # in a face first: off the faces, a label takes paper that other pieces could use
+        tries = ((mid, u, c) for t in (0.5, 0.25, 0.75) for inside in (True, False)
+                 for mid in (side.p0 + t * (side.p1 - side.p0),) for u, bw, bh in ((level, w, h), (upward, h, w))
+                 for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside))
+        for mid, u, center in tries:
+            box = text_box(center, u, text, self.size)
+            if self._hits(box):
+                continue
+            poly = Polygon(box)
+            in_face = any(_inside_triangle(np.asarray(self.room.faces[f].exterior.coords)[:3], box, LABEL_PAD_MM)
+                          for f in self.room.tree.query(poly))
+            if not in_face and (not self.allowed.contains(poly) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
+                continue
+            end = np.asarray(poly.exterior.interpolate(poly.exterior.project(Point(*mid))).coords[0])
+            strip = LineString([mid, end]).buffer(LEADER_HALF_MM)
+            if self.boxes.hits_geom(strip):
+                continue
+            self.leaders.append(np.array([mid, end]))
+            self._put(text, center, u, self.size, "edge-label", box)
+            self.strips.add_geom(strip)  # later labels keep off it (leaders may cross)
+            self._taken.mark(strip, LABEL_PAD_MM)
+            if not in_face:
+                self.room.add([poly])
+                self.outside.append(poly)
+            return True
+        self._no_spot += 1
         return False
 
     def _on_tab(self, text: str, u: np.ndarray, parts, folds, n_out: np.ndarray, h: float) -> bool:
@@ -274,7 +472,7 @@ class PieceLabels:
                 for depth in (LABEL_PAD_MM + h / 2, LABEL_PAD_MM + h):
                     center = fold[0] + t * (fold[1] - fold[0]) + n_out * depth
                     box = text_box(center, u, text, self.size)
-                    if poly.contains(Polygon(box)) and not self.boxes.hits(box):
+                    if poly.contains(Polygon(box)) and not self._hits(box):
                         self._put(text, center, u, self.size, "edge-label", box)
                         return True
         return False

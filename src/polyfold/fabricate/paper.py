@@ -23,7 +23,6 @@ MARK_LEG_MM = 20.0  # length of each leg of the L-shaped corner marks
 MARK_LINE_MM = 0.5  # thickness of the L legs
 MARK_CLEAR_MM = MARK_INSET_MM + MARK_LEG_MM  # corner squares kept free of pieces, from the page's edges
 CAP_HEIGHT = 0.718  # Helvetica's cap height per em: a label's printed height, the DXF text height
-CHAR_EM = 0.62  # mean advance width of a Helvetica digit/capital, in em
 MIN_LABEL_MM = 2.0  # default least cap height of a label (`--min-label-mm`): readable when printed
 BUILDABLE_EDGE_MM = 5.0  # shorter printed edges are hard to cut, fold and glue: make warns
 

@@ -228,7 +228,9 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     for idx, ((_key, sides), tab) in enumerate(zip(pairs, chosen)):
         for s, side in enumerate(sides):
             mine = tab is not None and tab.side == s
-            placed[side.piece].edge(side, str(idx + 1), tab.polygons if mine else (), tab.folds if mine else None)
+            other = sides[1 - s]
+            placed[side.piece].edge(side, str(idx + 1), tab.polygons if mine else (), tab.folds if mine else None,
+                                    other if other.piece == side.piece else None)
     stats = LabelStats()
     for p in placed:
         stats.on_tabs += p.stats.on_tabs

@@ -11,7 +11,8 @@ the edge. When it does not fit, in order, on either side: flatter sides (they sl
 notches of a net), a lower tab (TAB_MIN_MM), then the full tab clipped: everything within
 TAB_CLEAR_MM of the piece's other faces, tabs and labels removed (tapered where something comes
 close, split in two where it reaches the fold line). A clipped tab keeps at least MIN_GLUE_FRAC of
-the full tab's glue area and reaches TAB_MIN_DEPTH_MM from its fold line; less does not hold.
+the full tab's glue area, is hinged along MIN_FOLD_FRAC of its edge and reaches TAB_MIN_DEPTH_MM
+from its fold line; less does not hold.
 
 Clearance. Apart from the corners where its fold line meets the neighbouring faces, every tab
 stays TAB_CLEAR_MM from everything else on its piece, so a blade never runs two cuts closer.
@@ -30,6 +31,7 @@ TAB_REL = 0.4  # full tab depth as a fraction of its edge length, between TAB_MI
 TAB_MIN_MM = 3.0  # a lowered tab: the least depth that still takes a finger and glue
 TAB_MIN_DEPTH_MM = 2.0  # a clipped (tapered) tab must reach this far from its fold line somewhere
 MIN_GLUE_FRAC = 0.4  # a clipped tab keeps this fraction of the full tab's area
+MIN_FOLD_FRAC = 0.4  # and its fold lines this fraction of the edge: a flap hinged on a stub twists
 TAB_CLEAR_MM = 0.5  # gap kept between a tab and the piece's other faces, tabs and labels
 OVERLAP_MM2 = 1e-4  # intersections below this area (0.01 x 0.01 mm) are touching, not overlap
 MIN_PART_MM2 = 1.0  # parts of a clipped tab smaller than this are dropped
@@ -117,13 +119,16 @@ class Room:
 
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
-        near = [self.faces[i] for i in self.tree.query(region) if i != skip_face]
-        if self._bounds:
-            x0, y0, x1, y1 = region.bounds
-            b = np.asarray(self._bounds)
-            hit = np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
-            near += [self.extra[i] for i in hit]
-        return near
+        return [self.faces[i] for i in self.tree.query(region) if i != skip_face] + self.extras_near(region)
+
+    def extras_near(self, region) -> list:
+        """The extras whose bounds meet `region`'s."""
+        if not self._bounds:
+            return []
+        x0, y0, x1, y1 = region.bounds
+        b = np.asarray(self._bounds)
+        hit = np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
+        return [self.extra[i] for i in hit]
 
     def blocked(self, poly, skip_face: int | None = None, clear: float = 0.0, keep_free: list | None = None) -> bool:
         """True when `poly` overlaps a face (but `skip_face`) or an extra, or comes within `clear`
@@ -168,7 +173,7 @@ def _depth(poly: np.ndarray, side: CutSide) -> float:
 
 def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
     """The full tab on sides[s] minus everything within TAB_CLEAR_MM of the piece's other faces and
-    extras; None when less than the minimum glue area or depth stays."""
+    extras; None when less than the minimum glue area, hinge or depth stays."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -198,7 +203,9 @@ def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
         return None
     area = sum(Polygon(p).area for p in parts)
     depth = max(_depth(p, side) for p in parts)
-    if area < MIN_GLUE_FRAC * whole.area or depth < min(TAB_MIN_DEPTH_MM, full_depth(side.length)) - 1e-9:
+    hinged = float(sum(np.linalg.norm(f[1] - f[0]) for f in folds))
+    if (area < MIN_GLUE_FRAC * whole.area or hinged < MIN_FOLD_FRAC * side.length
+            or depth < min(TAB_MIN_DEPTH_MM, full_depth(side.length)) - 1e-9):
         return None
     return Tab(s, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
 

@@ -1,0 +1,48 @@
+"""fabricate/labels.py: a glue label that fits neither its face, its tab nor the paper just beside
+its edge goes to the nearest free spot (here: inside another, larger face) with a leader line from
+its edge, at full size and overlapping nothing; text widths are Helvetica's."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from shapely.geometry import LineString, Point, Polygon
+
+from polyfold.fabricate.labels import LABEL_PAD_MM, PieceLabels, label_font, text_box, text_width
+from polyfold.fabricate.paper import CAP_HEIGHT
+from polyfold.fabricate.tabs import CutSide, Room
+
+
+def test_a_label_with_no_room_beside_its_edge_goes_elsewhere_with_a_leader() -> None:
+    small = np.array([[0.0, 0.0], [3.0, 0.0], [1.5, 2.0]])  # too small for a 2 mm label
+    large = np.array([[-30.0, 5.0], [-5.0, 5.0], [-17.0, 25.0]])  # another face of the piece, 5 mm away
+    room = Room(np.array([Polygon(small), Polygon(large)], dtype=object))
+    # all paper off the faces is taken, as by the tabs of other edges
+    taken = Polygon([(-60, -60), (60, -60), (60, 60), (-60, 60)]).difference(
+        Polygon(small).union(Polygon(large)).buffer(0.6))
+    room.add([taken])
+    labels = PieceLabels(room, label_font(2.0))
+    side = CutSide(0, 0, 0, small[0], small[1], small)
+    labels.edge(side, "123")
+    assert (labels.stats.outside, labels.stats.unplaced) == (1, 0)
+    (item,) = labels.items
+    (leader,) = labels.leaders
+    box = text_box(np.array([item.x, item.y]), np.array([math.cos(math.radians(item.angle)),
+                                                         -math.sin(math.radians(item.angle))]), "123", item.size)
+    assert item.size == pytest.approx(label_font(2.0))  # never shrunk
+    # the leader starts on the edge and ends on the box
+    assert LineString([side.p0, side.p1]).distance(Point(*leader[0])) < 1e-9
+    assert Polygon(box).exterior.distance(Point(*leader[1])) < 1e-6
+    # the box lies in the large face, LABEL_PAD_MM from its sides, clear of what is taken
+    assert Polygon(large).buffer(-LABEL_PAD_MM + 1e-9).contains(Polygon(box))
+    assert not Polygon(box).intersects(taken)
+
+
+def test_text_widths_are_helveticas() -> None:
+    assert text_width("1", 10.0) == pytest.approx(5.56)  # every digit 0.556 em
+    assert text_width("W", 10.0) == pytest.approx(9.44)  # wider than a digit
+    assert text_width("I", 10.0) == pytest.approx(2.78)
+    box = text_box(np.zeros(2), np.array([1.0, 0.0]), "10", 2.0)
+    assert np.ptp(box[:, 0]) == pytest.approx(2.224) and np.ptp(box[:, 1]) == pytest.approx(CAP_HEIGHT * 2.0)
