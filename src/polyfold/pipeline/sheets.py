@@ -179,8 +179,10 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
     search. Then one page fewer than the best so far is planned with compact parts (`plan_pages`'
     cap, each of CAPS in turn, emptiest page first) while the outlines grown by half the gap would
-    fill at most COMPACT_FILL of the pages; when that is met, one page fewer again. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
-    it when folding splits nothing); a plan is only started with that drawing's time left."""
+    fill at most COMPACT_FILL of the pages; when that is met, one page fewer again. `box`:
+    `pack_box`. Time: `pack_budget` and one drawing's time (as long as the first drawing took),
+    from after the first drawing (`lay_out` reuses it when folding splits nothing); a plan is only
+    started with that drawing's time left."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
@@ -197,7 +199,9 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     draw_seconds = time.perf_counter() - t0
     pieces = drawn[0]
     packing = pack(pieces, None, pack_budget(deadline))
-    budget = deadline.within(pack_budget(deadline))
+    # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
+    # (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1 planned or not by chance)
+    budget = deadline.within(pack_budget(deadline) + draw_seconds)
     best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
