@@ -138,3 +138,23 @@ def test_flat_polygons_are_never_cut(models_dir):
         is_merged = (net.parent_edge >= 0) & merged_edges(net.mesh)[net.parent_edge]
         merged_creases |= {(inp.face_ids[f], below) for f in np.flatnonzero(is_merged) for below in (True, False)}
     assert offered and merged_creases and not offered & merged_creases
+
+
+def test_a_cap_cuts_sprawling_pieces_into_compact_parts_that_fill_one_page(models_dir):
+    # star-24's two nets cover 0.59 of a page, but their spikes enclose gaps that the bottom-left fill
+    # cannot use: however the plan cuts them they need two pages, cut into parts whose convex hulls
+    # are at most 0.2 of a page they fit one
+    star = drawn(models_dir, "star-24")
+    area = sum(p.footprint.area for p in star["pieces"]) / printable_area(star["page"])
+    assert 0.5 < area < 0.65
+    assert plan(star, 1) is None
+    p = plan(star, 1, cap=0.2)
+    assert p is not None and p.pages == 1 and sum(len(c) for c in p.cuts) > 0
+    cap = 0.2 * printable_area(star["page"])
+    for piece, inp, cuts in zip(star["pieces"], star["inputs"], p.cuts):
+        tree, cut = _Tree(piece, inp.net), cut_creases(inp.net, cuts)
+        for k in range(cut.n_pieces):  # every part is compact: its hull (tabs and labels) within the cap
+            mask = np.zeros(len(inp.net.parent), dtype=bool)
+            mask[piece_net(cut, k)[1]] = True
+            assert tree.hull(mask) <= cap
+    assert plan(star, 1, cap=0.2).order == p.order  # deterministic

@@ -54,6 +54,18 @@ def test_bumpy_is_split_to_fill_its_pages(models_dir, tmp_path):
     assert sum(r.faces for r in report.pieces) == report.input.faces
 
 
+@pytest.mark.parametrize("name", ["periscope2-44", "star-24"])
+def test_sprawling_nets_are_cut_into_compact_parts_to_fit_one_page(name, models_dir, tmp_path):
+    # their nets cover about half a page but, cut only where a piece fits nowhere, needed two pages
+    out = tmp_path / name
+    report = make(models_dir / f"{name}.obj", out, MakeOptions(fold=False)).report
+    lay = report.stages.layout
+    assert lay.pages == 1 and lay.splits_for_packing > 0
+    assert sum(r.faces for r in report.pieces) == report.input.faces
+    svgs = sorted(out.glob("sheet-*.svg"))
+    assert len(svgs) == 1 and check_sheet(read_sheet(svgs[0]), 10.0) == []  # nothing overlaps
+
+
 def test_pieces_that_fit_one_page_are_not_cut(models_dir, tmp_path):
     report = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False, size=80.0)).report
     lay = report.stages.layout

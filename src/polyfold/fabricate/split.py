@@ -6,9 +6,13 @@ the pieces onto a given number of pages, larger first, each onto the first page 
 bottom-left fill of `pack.PageFiller`). A piece that fits on no page is split along one crease:
 the largest of its two sides that fits on some page (the emptiest first, or the first) goes there
 and the other side goes back into the queue; when nothing of it fits anywhere, the plan fails
-(None). A side is a subtree of the piece's tree or what is left of the piece without one, so only
-creases are cut and no face moves: the parts stay overlap-free. Only creases the net allows to be
-cut are cut (`Net.cuttable`: never inside a flat polygon).
+(None). With a `cap`, a part whose convex hull is larger than that is split first, whether or not
+it fits whole: the largest side with a hull within the cap that fits goes onto a page (when no
+such side fits, the part is placed or split as without a cap). A sprawling part encloses gaps that
+the bottom-left fill cannot use, so compact parts fill a page denser (periscope2-44 and star-24
+on one page instead of two). A side is a subtree of the piece's tree or what is left of the piece
+without one, so only creases are cut and no face moves: the parts stay overlap-free. Only creases
+the net allows to be cut are cut (`Net.cuttable`: never inside a flat polygon).
 
 What is packed is a piece's footprint (outline and labels printed off its faces). The footprint of
 a part is estimated before anything is redrawn: its faces with the tabs and labels the whole piece
@@ -21,6 +25,7 @@ a net) are placed whole.
 from __future__ import annotations
 
 import bisect
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -61,6 +66,7 @@ class _Tree:
     def __init__(self, piece: SheetPiece, net: Net | None) -> None:
         self.piece = piece
         self._room: dict[tuple[int, int], Polygon | None] = {}
+        self._corners: tuple[np.ndarray, np.ndarray] | None = None  # `hull`'s, made on its first call
         if net is None:
             self.polys = np.array([piece.footprint], dtype=object)
             self.area = shapely.area(self.polys)
@@ -102,6 +108,16 @@ class _Tree:
         """The face of a part (a connected set of the tree's faces) whose parent is not in it."""
         f = np.flatnonzero(mask & ((self.parent < 0) | ~mask[np.maximum(self.parent, 0)]))
         return int(f[0])
+
+    def hull(self, mask: np.ndarray) -> float:
+        """Area of the convex hull of the part (its faces with their tabs and labels; without tab
+        room on the creases cut): the hull of the corners of its faces' hulls, which are made once,
+        on the first call (plans without a cap never ask: a plan's time is the page split's budget)."""
+        if self._corners is None:
+            hulls = shapely.convex_hull(self.polys)
+            self._corners = (shapely.get_coordinates(hulls), shapely.get_num_coordinates(hulls))
+        corners, counts = self._corners
+        return float(shapely.convex_hull(shapely.multipoints(corners[np.repeat(mask, counts)])).area)
 
     def room(self, f: int, side: int) -> Polygon | None:
         """Room for a full-size tab on the crease of face f to its parent, on f (side 0) or on the
@@ -154,18 +170,20 @@ class _Tree:
 
 
 def _split_onto(filler: PageFiller, page: int, tree: _Tree, t: int, mask: np.ndarray, lo: float,
-                tries: int) -> tuple[Spot, np.ndarray, np.ndarray, int] | None:
-    """The largest side of one cut of part (t, mask) that fits on `page`: a spread of `tries`
-    candidates (largest first) finds the largest of them that fits, then the candidates between
-    it and the last one that did not are tried in turn. (spot, side, rest, the face whose crease
-    to its parent is cut) or None."""
-    cands = tree.sides(mask, lo, 0.95 * filler.free_area(page))
+                tries: int, cap: float = math.inf) -> tuple[Spot, np.ndarray, np.ndarray, int] | None:
+    """The largest side of one cut of part (t, mask) that fits on `page` and whose convex hull is
+    at most `cap` mm^2: a spread of `tries` candidates (largest first) finds the largest of them
+    that fits, then the candidates between it and the last one that did not are tried in turn.
+    (spot, side, rest, the face whose crease to its parent is cut) or None."""
+    cands = tree.sides(mask, lo, min(cap, 0.95 * filler.free_area(page)))
     if not cands:
         return None
 
     def attempt(i: int):
         _, face, below = cands[i]
         side, rest = tree.split(mask, face, below)
+        if cap < math.inf and tree.hull(side) > cap:  # like a side that does not fit: hull >= area
+            return None
         spot = filler.spot(page, tree.outline(side), (t, side.tobytes()))
         return None if spot is None else (spot, side, rest, face)
 
@@ -187,7 +205,7 @@ def _split_onto(filler: PageFiller, page: int, tree: _Tree, t: int, mask: np.nda
 def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tuple[float, float], margin: float,
                gap: float, n_pages: int, deadline: float, angles: int = ANGLES, seed: int = 0,
                emptiest_first: bool = True, min_part: float = MIN_PART, tries: int = SPLIT_TRIES,
-               rasters: dict | None = None) -> PagePlan | None:
+               rasters: dict | None = None, cap: float | None = None) -> PagePlan | None:
     """Cut creases so that the pieces fit on `n_pages` pages (see the module docstring). pieces[i]
     is drawn from the single-piece net nets[i] (same faces, same order); pieces after the last net
     (glue strips) are placed whole. Packed: the pieces' footprints. page_size (width, height mm),
@@ -197,9 +215,11 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
     `deadline` (`time.perf_counter()` seconds). A plan without cuts is pack_outlines' first fit in
     the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages.
     `rasters`: a dict kept across plans of these very pieces (same page, gap, angles, seed), so that
-    a part tried by one is not rasterised again by the next."""
+    a part tried by one is not rasterised again by the next. `cap`: the largest convex hull of a part
+    placed whole (a fraction of the printable area), when given."""
     filler = PageFiller(page_size, margin, gap, n_pages, angles, seed, rasters)
     lo = min_part * filler.printable_area
+    cap_area = math.inf if cap is None else cap * filler.printable_area
     trees = [_Tree(p, nets[i] if i < len(nets) else None) for i, p in enumerate(pieces)]
     # the queue: (-area, sequence number, piece, faces); larger first, ties in input order
     queue = sorted((-float(tr.area.sum()), t, t, np.ones(len(tr.area), dtype=bool)) for t, tr in enumerate(trees))
@@ -212,18 +232,22 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
         _, _, t, mask = queue.pop(0)
         tree = trees[t]
         outline, key = tree.outline(mask), (t, mask.tobytes())
-        spot = next((s for pg in range(n_pages) if (s := filler.spot(pg, outline, key)) is not None), None)
-        if spot is not None:
-            filler.put(spot)
-            placed.append((t, tree.root(mask)))
-            continue
         pages = sorted(range(n_pages), key=lambda p: -filler.free_area(p)) if emptiest_first else range(n_pages)
-        for pg in pages:
-            hit = _split_onto(filler, pg, tree, t, mask, lo, tries)
-            if hit is not None:
-                break
-        else:
-            return None
+        hit = None
+        if cap_area < math.inf and tree.hull(mask) > cap_area:  # not compact: a compact side first
+            hit = next((h for pg in pages if (h := _split_onto(filler, pg, tree, t, mask, lo, tries, cap_area))), None)
+        if hit is None:
+            spot = next((s for pg in range(n_pages) if (s := filler.spot(pg, outline, key)) is not None), None)
+            if spot is not None:
+                filler.put(spot)
+                placed.append((t, tree.root(mask)))
+                continue
+            for pg in pages:
+                hit = _split_onto(filler, pg, tree, t, mask, lo, tries)
+                if hit is not None:
+                    break
+            else:
+                return None
         spot, side, rest, face = hit
         filler.put(spot)
         cuts[t].append(face)

@@ -80,6 +80,13 @@ PAGE_CHOICES = (True, False)
 # page counts at which the outlines would fill more than this of the printable area are not tried:
 # on the benchmark models no plan above 0.60 succeeded, and failing plans take the longest
 MAX_FILL = 0.75
+# hull areas (fractions of the printable area) that compact parts are cut to, the coarsest first
+# (fewest cuts): a sprawling net encloses gaps that the bottom-left fill cannot use
+CAPS = (0.4, 0.3, 0.2, 0.15, 0.1)
+# page counts at which the outlines grown by half the gap (the room the packer gives each) would fill
+# more than this are not tried with compact parts: on the benchmark models those that met their page
+# count filled up to 0.64 of it (star-24), and the plans fail slowly (fish-472 at 0.84: 4 s for all caps)
+COMPACT_FILL = 0.7
 
 
 def pack_budget(deadline: Deadline) -> float:
@@ -170,8 +177,12 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     again, up to PLAN_ROUNDS times, until a plan needs no cut; the redrawn pieces are packed in the
     plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
-    search. `box`: `pack_box`. Time: `pack_budget`, from after the first drawing (`lay_out` reuses
-    it when folding splits nothing); a plan is only started with that drawing's time left."""
+    search. Then one page fewer than the best so far is planned with compact parts (`plan_pages`'
+    cap, each of CAPS in turn, emptiest page first) while the outlines grown by half the gap would
+    fill at most COMPACT_FILL of the pages; when that is met, one page fewer again. `box`:
+    `pack_box`. Time: `pack_budget` and one drawing's time (as long as the first drawing took),
+    from after the first drawing (`lay_out` reuses it when folding splits nothing); a plan is only
+    started with that drawing's time left."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
@@ -188,47 +199,71 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     draw_seconds = time.perf_counter() - t0
     pieces = drawn[0]
     packing = pack(pieces, None, pack_budget(deadline))
-    budget = deadline.within(pack_budget(deadline))
+    # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
+    # (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1 planned or not by chance)
+    budget = deadline.within(pack_budget(deadline) + draw_seconds)
     best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
     ran_out = packing.ran_out
     rasters: dict[int, tuple] = {}  # per drawing: (the drawing, kept alive so its id stays its own, rasters)
+
+    def attempt(n_pages: int, cap: float | None, emptiest_first: bool) -> None:
+        """Plan the cuts for `n_pages` (rounds of plan, cut, redraw), pack the cut pieces in the
+        plan's order and keep them in `best` when they beat it."""
+        nonlocal best, ran_out
+        cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
+        for _ in range(PLAN_ROUNDS):
+            if budget.left() < draw_seconds:  # no time to draw the pieces this plan would cut
+                ran_out = True
+                break
+            plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
+                              budget.at, seed=opts.seed, emptiest_first=emptiest_first,
+                              rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1], cap=cap)
+            if plan is None:
+                ran_out |= budget.expired()
+                break
+            if not any(len(c) for c in plan.cuts):
+                hint = [t for t, _ in plan.order]
+                break
+            cur_parts, n_cut = _cut_plan(cur_parts, cur_inputs, plan)
+            cut_inputs = part_piece_inputs(mesh, cur_parts)
+            owner = _owner(cut_inputs, mesh.n_faces)
+            # the plan's order (glue strips are drawn anew: after the net pieces)
+            hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
+            cuts += n_cut
+            cur_inputs = cut_inputs
+            cur_drawn = draw(cur_inputs)
+        if hint is not None:
+            cut_packing = pack(cur_drawn[0], hint, max(0.5, budget.left()))
+            ran_out |= cut_packing.ran_out
+            if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
+                best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
+                        cur_drawn)
+
     for n_pages in range(fewest, packing.n_pages):
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
         for emptiest_first in PAGE_CHOICES:
-            cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
-            for _ in range(PLAN_ROUNDS):
-                if budget.left() < draw_seconds:  # no time to draw the pieces this plan would cut
-                    ran_out = True
-                    break
-                plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
-                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first,
-                                  rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1])
-                if plan is None:
-                    ran_out |= budget.expired()
-                    break
-                if not any(len(c) for c in plan.cuts):
-                    hint = [t for t, _ in plan.order]
-                    break
-                cur_parts, n_cut = _cut_plan(cur_parts, cur_inputs, plan)
-                cut_inputs = part_piece_inputs(mesh, cur_parts)
-                owner = _owner(cut_inputs, mesh.n_faces)
-                # the plan's order (glue strips are drawn anew: after the net pieces)
-                hint = [int(owner[cur_inputs[t].face_ids[root]]) for t, root in plan.order if t < len(cur_inputs)]
-                cuts += n_cut
-                cur_inputs = cut_inputs
-                cur_drawn = draw(cur_inputs)
-            if hint is not None:
-                cut_packing = pack(cur_drawn[0], hint, max(0.5, budget.left()))
-                ran_out |= cut_packing.ran_out
-                if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
-                    best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
-                            cur_drawn)
+            attempt(n_pages, None, emptiest_first)
             if best[0] <= n_pages or ran_out:
                 break
         if best[0] <= n_pages or ran_out:
             break
+    # one page fewer than that, with the parts cut compact (hulls of at most CAPS of a page, the
+    # largest first); when that is met, one page fewer again
+    n_pages, least = best[0] - 1, fewest
+    if n_pages >= fewest:  # (only then: growing the outlines of a dense model takes a while)
+        grown = sum(p.footprint.buffer(GAP_MM / 2).area for p in pieces) / box_area
+        least = max(fewest, math.ceil(grown / COMPACT_FILL - 1e-9))
+    while n_pages >= least and not ran_out:
+        say("layout", f"splitting pieces into compact parts to fit {n_pages} page{'s' * (n_pages > 1)}")
+        for cap in CAPS:
+            attempt(n_pages, cap, True)
+            if best[0] <= n_pages or ran_out:
+                break
+        if best[0] > n_pages:
+            break
+        n_pages = best[0] - 1
     n_pages, n_pieces, parts, inputs, order, cuts, drawn = best
     rank = np.full(mesh.n_faces, len(order), dtype=np.int64)
     for pos, i in enumerate(order):
