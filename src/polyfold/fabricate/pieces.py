@@ -21,6 +21,8 @@ from .page import TextItem
 from .paper import MIN_LABEL_MM
 from .tabs import CutSide, Room, Tab, choose_tab, full_depth
 
+OUTLINE_TOL_MM = 1e-3  # outline corners closer than this are one corner
+
 
 @dataclass(frozen=True, eq=False)
 class PieceInput:
@@ -282,6 +284,9 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         # each tab is grown by 10 nm (invisible) so it overlaps its face, then all is unioned on a grid
         grown = [t.buffer(1e-5, join_style="mitre") for t in tab_polys]
         outline = shapely.union_all([d.body, *grown], grid_size=1e-6) if tab_polys else d.body
+        # the union leaves sides of a few nm where a grown tab meets its face: merged into their
+        # neighbours (files are written to 1e-4 mm, where they would be zero-length cuts)
+        outline = shapely.remove_repeated_points(outline, OUTLINE_TOL_MM)
         footprint = shapely.union_all([outline, *placed[i].outside]) if placed[i].outside else outline
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
