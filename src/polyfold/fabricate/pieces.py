@@ -24,6 +24,22 @@ from .tabs import CutSide, Room, Tab, choose_tab, full_depth
 OUTLINE_TOL_MM = 1e-3  # outline corners closer than this are one corner
 
 
+def _without_specks(outline):
+    """The outline without what the union of faces and grown tabs leaves at nm scale, which files
+    written to 1e-4 mm would turn into zero-length cuts: corners within OUTLINE_TOL_MM merged,
+    then holes (and parts) that shrank to nothing dropped."""
+    import shapely
+
+    merged = shapely.remove_repeated_points(outline, OUTLINE_TOL_MM)
+    parts = []
+    for poly in getattr(merged, "geoms", [merged]):
+        if poly.geom_type != "Polygon" or poly.area <= OUTLINE_TOL_MM ** 2:
+            continue
+        holes = [r for r in poly.interiors if len(r.coords) >= 4 and shapely.Polygon(r).area > OUTLINE_TOL_MM ** 2]
+        parts.append(shapely.Polygon(poly.exterior, holes))
+    return parts[0] if len(parts) == 1 else shapely.MultiPolygon(parts)
+
+
 @dataclass(frozen=True, eq=False)
 class PieceInput:
     """One piece to draw: a single-piece net, its part, and its maps into the whole mesh."""
@@ -284,9 +300,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         # each tab is grown by 10 nm (invisible) so it overlaps its face, then all is unioned on a grid
         grown = [t.buffer(1e-5, join_style="mitre") for t in tab_polys]
         outline = shapely.union_all([d.body, *grown], grid_size=1e-6) if tab_polys else d.body
-        # the union leaves sides of a few nm where a grown tab meets its face: merged into their
-        # neighbours (files are written to 1e-4 mm, where they would be zero-length cuts)
-        outline = shapely.remove_repeated_points(outline, OUTLINE_TOL_MM)
+        outline = _without_specks(outline)
         footprint = shapely.union_all([outline, *placed[i].outside]) if placed[i].outside else outline
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
