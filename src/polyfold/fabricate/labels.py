@@ -157,6 +157,14 @@ class LabelStats:
     unplaced: int = 0
 
 
+def _nearest_on(poly, p: np.ndarray) -> np.ndarray:
+    """The point of a label box's outline nearest p (where a leader from p ends)."""
+    from shapely.geometry import Point
+
+    ring = poly.exterior
+    return np.asarray(ring.interpolate(ring.project(Point(*p))).coords[0])
+
+
 def _incentre(tri: np.ndarray) -> np.ndarray:
     a, b, c = tri
     la, lb, lc = np.linalg.norm(b - c), np.linalg.norm(c - a), np.linalg.norm(a - b)
@@ -234,21 +242,23 @@ class _Taken:
         return np.clip(ij, 0, self._last, out=ij)
 
     def mark(self, geom, grow: float, text: bool = False) -> None:
-        """Mark the cells whose centres lie in `geom` grown by `grow` mm (a label's box, `text`:
-        also in `texts`, grown as much as a leader looked up there needs)."""
+        """Mark the cells whose centres lie in `geom` grown by `grow` mm; a label's box (`text`)
+        also in `texts`, grown by half the step between a leader's points and half a cell's
+        diagonal beyond LEADER_HALF_MM, as a leader is looked up at the cells of its points."""
+        self._fill(self.grid, geom, grow)
+        if text:
+            self._fill(self.texts, geom, LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM)
+
+    def _fill(self, grid: np.ndarray, geom, grow: float) -> None:
         import shapely
 
-        # texts: grown by half the step between a leader's points and half a cell's diagonal too,
-        # as a leader is looked up at the cells of its points
-        reach = LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM
-        for where, by in ((self.grid, grow),) + (((self.texts, reach),) if text else ()):
-            g = geom.buffer(by, quad_segs=2)
-            x0, y0, x1, y1 = g.bounds
-            (c0, r0), (c1, r1) = self._cells(np.array([[x0, y0], [x1, y1]]))
-            cx = self.origin[0] + (np.arange(c0, c1 + 1) + 0.5) * FREE_CELL_MM
-            cy = self.origin[1] + (np.arange(r0, r1 + 1) + 0.5) * FREE_CELL_MM
-            gx, gy = np.meshgrid(cx, cy)
-            where[r0:r1 + 1, c0:c1 + 1] |= shapely.contains_xy(g, gx, gy)
+        g = geom.buffer(grow, quad_segs=2)
+        x0, y0, x1, y1 = g.bounds
+        (c0, r0), (c1, r1) = self._cells(np.array([[x0, y0], [x1, y1]]))
+        cx = self.origin[0] + (np.arange(c0, c1 + 1) + 0.5) * FREE_CELL_MM
+        cy = self.origin[1] + (np.arange(r0, r1 + 1) + 0.5) * FREE_CELL_MM
+        gx, gy = np.meshgrid(cx, cy)
+        grid[r0:r1 + 1, c0:c1 + 1] |= shapely.contains_xy(g, gx, gy)
 
     def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
         """Centres (up to want, 2) of level w x h mm boxes that touch no taken cell and whose
@@ -307,6 +317,15 @@ class PieceLabels:
     def _hits(self, box: np.ndarray) -> bool:
         """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
         return self.boxes.hits(box) or self.strips.hits(box)
+
+    def _off_faces(self, geoms: list) -> None:
+        """Record what an off-face label puts on the paper (its box, its leader's stretch beyond
+        the tab): in the piece's room (tabs keep clear of it), its footprint and the raster."""
+        self.room.add(geoms)
+        self.outside.extend(geoms)
+        if self._taken is not None:
+            for g in geoms:
+                self._taken.mark(g, TAB_CLEAR_MM)
 
     def _put(self, text: str, center: np.ndarray, u: np.ndarray, size: float, kind: str, box: np.ndarray) -> None:
         self.boxes.add(box)
@@ -373,7 +392,7 @@ class PieceLabels:
                  partner: CutSide | None) -> bool:
         """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it, else up to
         LEADER_STEPS_MM away in a free spot with a leader line from the middle of the edge."""
-        from shapely.geometry import LineString, Point, Polygon
+        from shapely.geometry import LineString, Polygon
 
         d = side.p1 - side.p0
         mid = side.p0 + 0.5 * d
@@ -396,7 +415,7 @@ class PieceLabels:
                 continue
             extra = [poly]
             if leader:
-                end = np.asarray(poly.exterior.interpolate(poly.exterior.project(Point(*start))).coords[0])
+                end = _nearest_on(poly, start)
                 line = LineString([start + (end - start) * min(1.0, TAB_CLEAR_MM / max(np.linalg.norm(end - start), 1e-9)), end])
                 # drawn from the edge itself, over its own tab: a leader ending at the tab's tip
                 # points at whatever edge lies beyond it (the partner's, in a notch)
@@ -408,11 +427,7 @@ class PieceLabels:
                 self.leaders.append(np.array([mid, end]))
                 extra.append(line.buffer(LEADER_HALF_MM))
             self._put(text, center, u, self.size, "edge-label", box)
-            self.room.add(extra)
-            self.outside.extend(extra)
-            if self._taken is not None:
-                for g in extra:
-                    self._taken.mark(g, TAB_CLEAR_MM)
+            self._off_faces(extra)
             return True
         return False
 
@@ -424,7 +439,7 @@ class PieceLabels:
         label. Candidates come from the piece's `_Taken` raster, nearest first; each is checked
         exactly. After ELSEWHERE_GIVE_UP labels without a spot the piece is not searched again (a
         mesh that dense needs a larger --size)."""
-        from shapely.geometry import LineString, Point, Polygon
+        from shapely.geometry import LineString, Polygon
 
         if self._no_spot >= ELSEWHERE_GIVE_UP:
             return False
@@ -432,11 +447,16 @@ class PieceLabels:
             self._taken = _Taken(self)
         w, h = text_width(text, self.size), CAP_HEIGHT * self.size
         level, upward = np.array([1.0, 0.0]), _reading(np.array([0.0, 1.0]))
-        # in a face first: off the faces, a label takes paper that other pieces could use
-        tries = ((mid, u, c) for t in (0.5, 0.25, 0.75) for inside in (True, False)
-                 for mid in (side.p0 + t * (side.p1 - side.p0),) for u, bw, bh in ((level, w, h), (upward, h, w))
-                 for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside))
-        for mid, u, center in tries:
+
+        def tries():
+            for t in (0.5, 0.25, 0.75):
+                mid = side.p0 + t * (side.p1 - side.p0)
+                for inside in (True, False):  # in a face first: off them a label takes paper
+                    for u, bw, bh in ((level, w, h), (upward, h, w)):
+                        for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside):
+                            yield mid, u, c
+
+        for mid, u, center in tries():
             box = text_box(center, u, text, self.size)
             if self._hits(box):
                 continue
@@ -445,7 +465,7 @@ class PieceLabels:
                           for f in self.room.tree.query(poly))
             if not in_face and (not self.allowed.contains(poly) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
                 continue
-            end = np.asarray(poly.exterior.interpolate(poly.exterior.project(Point(*mid))).coords[0])
+            end = _nearest_on(poly, mid)
             strip = LineString([mid, end]).buffer(LEADER_HALF_MM)
             if self.boxes.hits_geom(strip):
                 continue
@@ -454,8 +474,7 @@ class PieceLabels:
             self.strips.add_geom(strip)  # later labels keep off it (leaders may cross)
             self._taken.mark(strip, LABEL_PAD_MM)
             if not in_face:
-                self.room.add([poly])
-                self.outside.append(poly)
+                self._off_faces([poly])
             return True
         self._no_spot += 1
         return False
