@@ -84,14 +84,14 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     split = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), deadline, lambda *a: None)
     n_fitted = sum(p.net.n_pieces for p in fitted)
     assert split.cuts > 0 and split.net_pieces == n_fitted + split.cuts
-    folded, _ = fold_pieces(split.parts, opts, deadline, lambda *a: None)
+    folded, _ = fold_pieces(split.parts, opts, deadline, lambda *a: None, scale)
     sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
     assert len(sheets.pieces) == split.pieces and sheets.packing.n_pages == split.pages
     # the pieces drawn before folding, laid out again, are what drawing the folded pieces gives
     fresh, _, _ = build_sheet_pieces(piece_inputs(mesh, folded), scale, min_label_mm=opts.min_label_mm)
     assert [p.footprint.equals_exact(q.footprint, 0.0) for p, q in zip(split.drawn[0], fresh)] == [True] * len(fresh)
     # and without the split the same pieces need more pages
-    unsplit, _ = fold_pieces(fitted, opts, deadline, lambda *a: None)
+    unsplit, _ = fold_pieces(fitted, opts, deadline, lambda *a: None, scale)
     assert lay_out(mesh, unsplit, scale, opts, w, h, deadline, lambda *a: None).packing.n_pages > split.pages
 
 

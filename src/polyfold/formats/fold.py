@@ -242,10 +242,14 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
 # Folding paths
 
 
-def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float) -> dict:
+def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float, thickness: float = 0.0,
+              verified: bool = False) -> dict:
     """A copy of the FOLD dict with the path: `polyfold:path` (frames of FOLD fold angles in
     degrees, one per edge, 0 for B edges; first all 0, last = edges_foldAngle) and its facts
-    (planner, linear, resolution in degrees, contact tolerance relative to the model size)."""
+    (planner, linear, resolution in degrees, contact tolerance and material thickness relative
+    to the model size: the foldedForm's bounding-box diagonal; thickness given here in the dict's
+    units) and `polyfold:path_verified`: whether the independent check (`verify.paths`) accepted
+    it at that thickness."""
     out = dict(fold)
     frames = path.degrees_fold()
     # The last frame is the goal itself: write the file's own angles so it matches bit for bit.
@@ -256,6 +260,9 @@ def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: fl
     out["polyfold:path_linear"] = bool(path.linear)
     out["polyfold:path_resolutionDeg"] = float(resolution_deg)
     out["polyfold:path_contactTol"] = float(contact_tol)
+    folded = np.asarray(fold["file_frames"][0]["vertices_coords"], dtype=np.float64)
+    out["polyfold:path_thicknessRel"] = float(thickness) / max(bbox_diagonal(folded), 1e-300)
+    out["polyfold:path_verified"] = bool(verified)
     return out
 
 
@@ -264,9 +271,10 @@ PAGE_TO_FOLD = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # page mm (y down)
 
 def piece_fold(pattern: CreasePattern, *, title: str, file_title: str, whole_mesh_faces: Sequence[int],
                path: FoldPath | None = None, resolution_deg: float = 1.0, contact_tol: float = CONTACT_TOL,
+               thickness: float = 0.0, verified: bool = False,
                mm_per_unit: float | None = None, page: int | None = None, to_page: np.ndarray | None = None) -> dict:
     """The FOLD document of one piece of a make folder: its crease pattern (frame_title `title`),
-    its folding path when it has one (`with_path`), file_title, and `polyfold:faces_wholeMeshFace`
+    its folding path when it has one (`with_path`; thickness in model units), file_title, and `polyfold:faces_wholeMeshFace`
     (the piece's faces as faces of the whole model).
 
     Printed scale (make): with mm_per_unit (mm per model unit), page (1-based) and to_page (2, 3),
@@ -281,7 +289,7 @@ def piece_fold(pattern: CreasePattern, *, title: str, file_title: str, whole_mes
     Fold angles, the path and its relative contact tolerance do not depend on the unit."""
     fold = pattern_fold(pattern, title=title)
     if path is not None:
-        fold = with_path(fold, path, resolution_deg, contact_tol)
+        fold = with_path(fold, path, resolution_deg, contact_tol, thickness, verified)
     fold["file_title"] = file_title
     fold["polyfold:faces_wholeMeshFace"] = [int(x) for x in whole_mesh_faces]
     if mm_per_unit is not None:

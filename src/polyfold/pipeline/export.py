@@ -111,7 +111,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             stage.write(row.fold_file, dumps(piece_fold(
                 fp.pattern, title=f"part {fp.part} piece", file_title=f"{model} piece {piece.name} (part {fp.part})",
                 whole_mesh_faces=fp.mesh_faces, path=fp.path, resolution_deg=opts.resolution_deg,
-                contact_tol=opts.contact_tol, mm_per_unit=sheets.scale, page=row.page,
+                contact_tol=opts.contact_tol, thickness=opts.thickness / sheets.scale, verified=fp.info.path,
+                mm_per_unit=sheets.scale, page=row.page,
                 to_page=pattern_to_page(fp.pattern, fp.net, sheets.scale, placement))))
         stage.write("assembly.json", assembly(model, opts, parts, sheets, rows).to_json())
         stage.write("instructions.html", instructions_html(

@@ -1,7 +1,9 @@
 """make's fold stage: a verified folding path for every piece.
 
 A piece without a path in its time share is split in two (fewer faces always fold more easily)
-and both halves are planned again, at most MAX_SPLITS times per piece.
+and both halves are planned again, at most MAX_SPLITS times per piece. A path counts as found
+only when the independent checker (`verify.paths`) accepts it as it will be written (FOLD
+degrees) at the paper's thickness; one it rejects is treated as no path (split, or reported).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..fold.plan import FoldPath, plan_fold
 from ..fold.tree import FoldTree, collides
+from ..formats.fold import pattern_fold, with_path
 from ..unfold.net import Net, balanced_cut, cut_creases, piece_net
 from ..unfold.pattern import CreasePattern, crease_pattern
 from .options import MakeOptions
@@ -63,10 +66,12 @@ class _Planner:
     """The fold stage's state: pieces still to plan (for the time shares), splits, results."""
 
     def __init__(self, opts: MakeOptions, deadline: Deadline, n_parts: int, pending: int,
-                 say: Callable[[str, str], None]) -> None:
+                 say: Callable[[str, str], None], thickness: float) -> None:
         self.opts, self.deadline, self.n_parts, self.say = opts, deadline, n_parts, say
+        self.thickness = thickness  # model units
         self.pending = pending
         self.splits = 0
+        self.rejected = 0  # paths the independent check rejected
         self.results: list[FoldedPiece] = []
 
     def plan(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, depth: int) -> None:
@@ -92,14 +97,22 @@ class _Planner:
                     path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
                 except PolyfoldError as exc:
                     path, note = None, str(exc)
+                if path is not None:
+                    check = verify_written(pattern, path, opts, self.thickness)
+                    if not check.ok:
+                        self.rejected += 1
+                        self.say("fold", f"the path failed the independent check ({check.why()})")
+                        path, note = None, f"the planned path failed the independent check: {check.why()}"
                 may_split = path is None and depth < MAX_SPLITS and self.deadline.left() > 0
                 cut = balanced_cut(pnet, 0) if may_split else None  # None: one flat polygon, never cut
                 if cut is not None:
-                    self.say("fold", f"no path in {share:.1f} s: split the piece in two")
+                    self.say("fold", f"no verified path in {share:.1f} s: split the piece in two")
                     self._split(pi, faces, pnet, fids, cut, depth)
                     return
                 if path is None and not note:
                     note = "no path within the time limit"
+                elif path is None and note.startswith("the planned path failed") and depth >= MAX_SPLITS:
+                    note += f" (after {MAX_SPLITS} halvings)"
             seconds = time.perf_counter() - tf
             info = PathInfo(note=note, seconds=seconds) if path is None else PathInfo(
                 path=True, linear=bool(path.linear), planner=path.planner, seconds=seconds, frames=len(path.frames))
@@ -115,15 +128,27 @@ class _Planner:
             self.plan(pi, faces, sub, fids[sub_fids], depth + 1)
 
 
-def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline,
-                say: Callable[[str, str], None]) -> tuple[list[FoldedPiece], FoldReport]:
-    """Every piece of every part's net, with its folding path (see the module docstring)."""
+def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, thickness: float):
+    """The independent check (`verify.paths.check_fold_path`) of a piece's path as its FOLD file
+    holds it (degrees, the goal frame as written), at `thickness` model units."""
+    from ..verify.paths import check_fold_path
+
+    fold = with_path(pattern_fold(pattern), path, opts.resolution_deg, opts.contact_tol, thickness)
+    return check_fold_path(fold, thickness=thickness)
+
+
+def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None],
+                mm_per_unit: float) -> tuple[list[FoldedPiece], FoldReport]:
+    """Every piece of every part's net, with its folding path (see the module docstring); the
+    paper's thickness (opts.thickness mm) is mm_per_unit-scaled to model units."""
     t0 = time.perf_counter()
-    planner = _Planner(opts, deadline, len(parts), sum(p.net.n_pieces for p in parts), say)
+    planner = _Planner(opts, deadline, len(parts), sum(p.net.n_pieces for p in parts), say,
+                       opts.thickness / mm_per_unit)
     for pi, part in enumerate(parts):
         for k in range(part.net.n_pieces):
             planner.plan(pi, part.faces, *piece_net(part.net, k), 0)
     results = planner.results
     report = FoldReport(enabled=opts.fold, seconds=time.perf_counter() - t0, splits_for_folding=planner.splits,
-                        verified=sum(r.info.path for r in results), pieces=len(results))
+                        verified=sum(r.info.path for r in results), pieces=len(results),
+                        thickness_mm=opts.thickness, rejected_paths=planner.rejected)
     return results, report

@@ -136,7 +136,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     split = split_for_pages(mesh, fitted, scale, opts, box, deadline, say)
     fitted = split.parts
     fit_seconds = time.perf_counter() - ts
-    folded, fold_report = fold_pieces(fitted, opts, deadline, say)
+    folded, fold_report = fold_pieces(fitted, opts, deadline, say, scale)
     sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say, planned=split)
     checks = _check(sheets, opts, name, fold_report.verified, say)
     layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)

@@ -8,7 +8,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from ..collide.tolerance import CONTACT_TOL
+from ..collide.tolerance import CONTACT_TOL, THICKNESS_MM
 from ..errors import PolyfoldError
 from ..fabricate.paper import FOOTER_MM, MARK_CLEAR_MM, MIN_LABEL_MM
 
@@ -34,6 +34,7 @@ class MakeOptions:
     fold: bool = True  # plan and verify a folding path per piece
     contact_tol: float = CONTACT_TOL
     resolution_deg: float = 1.0
+    thickness: float = THICKNESS_MM  # of the paper (mm): faces closer than this collide (verify.paths)
     marks: bool = False  # print-and-cut registration marks (Silhouette "Type 1") on the printed pages
     min_label_mm: float = MIN_LABEL_MM  # least cap height of every label (mm)
 
@@ -64,6 +65,8 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
         raise PolyfoldError(f"--size must be a positive number of mm, not {opts.size}")
     if not (0.5 <= opts.min_label_mm <= 10):
         raise PolyfoldError(f"--min-label-mm must be between 0.5 and 10 mm, not {opts.min_label_mm}")
+    if not (0 <= opts.thickness <= 5 and math.isfinite(opts.thickness)):
+        raise PolyfoldError(f"--thickness must be between 0 and 5 mm, not {opts.thickness}")
     width, height = paper_size(opts.paper)
     if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
         raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")

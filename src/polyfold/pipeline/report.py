@@ -83,8 +83,10 @@ class FoldReport:
     enabled: bool
     seconds: float
     splits_for_folding: int
-    verified: int
+    verified: int  # pieces whose path the independent check (verify.paths) accepted
     pieces: int
+    thickness_mm: float = 0.0  # the paper thickness the paths were checked at
+    rejected_paths: int = 0  # planned paths the independent check rejected (split or reported)
 
 
 @dataclass(frozen=True)

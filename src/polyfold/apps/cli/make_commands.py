@@ -32,6 +32,7 @@ def make(
     fold: bool = options.FOLD,
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
+    thickness: float = options.THICKNESS_MM,
     min_label_mm: float = options.MIN_LABEL,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
@@ -39,7 +40,7 @@ def make(
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks, min_label_mm=min_label_mm)
+                                    marks=marks, min_label_mm=min_label_mm, thickness=thickness)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -74,7 +75,8 @@ def make(
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
              f"page(s) ({lay.utilisation:.0%} of their printable area), {lay.glue_edges} glue edges, "
              f"smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
-             f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified, "
+             f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified "
+             f"(independent check, {opts.thickness:g} mm paper), "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
 
 

@@ -10,7 +10,7 @@ from typing import Callable, Iterator, Optional
 
 import typer
 
-from ...collide.tolerance import CONTACT_TOL
+from ...collide.tolerance import CONTACT_TOL, THICKNESS_REL
 from ...pipeline.options import MakeOptions
 
 _D = MakeOptions()
@@ -41,6 +41,10 @@ MARKS = typer.Option(_D.marks, "--marks/--no-marks",
                      help="Print-and-cut registration marks (Silhouette Studio 'Type 1', 10 mm inset) on the printed "
                           "pages; pieces keep out of the marked corners.")
 CONTACT_TOL_OPTION = contact_tol_option()
+THICKNESS_MM = typer.Option(_D.thickness, "--thickness", min=0.0, max=5.0,
+                            help="Paper thickness, mm: faces closer than this with overlapping projections collide (every path is re-checked at it).")
+THICKNESS_REL = typer.Option(THICKNESS_REL, "--thickness", min=0.0, max=0.1,
+                             help="Material thickness as a fraction of the model size (bounding-box diagonal): faces closer than this with overlapping projections collide.")
 MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
                          help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
@@ -48,7 +52,7 @@ MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
 def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str, tau: Optional[float],
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
                  time_limit: float, fold: bool, contact_tol: float, marks: bool,
-                 min_label_mm: float = _D.min_label_mm) -> MakeOptions:
+                 min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -56,7 +60,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
         fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
-                       contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm)
+                       contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness)
 
 
 @contextlib.contextmanager
