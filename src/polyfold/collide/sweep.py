@@ -22,7 +22,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .triangles import GEO_LO, face_geometry, faces_cross, load_face, store_face, tri_corners, triangles_collide
+from .triangles import (GEO_LO, face_geometry, faces_cross, load_face, store_face, thick_collides, tri_corners,
+                        triangles_collide)
 
 NO_LIMIT = np.iinfo(np.int64).max  # `sweep_pairs`' stop_after that never stops early
 
@@ -126,7 +127,7 @@ def largest_group(rigid, counts):
 
 
 @njit(cache=True, inline="always")
-def sweep_collides(tris, geo, sb, si, tol, big):
+def sweep_collides(tris, geo, sb, si, tol, big, ids, thick):
     """Sort-and-sweep on x over the faces' AABBs in the order si[0] (filled by `gather_boxes`).
 
     A pair is tested (`faces_cross`, the face earlier in the order as a) unless its boxes are
@@ -136,9 +137,16 @@ def sweep_collides(tris, geo, sb, si, tol, big):
     big >= 0: a rigid group of most faces, whose own pairs are not tested: only the other faces
     are swept, forward and backward (big = -1: forward from every face).
     sb rows: lo x, hi x, lo y, hi y, lo z, hi z, running max of hi x; si rows: face, parent,
-    piece, rigid, non-degenerate, scratch.
+    piece, rigid, non-degenerate, scratch. thick (2,): the paper's thickness and the reach of a
+    shared point (`triangles.thick_collides`, which then tests the pairs, with ids (F, 6) the net
+    and mesh vertex ids of every corner); thickness 0: `faces_cross`, ids unread.
     """
     n = tris.shape[0]
+    h = thick[0]
+    if h > tol:
+        tol_box = h  # boxes closer than the thickness are candidates
+    else:
+        tol_box = tol
     for ii in range(n):
         if si[4, ii] == 0 or (big >= 0 and si[3, ii] == big):
             continue  # a degenerate face crosses nothing; big's faces are met from the others
@@ -150,12 +158,12 @@ def sweep_collides(tris, geo, sb, si, tol, big):
         # Branch-free box filters into si[5]: whether boxes overlap in y and z is hard to
         # predict, and a mispredicted branch costs more than all four comparisons.
         end = ii + 1
-        while end < n and not (sb[0, end] - sb[1, ii] > tol):  # later faces overlapping in x
+        while end < n and not (sb[0, end] - sb[1, ii] > tol_box):  # later faces overlapping in x
             end += 1
         k = 0
         for jj in range(ii + 1, end):
-            apart = ((sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
-                     | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol))
+            apart = ((sb[2, jj] - hiy > tol_box) | (loy - sb[3, jj] > tol_box)
+                     | (sb[4, jj] - hiz > tol_box) | (loz - sb[5, jj] > tol_box))
             si[5, k] = jj
             k += 1 - np.int64(apart)
         later = k
@@ -163,9 +171,9 @@ def sweep_collides(tris, geo, sb, si, tol, big):
             # earlier faces of big overlapping in x (the others were swept from themselves); no
             # face before jj reaches past the running maximum of hi x
             jj = ii - 1
-            while jj >= 0 and not (sb[0, ii] - sb[6, jj] > tol):
-                apart = ((sb[0, ii] - sb[1, jj] > tol) | (sb[2, jj] - hiy > tol) | (loy - sb[3, jj] > tol)
-                         | (sb[4, jj] - hiz > tol) | (loz - sb[5, jj] > tol) | (si[3, jj] != big))
+            while jj >= 0 and not (sb[0, ii] - sb[6, jj] > tol_box):
+                apart = ((sb[0, ii] - sb[1, jj] > tol_box) | (sb[2, jj] - hiy > tol_box) | (loy - sb[3, jj] > tol_box)
+                         | (sb[4, jj] - hiz > tol_box) | (loz - sb[5, jj] > tol_box) | (si[3, jj] != big))
                 si[5, k] = jj
                 k += 1 - np.int64(apart)
                 jj -= 1
@@ -183,9 +191,19 @@ def sweep_collides(tris, geo, sb, si, tol, big):
             gu = load_face(geo, j)
             # a: the face earlier in the order (i for the forward sweep, j for the backward one)
             a, b, ga, gb = (t, u, gt, gu) if c < later else (u, t, gu, gt)
-            if faces_cross(a, b, ga, gb, tol):
+            if h > 0.0:
+                fa, fb = (i, j) if c < later else (j, i)
+                if thick_collides(a, b, ga, gb, _ids(ids, fa), _ids(ids, fb), tol, h, thick[1]):
+                    return True
+            elif faces_cross(a, b, ga, gb, tol):
                 return True
     return False
+
+
+@njit(cache=True, inline="always")
+def _ids(ids, f):
+    """Row f of ids (F, 6) as a tuple (no array view: no reference counting in the hot loop)."""
+    return (ids[f, 0], ids[f, 1], ids[f, 2], ids[f, 3], ids[f, 4], ids[f, 5])
 
 
 @njit(cache=True)

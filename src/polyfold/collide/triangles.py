@@ -200,3 +200,167 @@ def load_face(geo, f):
     e = ((geo[f, 0], geo[f, 1], geo[f, 2]), (geo[f, 3], geo[f, 4], geo[f, 5]), (geo[f, 6], geo[f, 7], geo[f, 8]))
     return FaceGeometry(e, (geo[f, 9], geo[f, 10], geo[f, 11]), (geo[f, 12], geo[f, 13], geo[f, 14]), geo[f, 15],
                  geo[f, 19] > 0.0, (geo[f, 16], geo[f, 17], geo[f, 18]), (geo[f, 20], geo[f, 21]), geo[f, 22] > 0.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# Thickness: faces closer than the paper's thickness with overlapping projections collide
+
+
+@njit(cache=True)
+def _apart_on(a, b, n, ref2, gap):
+    """True when axis n (any length) separates triangles a, b by more than gap (unusable axis: False)."""
+    ok, u = _unit(n, ref2)
+    if not ok:
+        return False
+    amin, amax = _span(a, u, a[0])
+    bmin, bmax = _span(b, u, a[0])
+    return bmin - amax > gap or amin - bmax > gap
+
+
+@njit(cache=True)
+def _shallow_on(a, b, n, ref2, gap):
+    """True when on in-plane axis n the projections of a and b overlap by at most gap (they do not
+    reach more than the thickness into each other: side by side, or one resting on the other's edge)."""
+    ok, u = _unit(n, ref2)
+    if not ok:
+        return False
+    amin, amax = _span(a, u, a[0])
+    bmin, bmax = _span(b, u, a[0])
+    return min(amax - bmin, bmax - amin) <= gap
+
+
+@njit(cache=True)
+def faces_near(a, b, ga, gb, gap):
+    """True when triangles a, b come closer than gap with projections overlapping by more than gap:
+    no normal or edge x edge axis separates them by more than gap, and one reaches more than gap
+    into the other seen along the other's normal (on every axis in that plane normal to a side of
+    either, their projections overlap by more than gap). Conservative (a separating-axis bound of the
+    distance), so it may call near what the independent check (`verify.paths`) lets touch."""
+    if ga.uok and _apart_on(a, b, ga.u, 1.0, gap):
+        return False
+    if gb.uok and _apart_on(a, b, gb.u, 1.0, gap):
+        return False
+    for i in range(3):
+        for j in range(3):
+            if _apart_on(a, b, _cross(ga.e[i], gb.e[j]), ga.l[i] * gb.l[j], gap):
+                return False
+    # b reaches more than gap into a, seen along a's normal: the 2D separating-axis test in a's
+    # plane (a's sides and b's sides projected), every axis overlapping by more than gap; and a into b
+    into_a, into_b = True, True
+    for k in range(3):
+        if into_a and (_shallow_on(a, b, _cross(ga.n, ga.e[k]), ga.n2 * ga.l[k], gap)
+                       or _shallow_on(a, b, _cross(ga.n, gb.e[k]), ga.n2 * gb.l[k], gap)):
+            into_a = False
+        if into_b and (_shallow_on(a, b, _cross(gb.n, gb.e[k]), gb.n2 * gb.l[k], gap)
+                       or _shallow_on(a, b, _cross(gb.n, ga.e[k]), gb.n2 * ga.l[k], gap)):
+            into_b = False
+    return into_a or into_b
+
+
+@njit(cache=True)
+def _corners_cut(t, mask, reach):
+    """The corners of triangle t with each corner in mask (bit k: corner k) cut off at reach along
+    its two sides (at most half of each): what is left of a face away from the points it shares,
+    a convex polygon of 3-6 corners in order."""
+    out = []
+    for k in range(3):
+        c = t[k]
+        if not mask & (1 << k):
+            out.append(c)
+            continue
+        for o in (t[(k + 2) % 3], t[(k + 1) % 3]):  # the previous corner's side first: order kept
+            d = (o[0] - c[0], o[1] - c[1], o[2] - c[2])
+            ln = math.sqrt(_dot(d, d))
+            s = 0.0 if ln == 0.0 else min(reach, 0.5 * ln) / ln
+            out.append((c[0] + s * d[0], c[1] + s * d[1], c[2] + s * d[2]))
+    return out
+
+
+@njit(cache=True)
+def _beyond_side(t, mask, reach):
+    """(triangle, scale): the part of triangle t farther than reach from its side whose two corners
+    are in mask (the triangle shrunk towards the third corner by `scale`; scale <= 0: nothing left)."""
+    o = 0 if not mask & 1 else (1 if not mask & 2 else 2)
+    p, q = t[(o + 1) % 3], t[(o + 2) % 3]
+    e = (q[0] - p[0], q[1] - p[1], q[2] - p[2])
+    w = (t[o][0] - p[0], t[o][1] - p[1], t[o][2] - p[2])
+    c = _cross(e, w)
+    le = math.sqrt(_dot(e, e))
+    height = 0.0 if le == 0.0 else math.sqrt(_dot(c, c)) / le
+    s = 0.0 if height == 0.0 else 1.0 - reach / height
+    if s <= 0.0:
+        return t, s
+    v = t[o]
+    return (v, (v[0] + s * (p[0] - v[0]), v[1] + s * (p[1] - v[1]), v[2] + s * (p[2] - v[2])),
+            (v[0] + s * (q[0] - v[0]), v[1] + s * (q[1] - v[1]), v[2] + s * (q[2] - v[2]))), s
+
+
+@njit(cache=True)
+def _wedge_clear(a, ga, b, mb, gap, reach):
+    """True when every part of b within gap of a's plane lies within reach of b's shared corners
+    (mb): b's other corners are beyond gap on one side of the plane and the wedge they leave at
+    the shared corners is short. (A quick answer for faces around a common vertex.)"""
+    if not ga.uok:
+        return False
+    sides, wedge = 0, 0.0
+    for c in range(3):
+        if mb & (1 << c):
+            continue
+        d = ga.u[0] * (b[c][0] - a[0][0]) + ga.u[1] * (b[c][1] - a[0][1]) + ga.u[2] * (b[c][2] - a[0][2])
+        if abs(d) <= gap:
+            return False
+        sides |= 1 if d > 0 else 2
+        for k in range(3):
+            if mb & (1 << k):
+                e = (b[c][0] - b[k][0], b[c][1] - b[k][1], b[c][2] - b[k][2])
+                wedge = max(wedge, math.sqrt(_dot(e, e)) * gap / abs(d))
+    return sides != 3 and wedge + gap <= reach
+
+
+@njit(cache=True)
+def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
+    """The planners' pair test with the paper's thickness (ALGORITHMS.md 6.2, README "Paper
+    thickness"): a, b cross (`faces_cross`), or come closer than thick with overlapping
+    projections (`faces_near`). ids_a, ids_b: per corner (net vertex id x 3, mesh vertex id x 3;
+    -1 unknown). Where they share a point they may touch: corners at a shared net or mesh vertex
+    are cut off at reach first (the rest tested in triangles); faces sharing a mesh edge (a glued
+    seam, closing) lose the strip within reach of it, and once both its copies meet (closed) are
+    only tested for crossing. (The goal itself is tested without thickness: `fold.plan`.)"""
+    if faces_cross(a, b, ga, gb, tol):
+        return True
+    ma, mb, met, edge = 0, 0, 0, 0
+    for i in range(3):
+        for j in range(3):
+            shared = ids_a[i] == ids_b[j]
+            if ids_a[3 + i] >= 0 and ids_a[3 + i] == ids_b[3 + j]:
+                shared = True
+                edge += 1
+                d = (a[i][0] - b[j][0], a[i][1] - b[j][1], a[i][2] - b[j][2])
+                met += 1 if _dot(d, d) <= thick * thick else 0
+            if shared:
+                ma |= 1 << i
+                mb |= 1 << j
+    if met >= 2:
+        return False  # a closed seam: the faces meet along it
+    if ma == 0:
+        return faces_near(a, b, ga, gb, thick)
+    if edge >= 2:  # a mesh edge they share (a seam): what is left beyond reach of it
+        sa, sb = _beyond_side(a, ma, reach), _beyond_side(b, mb, reach)
+        if sa[1] <= 0.0 or sb[1] <= 0.0:
+            return False
+        return faces_near(sa[0], sb[0], face_geometry(sa[0], tol), face_geometry(sb[0], tol), thick)
+    if _wedge_clear(a, ga, b, mb, thick, reach) and _wedge_clear(b, gb, a, ma, thick, reach):
+        return False
+    pa = _corners_cut(a, ma, reach)
+    pb = _corners_cut(b, mb, reach)
+    for i in range(1, len(pa) - 1):
+        ta = (pa[0], pa[i], pa[i + 1])
+        sa = face_geometry(ta, tol)
+        if sa.sliver:
+            continue
+        for j in range(1, len(pb) - 1):
+            tb = (pb[0], pb[j], pb[j + 1])
+            sb = face_geometry(tb, tol)
+            if not sb.sliver and faces_near(ta, tb, sa, sb, thick):
+                return True
+    return False

@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from ..collide.sweep import fill_face_geometry, gather_boxes, largest_group, sort_by_lo_x, sweep_collides
+from ..collide.tolerance import EXEMPT_REACH
 from ..collide.triangles import GEO_SIZE
 from ..deadline import Deadline
 from .kinematics import fold_faces
@@ -33,7 +34,7 @@ if TYPE_CHECKING:
 @njit(cache=True)
 def collision_work(n_faces):
     """Work arrays of `segment_collides` for one tree of n_faces faces, reused across calls:
-    (geo, sb, si, last, R, T, out, meta).
+    (geo, sb, si, last, R, T, out, meta, ids, thick).
 
     geo (F, GEO_SIZE): per-face geometry and AABB; sb (7, F): the AABBs (lo x, hi x, lo y, hi y,
     lo z, hi z) in sweep order and the running maximum of hi x; si (6, F) int: si[0] the sweep
@@ -41,7 +42,9 @@ def collision_work(n_faces):
     per position parent, piece, rigid group, non-degenerate flag, and scratch for the candidates
     of one face; last (F, 2), R, T,
     out: the folded state of the previous call (see `kinematics.fold_faces`); meta (1,): the tol geo was filled
-    with (NaN: geo not of out). The state changes only the cost, never a verdict.
+    with (NaN: geo not of out). The state changes only the cost, never a verdict. ids (F, 6),
+    thick (2,): the corners' net and mesh vertex ids and (thickness, reach) for the thickness test
+    (`collide.sweep.sweep_collides`; thickness 0 here: `with_thickness` sets them).
     """
     si = np.empty((6, n_faces), dtype=np.int64)
     last = np.empty((n_faces, 2))
@@ -50,8 +53,10 @@ def collision_work(n_faces):
         si[0, f] = f
         last[f, 0] = np.nan
     meta[0] = np.nan
+    ids = np.empty((n_faces, 6), dtype=np.int64)
+    ids[:] = -1
     return (np.empty((n_faces, GEO_SIZE)), np.empty((7, n_faces)), si, last,
-            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), meta)
+            np.empty((n_faces, 3, 3)), np.empty((n_faces, 3)), np.empty((n_faces, 3, 3)), meta, ids, np.zeros(2))
 
 
 @njit(cache=True)
@@ -66,7 +71,7 @@ def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, ri
     functions updates the reference count of every array argument, which per configuration
     would cost a tenth of a small net's test.
     """
-    geo, sb, si, last, R, T, out, meta = work
+    geo, sb, si, last, R, T, out, meta, ids, thick = work
     if not (meta[0] == tol):
         last[:, 0] = np.nan  # geo rows of another tol: recompute every face
         meta[0] = tol
@@ -84,7 +89,7 @@ def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, ri
         fill_face_geometry(out, tol, geo, last)
         sort_by_lo_x(geo, sb, si)
         gather_boxes(geo, parent, piece, rigid, sb, si)
-        if sweep_collides(out, geo, sb, si, tol, big):
+        if sweep_collides(out, geo, sb, si, tol, big, ids, thick):
             return True, checked
     return False, checked
 
@@ -179,6 +184,11 @@ class ValidityChecker:
         self.step = resolution
         self.q = np.empty(len(tree.goal))
         self.work = collision_work(len(tree.order))
+        if tree.thickness > 0:
+            ids, thick = self.work[8], self.work[9]
+            ids[:, :3] = tree.faces
+            ids[:, 3:] = tree.mesh_faces
+            thick[0], thick[1] = tree.thickness, EXEMPT_REACH * tree.thickness
         self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
         self.configs = 0
         self.edges = 0

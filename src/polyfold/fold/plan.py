@@ -31,7 +31,7 @@ from ..mesh.geometry import rho_to_fold_deg
 from .checker import ValidityChecker, first_blocked_segment
 from .lazy_prm import plan_lazy_prm
 from .sequential import plan_sequential
-from .tree import FoldTree, colliding_pairs
+from .tree import FoldTree, collides, colliding_pairs
 
 
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
@@ -155,10 +155,12 @@ def plan_fold(
 
 
 def _check_ends(tree: FoldTree, check: ValidityChecker) -> None:
-    """PolyfoldError when the flat net or the folded goal self-intersects: no path can exist."""
+    """PolyfoldError when the flat net (at the tree's thickness) or the folded goal (without:
+    faces meet there) self-intersects: no path can exist."""
     if not check.valid(np.zeros(len(tree.goal))):
         raise PolyfoldError("the flat net overlaps itself: not a valid net")
-    if not check.valid(tree.goal.copy()):
+    # the goal without thickness: there faces meet along glued seams and at mesh vertices by design
+    if collides(tree, tree.goal):
         pairs = colliding_pairs(tree, tree.goal)
         raise PolyfoldError(
             f"the folded goal shape intersects itself (net faces {pairs[0, 0]} and {pairs[0, 1]} cross, "

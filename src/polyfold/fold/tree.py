@@ -12,7 +12,7 @@ net cannot be folded. `fold_positions`, `collides` and `colliding_pairs` fold a 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -49,7 +49,10 @@ class FoldTree:
     axis (F, 2) the parent's corners at the crease ends, a -> b in the parent's CCW order;
     piece (F,); goal (E,) goal angle per edge (rho, radians; 0 for cuts); creases (n,) the tree
     creases (the DOF), ascending; scale = bounding-box diagonal (foldedForm, else flat net);
-    tol = contact tolerance (CONTACT_TOL * scale); folded (V, 3) foldedForm coords or None.
+    tol = contact tolerance (CONTACT_TOL * scale); folded (V, 3) foldedForm coords or None;
+    mesh_faces (F, 3) the mesh vertex of every corner (-1 unknown: faces of a FOLD file without
+    `polyfold:vertices_meshVertex`); thickness: of the material, in the net's units (0: none; see
+    `with_thickness` and the README's "Paper thickness").
     """
 
     flat: np.ndarray
@@ -64,6 +67,14 @@ class FoldTree:
     scale: float
     tol: float
     folded: np.ndarray | None
+    mesh_faces: np.ndarray | None = None
+    thickness: float = 0.0
+
+    def with_thickness(self, thickness: float) -> FoldTree:
+        """The same tree whose collision test counts faces closer than `thickness` (net units)
+        with overlapping projections as colliding."""
+        mesh_faces = self.mesh_faces if self.mesh_faces is not None else np.full_like(self.faces, -1)
+        return replace(self, thickness=float(thickness), mesh_faces=np.ascontiguousarray(mesh_faces, dtype=np.int64))
 
     @property
     def n_faces(self) -> int:
@@ -82,8 +93,9 @@ class FoldTree:
     def from_pattern(cls, pattern: CreasePattern, contact_tol: float = CONTACT_TOL) -> FoldTree:
         """The tree of a crease pattern (`unfold.pattern.crease_pattern`); contact_tol is relative
         to the model's bounding-box diagonal."""
-        return build_tree(pattern.coords, pattern.faces, pattern.edges, _PATTERN_KIND[pattern.kind], pattern.parent,
+        tree = build_tree(pattern.coords, pattern.faces, pattern.edges, _PATTERN_KIND[pattern.kind], pattern.parent,
                           pattern.piece, pattern.fold_deg, pattern.folded, contact_tol)
+        return replace(tree, mesh_faces=np.ascontiguousarray(pattern.mesh_vertex[pattern.faces], dtype=np.int64))
 
     @classmethod
     def from_net(cls, net: Net, contact_tol: float = CONTACT_TOL) -> FoldTree:

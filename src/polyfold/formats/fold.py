@@ -13,6 +13,7 @@ crease, -1 at the root of a piece), `polyfold:edges_meshEdge` (twin cut edges sh
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from dataclasses import dataclass
@@ -235,7 +236,15 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
             stage = 4
     except Exception as exc:  # noqa: BLE001 (raised below, after the checks that come first)
         late = exc
-    return build_tree(xy, faces, edges, kind, parent_in, piece_in, deg, folded, contact_tol, scale, stage, late)
+    tree = build_tree(xy, faces, edges, kind, parent_in, piece_in, deg, folded, contact_tol, scale, stage, late)
+    mesh_vertex = fold.get("polyfold:vertices_meshVertex")
+    if isinstance(mesh_vertex, list) and len(mesh_vertex) == n_v:
+        try:
+            ids = np.asarray(mesh_vertex, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            return tree
+        return dataclasses.replace(tree, mesh_faces=np.ascontiguousarray(ids[faces]))
+    return tree
 
 
 # ----------------------------------------------------------------------------------------------

@@ -84,7 +84,7 @@ class _Planner:
         elif opts.fold:
             self.say("fold", f"part {pi + 1}/{self.n_parts}: planning a path for {pnet.mesh.n_faces} faces")
             tf = time.perf_counter()
-            tree = FoldTree.from_pattern(pattern, opts.contact_tol)
+            tree = FoldTree.from_pattern(pattern, opts.contact_tol).with_thickness(self.thickness)
             note = ""
             if collides(tree, tree.goal):
                 note = "the folded shape itself intersects (input geometry); no path can exist"

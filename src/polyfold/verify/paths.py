@@ -13,14 +13,18 @@ collide when
 
 1. they cross: an edge of one passes through the other's interior (more than `tol` from its plane
    on both sides and from its sides), or
-2. they come closer than the thickness with overlapping projections: the part of one face within
-   max(thickness, tol) of the other's plane, projected onto that plane, overlaps the other face
-   in an area above tol x its longest side (paper lying on paper, whatever the tiny gap).
+2. they come closer than the thickness with overlapping projections (with no thickness: they lie
+   in one plane, within tol, and overlap): the part of one face within
+   w = max(thickness, tol) of the other's plane, projected onto that plane, reaches more than w
+   into the other face, in an area above tol x its longest side (paper lying on paper, whatever
+   the tiny gap; a face resting on the other's edge touches it).
 
 Exempt from 2, where plates meet anyway: the overlap lying entirely within `reach` (default
 EXEMPT_REACH x thickness) of a point the two faces share in the net (they may touch at it) or of
 either copy of a mesh vertex or edge they share on the model (they close onto each other there);
-and at the goal (the last frame) every pair that shares a mesh vertex or edge. Not modelled:
+and every pair that shares a mesh vertex or edge where it is posed as on the model: at the goal
+(the last frame), or earlier when the pair already holds its final pose (their nine corner
+distances those of the foldedForm). Not modelled:
 bending, the thickness at creases (two plates of one crease), glue and tab layers.
 
 `check_fold_path(fold, step_deg, tol_rel, thickness)` samples every segment between consecutive
@@ -269,9 +273,10 @@ def _near_feature(x, feats, nfeat, reach):
 
 
 @njit(cache=True)
-def _slab_overlap(T, f, g, nf, lf, w, feats, nfeat, reach, buf, gshared):
-    """True when the part of face g within w of face f's plane, projected onto it, overlaps f in an
-    area above 1e-9 x longest side squared (and, with features, not all within reach of them).
+def _slab_overlap(T, f, g, nf, lf, w, tol, feats, nfeat, reach, buf, gshared):
+    """True when the part of face g within w of face f's plane, projected onto it, overlaps f shrunk
+    by w (a face resting on f's edge touches it) in an area above tol x f's longest side and,
+    with features, not all within reach of them.
     buf (6, 8) scratch; gshared: bit k set when g's corner k is a point they share (a quick
     rejection: g's other corners beyond w on one side leave only a wedge at those points)."""
     o = _corner(T, f, 0)
@@ -291,7 +296,7 @@ def _slab_overlap(T, f, g, nf, lf, w, feats, nfeat, reach, buf, gshared):
                     ln = math.sqrt(_dot(e, e)) * w / abs(d)
                     wedge = max(wedge, ln)
                     area *= ln
-        if ok and sides != 3 and (wedge + w <= reach or 0.5 * area <= 1e-9 * lf * lf):
+        if ok and sides != 3 and (wedge + w <= reach or 0.5 * area <= tol * lf):
             return False
     px, py, pz, qx, qy, qz = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5]
     for k in range(3):
@@ -303,20 +308,20 @@ def _slab_overlap(T, f, g, nf, lf, w, feats, nfeat, reach, buf, gshared):
     for k in range(n):  # onto f's plane
         d = nf[0] * (px[k] - o[0]) + nf[1] * (py[k] - o[1]) + nf[2] * (pz[k] - o[2])
         px[k], py[k], pz[k] = px[k] - d * nf[0], py[k] - d * nf[1], pz[k] - d * nf[2]
-    for k in range(3):  # inside f: behind each side's outward half-plane
+    for k in range(3):  # inside f, deeper than w: resting on its edge is touching
         a, b = _corner(T, f, k), _corner(T, f, (k + 1) % 3)
         out = _crs(_sub(b, a), nf)
         lo = math.sqrt(_dot(out, out))
         if lo == 0.0:
             return False
-        n = _clip(px, py, pz, qx, qy, qz, n, (out[0] / lo, out[1] / lo, out[2] / lo), a, 0.0, 1.0)
+        n = _clip(px, py, pz, qx, qy, qz, n, (out[0] / lo, out[1] / lo, out[2] / lo), a, -w, 1.0)
         if n < 3:
             return False
     area = 0.0
     for k in range(1, n - 1):
         c = _crs((px[k] - px[0], py[k] - py[0], pz[k] - pz[0]), (px[k + 1] - px[0], py[k + 1] - py[0], pz[k + 1] - pz[0]))
         area += 0.5 * math.sqrt(_dot(c, c))
-    if not (area > 1e-9 * lf * lf):
+    if not (area > tol * lf):
         return False
     if nfeat == 0:
         return True
@@ -372,9 +377,24 @@ def _shared(faces, mesh_faces, T, i, j, feats):
 
 
 @njit(cache=True)
-def _pair_collides(T, nrm, lng, faces, mesh_faces, i, j, tol, thick, reach, goal, feats, buf):
+def _goal_pose(T, G, i, j, tol):
+    """True when faces i and j are posed relative to each other as at the goal G (F, 3, 3): their
+    nine corner-to-corner distances those of G within tol (G empty: never)."""
+    if G.shape[0] == 0:
+        return False
+    for a in range(3):
+        for b in range(3):
+            d = _sub(_corner(T, i, a), _corner(T, j, b))
+            e = _sub(_corner(G, i, a), _corner(G, j, b))
+            if abs(math.sqrt(_dot(d, d)) - math.sqrt(_dot(e, e))) > tol:
+                return False
+    return True
+
+
+@njit(cache=True)
+def _pair_collides(T, G, nrm, lng, faces, mesh_faces, i, j, tol, thick, reach, goal, feats, buf):
     """The pair test of the module docstring for faces i, j of one piece, both solid (`_frame`;
-    nrm, lng: their unit normals and longest sides)."""
+    nrm, lng: their unit normals and longest sides; G: the faces at the goal, or empty)."""
     ni = (nrm[i, 0], nrm[i, 1], nrm[i, 2])
     nj = (nrm[j, 0], nrm[j, 1], nrm[j, 2])
     li, lj = lng[i], lng[j]
@@ -383,16 +403,29 @@ def _pair_collides(T, nrm, lng, faces, mesh_faces, i, j, tol, thick, reach, goal
         return False  # the two faces of a crease
     if _pierces(T, i, j, ni, tol) or _pierces(T, j, i, nj, tol):
         return True
-    if goal and mesh > 0:
-        return False  # they close onto each other at the goal
+    if mesh > 0 and (goal or _goal_pose(T, G, i, j, tol)):
+        return False  # posed as on the model, where they meet (at the goal, or held so since)
+    if thick <= 0.0:  # no thickness: only paper lying on paper (coplanar within tol) beyond crossing
+        if not (_within(T, j, i, ni, tol) or _within(T, i, j, nj, tol)):
+            return False
     w = max(thick, tol)
     r = max(reach, tol)
-    return (_slab_overlap(T, i, j, ni, li, w, feats, nfeat, r, buf, mj)
-            or _slab_overlap(T, j, i, nj, lj, w, feats, nfeat, r, buf, mi))
+    return (_slab_overlap(T, i, j, ni, li, w, tol, feats, nfeat, r, buf, mj)
+            or _slab_overlap(T, j, i, nj, lj, w, tol, feats, nfeat, r, buf, mi))
 
 
 @njit(cache=True)
-def _first_pair(T, piece, faces, mesh_faces, tol, thick, reach, goal):
+def _within(T, g, f, nf, tol):
+    """True when every corner of face g lies within tol of face f's plane."""
+    o = _corner(T, f, 0)
+    for k in range(3):
+        if abs(_dot(nf, _sub(_corner(T, g, k), o))) > tol:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, goal):
     """The first colliding pair (i, j) of folded faces T (F, 3, 3) by a sweep on z, or (-1, -1)."""
     n = T.shape[0]
     lo = np.empty((n, 3))
@@ -422,13 +455,13 @@ def _first_pair(T, piece, faces, mesh_faces, tol, thick, reach, goal):
                 continue
             if lo[j, 0] > hi[i, 0] + m or lo[i, 0] > hi[j, 0] + m or lo[j, 1] > hi[i, 1] + m or lo[i, 1] > hi[j, 1] + m:
                 continue
-            if _pair_collides(T, nrm, lng, faces, mesh_faces, i, j, tol, thick, reach, goal, feats, buf):
+            if _pair_collides(T, G, nrm, lng, faces, mesh_faces, i, j, tol, thick, reach, goal, feats, buf):
                 return min(i, j), max(i, j)
     return -1, -1
 
 
 @njit(cache=True)
-def _segment(qa, qb, m, k0, last, order, parent, edge, hinge, flat, piece, faces, mesh_faces, tol, thick, reach):
+def _segment(qa, qb, m, k0, last, order, parent, edge, hinge, flat, G, piece, faces, mesh_faces, tol, thick, reach):
     """Samples k0..m of qa -> qb (t = k / m): (first colliding k or -1, i, j, samples checked).
     last: the segment ends at the goal (its t = 1 gets the goal's exemption)."""
     q = np.empty(qa.shape[0])
@@ -440,10 +473,19 @@ def _segment(qa, qb, m, k0, last, order, parent, edge, hinge, flat, piece, faces
             q[e] = qa[e] + t * (qb[e] - qa[e]) if k < m else qb[e]
         _fold(q, order, parent, edge, hinge, flat, T)
         checked += 1
-        i, j = _first_pair(T, piece, faces, mesh_faces, tol, thick, reach, last and k == m)
+        i, j = _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, last and k == m)
         if i >= 0:
             return k, i, j, checked
     return -1, -1, -1, checked
+
+
+def faces_collide(a: np.ndarray, b: np.ndarray, tol: float, thickness: float = 0.0) -> bool:
+    """The pair test for two faces a, b (3, 3) that share nothing (no crease, no point)."""
+    T = np.stack([np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)])
+    faces = np.array([[0, 1, 2], [3, 4, 5]], dtype=np.int64)
+    i, _ = _first_pair(T, np.empty((0, 3, 3)), np.zeros(2, dtype=np.int64), faces, np.full((2, 3), -1, dtype=np.int64), float(tol),
+                       float(thickness), EXEMPT_REACH * float(thickness), False)
+    return bool(i >= 0)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -503,7 +545,8 @@ def check_fold_path(fold: dict, step_deg: float | None = None, tol_rel: float | 
     mesh_vertex = fold.get("polyfold:vertices_meshVertex")
     mesh_faces = (np.asarray(mesh_vertex, dtype=np.int64)[faces] if mesh_vertex is not None
                   else np.full_like(faces, -1))
-    args = (tree.order, tree.parent, tree.edge, tree.hinge, tree.flat, tree.piece, faces, mesh_faces, tol, thick, r)
+    G = np.ascontiguousarray(folded[faces]) if folded is not None else np.empty((0, 3, 3))
+    args = (tree.order, tree.parent, tree.edge, tree.hinge, tree.flat, G, tree.piece, faces, mesh_faces, tol, thick, r)
     if folded is not None:
         err = _goal_error(frames[-1], tree, faces, folded)
         if err > 1e-6 * max(scale, 1e-300):

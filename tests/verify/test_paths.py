@@ -1,0 +1,162 @@
+"""verify/paths.py, the independent re-check of written folding paths: its physical model on
+hand-made strips (paper sliding on paper collides at any tiny gap, a crease folded flat does
+not, a glued seam closing at the goal does not), agreement with tests/path_checker.py on real
+paths, paths it must reject, and its independence from the planners' code."""
+
+from __future__ import annotations
+
+import ast
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from path_checker import check_path
+from polyfold.fold.plan import plan_fold
+from polyfold.fold.tree import FoldTree
+from polyfold.formats.fold import pattern_fold, with_path
+from polyfold.formats.meshes import load_mesh
+from polyfold.unfold.pattern import crease_pattern
+from polyfold.unfold.search import unfold
+from polyfold.verify.paths import check_fold_path, faces_collide
+
+SRC = Path(__file__).resolve().parents[2] / "src" / "polyfold"
+
+
+def _strip(frames_deg: list[list[float]], mesh_vertex: list[int] | None = None) -> dict:
+    """Three unit right triangles in a row, A = (0, 1, 2), B = (1, 3, 2), C = (2, 3, 4): creases
+    A-B (edge 1) and B-C (edge 3); A and C share only net vertex 2."""
+    coords = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.0, 2.0]]
+    faces = [[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+    edges = [[0, 1], [1, 2], [2, 0], [1, 3], [3, 2], [3, 4], [4, 2]]
+    assignment = ["B", "V", "B", "B", "V", "B", "B"]
+    fold = {"vertices_coords": coords, "faces_vertices": faces, "edges_vertices": edges,
+            "edges_assignment": assignment, "edges_foldAngle": frames_deg[-1], "polyfold:path": frames_deg}
+    if mesh_vertex is not None:
+        fold["polyfold:vertices_meshVertex"] = mesh_vertex
+    return fold
+
+
+def _frames(*angles: tuple[float, float]) -> list[list[float]]:
+    """Frames of the strip from (A-B angle, B-C angle) pairs, FOLD degrees."""
+    return [[0.0, a, 0.0, 0.0, b, 0.0, 0.0] for a, b in angles]
+
+
+def test_two_faces_sliding_on_each_other_collide_whatever_the_gap():
+    a = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    for gap in (1e-6, 1e-4):
+        b = a + [0.3, 0.3, gap]  # nearly coplanar, overlapping in projection
+        assert not faces_collide(a, b, tol=1e-7)  # a zero-thickness test lets them pass
+        assert faces_collide(a, b, tol=1e-7, thickness=1e-3)
+        assert faces_collide(a, b, tol=1e-7, thickness=0.0) is False
+    side = a + [1.2, 0.0, 1e-6]  # side by side: closer than the thickness, no overlap
+    assert not faces_collide(a, side, tol=1e-7, thickness=1e-3)
+    tilted = np.array([[0.2, 0.2, 1e-4], [0.8, 0.2, 0.3], [0.2, 0.6, 0.5]])  # near at one corner only
+    assert faces_collide(a, tilted, tol=1e-7, thickness=1e-3) and not faces_collide(a, tilted, tol=1e-7)
+
+
+def test_paper_folding_onto_paper_collides_at_any_thickness():
+    # B folds onto A, then C (hinged on B) back down onto A: a three-layer stack, C ends 2e-6 rad
+    # from A's plane over it (a zero-thickness test with a contact tolerance lets that pass)
+    almost = 180.0 - 1e-4
+    fold = _strip(_frames((0.0, 0.0), (almost, 0.0), (almost, -almost)))
+    thin = check_fold_path(fold, thickness=0.0)
+    assert thin.ok, thin.why()  # apart by more than the tolerance: no crossing
+    assert check_path(fold).first_collision is None  # the tests' checker agrees at that tolerance ...
+    assert check_path(fold, tol_rel=1e-5).first_collision is not None  # ... and sees it within 1e-5
+    thick = check_fold_path(fold, thickness=1e-3)
+    assert not thick.ok and thick.first_collision is not None
+    seg, t, i, j = thick.first_collision
+    assert (seg, {i, j}) == (1, {0, 2}) and 0 < t <= 1
+    # the other way round C folds through A: a crossing at any thickness, where both checkers see it
+    through = _strip(_frames((0.0, 0.0), (almost, 0.0), (almost, almost)))
+    hit = check_fold_path(through).first_collision
+    assert hit is not None and hit[:2] == check_path(through).first_collision[:2]
+
+
+def test_a_crease_folded_flat_is_no_collision():
+    fold = _strip(_frames((0.0, 0.0), (180.0, 0.0)))
+    check = check_fold_path(fold, thickness=0.01)
+    assert check.ok, check.why()
+    assert check.configs == 1 + 180  # the flat frame, then every degree
+
+
+def test_faces_sharing_a_net_vertex_may_touch_at_it():
+    # A and C fold towards each other about the shared corner 2, stopping apart
+    fold = _strip(_frames((0.0, 0.0), (60.0, -60.0)))
+    assert check_fold_path(fold, thickness=0.01).ok
+
+
+def test_glued_seams_closing_at_the_goal_are_no_collision(models_dir):
+    """star-24's spikes close along seams whose faces are a few degrees apart (well within 1 % of
+    its size of each other near the seam): the planner's path at that thickness is accepted, and
+    only because the seams are known as seams (without the mesh vertices the closing spikes are
+    paper on paper)."""
+    mesh = load_mesh(models_dir / "star-24.obj").mesh
+    net, _ = unfold(mesh, seed=1, time_limit=10)
+    pattern = crease_pattern([net])
+    tree = FoldTree.from_pattern(pattern)
+    thickness = 0.01 * tree.scale
+    path = plan_fold(tree.with_thickness(thickness), time_limit=20, seed=1)
+    assert path is not None
+    fold = with_path(pattern_fold(pattern), path, 1.0, 1e-7, thickness)
+    check = check_fold_path(fold, thickness=thickness)
+    assert check.ok, check.why()
+    assert check_path(fold).ok  # and at no thickness by the tests' checker
+    del fold["polyfold:vertices_meshVertex"]
+    assert not check_fold_path(fold, thickness=thickness).ok
+
+
+def test_rejects_what_is_not_the_written_goal_or_folds_a_cut():
+    fold = _strip(_frames((0.0, 0.0), (90.0, 0.0)))
+    fold["edges_foldAngle"] = [0.0, 91.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    assert "goal" in check_fold_path(fold).why()
+    fold = _strip(_frames((0.0, 0.0), (90.0, 0.0)))
+    fold["polyfold:path"][1][0] = 5.0  # a cut edge
+    assert "cut" in check_fold_path(_strip(fold["polyfold:path"])).why()
+    fold = _strip(_frames((0.0, 0.0), (90.0, 0.0)))
+    fold["polyfold:path"][0][1] = 3.0
+    assert "flat" in check_fold_path(fold).why()
+
+
+def test_agrees_with_the_tests_checker_on_a_colliding_straight_line(lazy_case):
+    """The l-prism net whose straight fold collides: both checkers find the collision on the
+    straight line, and both accept the Lazy PRM's path around it."""
+    _, _, fold, _, path = lazy_case
+    straight = dict(fold, **{"polyfold:path": [[0.0] * len(fold["edges_foldAngle"]), list(fold["edges_foldAngle"])]})
+    mine = check_fold_path(straight, step_deg=0.5)
+    theirs = check_path(straight, step_deg=0.5)
+    assert not mine.ok and theirs.first_collision is not None
+    written = with_path(fold, path, 1.0, 1e-7)
+    assert check_fold_path(written).ok and check_path(written).ok
+
+
+def test_make_pieces_are_verified_as_written(tmp_path, models_dir):
+    """Every piece make calls verified says so in its FOLD file, at the thickness it states, and
+    both the package's check and the tests' checker accept the file as written (mm)."""
+    from polyfold.pipeline.make import make
+    from polyfold.pipeline.options import MakeOptions
+
+    rep = make(models_dir / "bunny-128.obj", tmp_path, MakeOptions(thickness=0.3)).report
+    assert rep.stages.fold.thickness_mm == 0.3 and rep.checks.paths_verified == len(rep.pieces)
+    for f in sorted(tmp_path.glob("piece-*.fold")):
+        fold = json.loads(f.read_text())
+        assert fold["polyfold:path_verified"] is True
+        folded = np.asarray(fold["file_frames"][0]["vertices_coords"])
+        diag = float(np.linalg.norm(folded.max(axis=0) - folded.min(axis=0)))
+        assert fold["polyfold:path_thicknessRel"] * diag == pytest.approx(0.3)
+        check = check_fold_path(fold, thickness=0.3)
+        assert check.ok, f"{f.name}: {check.why()}"
+        assert check_path(fold).ok, f.name
+
+
+def test_shares_no_code_with_the_planners():
+    """verify/ imports nothing of polyfold (its own kinematics and triangle tests)."""
+    for path in (SRC / "verify").glob("*.py"):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                assert node.level == 0 and not (node.module or "").startswith("polyfold"), (path.name, node.module)
+            if isinstance(node, ast.Import):
+                assert not any(a.name.startswith("polyfold") for a in node.names), path.name
