@@ -160,3 +160,24 @@ def test_shares_no_code_with_the_planners():
                 assert node.level == 0 and not (node.module or "").startswith("polyfold"), (path.name, node.module)
             if isinstance(node, ast.Import):
                 assert not any(a.name.startswith("polyfold") for a in node.names), path.name
+
+
+def test_periscope2_seed_1_gets_a_path_both_checkers_accept(models_dir):
+    """`polyfold unfold periscope2-44.obj --fold --seed 1` (issue 19: a path of it once slid the two
+    halves of a flat quad across each other 1e-6 apart): its path now passes the independent
+    check at the default thickness, the tests' checker, and the tests' checker with a contact
+    tolerance of 1e-5 (paper on paper within 1e-5 of the model size would show there)."""
+    from polyfold.deadline import Deadline
+    from polyfold.pipeline.nets import NetsOptions, unfold_nets
+
+    loaded = load_mesh(models_dir / "periscope2-44.obj")
+    result = unfold_nets(loaded, "periscope2-44", NetsOptions(fold=True, seed=1), Deadline.after(60))
+    fold = result.fold
+    assert result.path_error is None and fold["polyfold:path_verified"] is True
+    folded = np.asarray(fold["file_frames"][0]["vertices_coords"])
+    diag = float(np.linalg.norm(folded.max(axis=0) - folded.min(axis=0)))
+    assert fold["polyfold:path_thicknessRel"] == pytest.approx(1e-3)
+    check = check_fold_path(fold, thickness=1e-3 * diag)
+    assert check.ok, check.why()
+    assert check_path(fold).ok
+    assert check_path(fold, tol_rel=1e-5).first_collision is None

@@ -128,6 +128,35 @@ class _Planner:
             self.plan(pi, faces, sub, fids[sub_fids], depth + 1)
 
 
+def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: float, time_limit: float, seed: int,
+                 contact_tol: float, thickness_rel: float) -> tuple[dict, FoldPath | None, str | None]:
+    """`polyfold fold` and `unfold --fold`: plan a path for the FOLD net `fold` (its `tree`) at the
+    material thickness (thickness_rel x the model size), then check it as written with the
+    independent checker (`verify.paths`); a rejected path is planned once more at half the
+    resolution. Returns (the FOLD dict with the path and polyfold:path_verified, the path, None)
+    or (fold, None, why there is none). Raises PolyfoldError when no path can exist."""
+    from ..verify.paths import check_fold_path
+
+    t0 = time.perf_counter()
+    thickness = thickness_rel * tree.scale
+    tree = tree.with_thickness(thickness)
+    resolution, why = resolution_deg, None
+    for attempt in range(2):
+        left = time_limit - (time.perf_counter() - t0)
+        if attempt and left <= 0:
+            break
+        path = plan_fold(tree, planner=planner, resolution_deg=resolution, time_limit=max(left, 0.5), seed=seed)
+        if path is None:
+            return fold, None, why or f"no folding path found in {time_limit:g} s with planner {planner}"
+        written = with_path(fold, path, resolution_deg, contact_tol, thickness)
+        check = check_fold_path(written, thickness=thickness)
+        if check.ok:
+            return dict(written, **{"polyfold:path_verified": True}), path, None
+        why = f"the planned path failed the independent check ({check.why()})"
+        resolution /= 2
+    return fold, None, why
+
+
 def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, thickness: float):
     """The independent check (`verify.paths.check_fold_path`) of a piece's path as its FOLD file
     holds it (degrees, the goal frame as written), at `thickness` model units."""

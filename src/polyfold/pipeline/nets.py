@@ -7,16 +7,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from ..collide.tolerance import CONTACT_TOL
+from ..collide.tolerance import CONTACT_TOL, THICKNESS_REL
 from ..deadline import Deadline
 from ..errors import PolyfoldError
-from ..fold.plan import FoldPath, is_linearly_foldable, plan_fold
+from ..fold.plan import FoldPath, is_linearly_foldable
 from ..fold.tree import FoldTree, collides
-from ..formats.fold import pattern_fold, with_path
+from ..formats.fold import pattern_fold
 from ..mesh.repair import LoadedMesh
 from ..unfold.net import Net
 from ..unfold.pattern import CreasePattern, crease_pattern
 from ..unfold.search import UnfoldStats
+from .folding import plan_checked
 from .parts import unfold_components
 
 
@@ -32,6 +33,7 @@ class NetsOptions:
     planner: str = "auto"
     resolution_deg: float = 1.0
     contact_tol: float = CONTACT_TOL
+    thickness: float = THICKNESS_REL  # with --fold: of the material, relative to the model size
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,14 +81,12 @@ def unfold_nets(loaded: LoadedMesh, title: str, opts: NetsOptions, deadline: Dea
     path, error, linear = None, None, None
     if opts.fold:
         try:
-            path = plan_fold(FoldTree.from_pattern(pattern, opts.contact_tol), planner=opts.planner,
-                             resolution_deg=opts.resolution_deg, time_limit=max(1.0, deadline.left()), seed=opts.seed)
+            fold, path, error = plan_checked(
+                fold, FoldTree.from_pattern(pattern, opts.contact_tol), planner=opts.planner,
+                resolution_deg=opts.resolution_deg, time_limit=max(1.0, deadline.left()), seed=opts.seed,
+                contact_tol=opts.contact_tol, thickness_rel=opts.thickness)
         except PolyfoldError as exc:  # e.g. the goal shape itself intersects: the flat net is still valid
             error = str(exc)
-        if path is None and error is None:
-            error = "no folding path found within the time limit"
-        if path is not None:
-            fold = with_path(fold, path, opts.resolution_deg, opts.contact_tol)
     if opts.prefer_linear:
         linear = is_linearly_foldable(FoldTree.from_pattern(pattern, opts.contact_tol), opts.resolution_deg)
     return NetsResult(nets, tuple(st for _, st in found), pattern, fold, path, error, linear)

@@ -32,7 +32,7 @@ def make(
     fold: bool = options.FOLD,
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
-    thickness: float = options.THICKNESS_MM,
+    thickness: float = options.THICKNESS_MM_OPTION,
     min_label_mm: float = options.MIN_LABEL,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
@@ -167,6 +167,7 @@ def batch(
     fold: bool = options.FOLD,
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
+    thickness: float = options.THICKNESS_MM_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress and no table: only the summary line and errors."),
 ) -> None:
     """Make (or study) every mesh matching GLOB, each in its own process, locally or on Dask.
@@ -178,7 +179,7 @@ def batch(
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks)
+                                    marks=marks, thickness=thickness)
     if study is not None and study not in ("cspace", "unfold"):
         fail(f"--study must be 'cspace' or 'unfold', not {study!r}", 2)
     from ..batch import run_batch

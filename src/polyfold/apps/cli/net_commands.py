@@ -12,6 +12,7 @@ from typing import Optional
 import typer
 
 from .app import app, fail, guard, load, say
+from . import options
 from .options import Planner, contact_tol_option
 
 
@@ -52,6 +53,7 @@ def unfold(
     planner: Planner = typer.Option(Planner.auto, "--planner", help="With --fold: folding planner."),
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="With --fold: collision-check step along path segments, degrees."),
     contact_tol: float = contact_tol_option(),
+    thickness: float = options.THICKNESS_REL_OPTION,
 ) -> None:
     """Unfold a mesh into overlap-free nets: one piece per component when one is found in time."""
     if max_pieces not in ("auto", "1"):
@@ -66,7 +68,7 @@ def unfold(
     loaded = load(mesh, quiet)
     opts = NetsOptions(method=method.value, seed=seed, max_pieces=1 if max_pieces == "1" else None, fold=fold,
                        prefer_linear=prefer_linear, planner=planner.value, resolution_deg=resolution_deg,
-                       contact_tol=contact_tol)
+                       contact_tol=contact_tol, thickness=thickness)
     show = not quiet and sys.stderr.isatty()
     n = len(loaded.components)
 
@@ -133,22 +135,27 @@ def fold_cmd(
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
     seed: int = typer.Option(1, "--seed", help="Random seed of the sampling planner."),
     contact_tol: float = contact_tol_option(),
+    thickness: float = options.THICKNESS_REL_OPTION,
 ) -> None:
-    """Plan a continuous, collision-free folding path from the flat net to the folded shape."""
+    """Plan a continuous, collision-free folding path from the flat net to the folded shape, at the
+    material's thickness, and check it again with an independent checker before writing it."""
     from ...errors import NoNetFound
-    from ...fold.plan import plan_fold
-    from ...formats.fold import fold_tree, read_fold, with_path, write_fold
+    from ...formats.fold import fold_tree, read_fold, write_fold
+    from ...pipeline.folding import plan_checked
 
     fold = read_fold(net)
     tree = fold_tree(fold, contact_tol)
-    path = plan_fold(tree, planner=planner.value, resolution_deg=resolution_deg, time_limit=time_limit, seed=seed)
+    written, path, why = plan_checked(fold, tree, planner=planner.value, resolution_deg=resolution_deg,
+                                      time_limit=time_limit, seed=seed, contact_tol=contact_tol,
+                                      thickness_rel=thickness)
     if path is None:
-        raise NoNetFound(f"{net.name}: no folding path found in {time_limit:g} s with planner {planner.value} "
-                         f"({len(tree.creases)} DOF); the flat net itself is still valid")
-    write_fold(output, with_path(fold, path, resolution_deg, contact_tol))
+        raise NoNetFound(f"{net.name}: {why} ({len(tree.creases)} DOF, thickness {thickness:g} of the model size); "
+                         "the flat net itself is still valid")
+    write_fold(output, written)
     say(f"{net.name}: {len(tree.creases)} DOF, {'linearly foldable' if path.linear else 'not linearly foldable'}, "
          f"path {len(path.frames)} frames, {path.seconds:.2f} s, planner {path.planner}, "
-         f"{path.edges_checked} segments / {path.configs_checked} configurations checked")
+         f"{path.edges_checked} segments / {path.configs_checked} configurations checked, "
+         f"verified by the independent check at thickness {thickness:g} of the model size")
 
 
 @app.command()

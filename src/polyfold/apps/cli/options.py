@@ -41,10 +41,10 @@ MARKS = typer.Option(_D.marks, "--marks/--no-marks",
                      help="Print-and-cut registration marks (Silhouette Studio 'Type 1', 10 mm inset) on the printed "
                           "pages; pieces keep out of the marked corners.")
 CONTACT_TOL_OPTION = contact_tol_option()
-THICKNESS_MM = typer.Option(_D.thickness, "--thickness", min=0.0, max=5.0,
-                            help="Paper thickness, mm: faces closer than this with overlapping projections collide (every path is re-checked at it).")
-THICKNESS_REL = typer.Option(THICKNESS_REL, "--thickness", min=0.0, max=0.1,
-                             help="Material thickness as a fraction of the model size (bounding-box diagonal): faces closer than this with overlapping projections collide.")
+THICKNESS_MM_OPTION = typer.Option(_D.thickness, "--thickness", min=0.0, max=5.0,
+                                   help="Paper thickness, mm: faces closer than this with overlapping projections collide (every path is re-checked at it).")
+THICKNESS_REL_OPTION = typer.Option(THICKNESS_REL, "--thickness", min=0.0, max=0.1,
+                                    help="Material thickness as a fraction of the model size (bounding-box diagonal): faces closer than this with overlapping projections collide.")
 MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
                          help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
