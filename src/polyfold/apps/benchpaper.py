@@ -10,7 +10,9 @@ Every time is wall-clock seconds in this process with the numba kernels already 
 "path" is a collision-free folding path found by `fold.plan.plan_fold` ("auto": straight line first =
 LC, then the sequential planner, then Lazy PRM); whole meshes are also run with the paper's own
 planner (straight line, then Lazy PRM) on a few seeds. A run without a path within the time limit
-counts the time limit as its path time and is marked.
+counts the time limit as its path time and is marked. Paths are planned at the default material
+thickness of `polyfold fold` (THICKNESS_REL of the model size; README "Paper thickness"); Fig. 5
+samples without thickness, as the paper.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..collide.tolerance import CONTACT_TOL
+from ..collide.tolerance import CONTACT_TOL, THICKNESS_REL
 
 # ALGORITHMS.md 8.1: (DOF, LC, finding net s, path planning s) per horse patch
 PAPER_TABLE1 = [(17, True, 0.00, 0.01), (17, True, 0.00, 0.02), (21, False, 0.00, 2.69), (42, False, 0.56, 1.39),
@@ -41,6 +43,9 @@ PAPER_TABLE2 = {
 # fish-472 folds into a shape that intersects itself by ~2.4e-4 of its size (MODELS.md): at the
 # default contact tolerance no path can exist, so the fish rows use the paper's thickness scale.
 CONTACT = {"fish-472": 1e-3, "fish-472 inflated": 1e-3}
+# ... and since its folded shape is closer to itself than any material thickness, those rows fold
+# without thickness; every other row plans at fold's default (THICKNESS_REL of the model size)
+THICKNESS = {"fish-472": 0.0, "fish-472 inflated": 0.0}
 STRATEGIES = ("discrete", "continuous", "continuous-full")
 STRATEGY_STYLE = {"discrete": ("o", "tab:red"), "continuous": ("^", "tab:blue"), "continuous-full": ("s", "tab:green")}
 FIG3_PAPER = {
@@ -68,10 +73,13 @@ def quick_settings() -> BenchSettings:
 PAPER_PLANNER_RUNS = 5  # whole meshes with the paper's planner: it mostly runs into the time limit
 
 
-def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner: str = "auto") -> dict:
+def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner: str = "auto",
+                 thickness: float = THICKNESS_REL) -> dict:
     """Unfold `mesh` (one component) and plan a folding path for the net; seconds and facts.
 
     planner: a `plan_fold` planner, or "paper": the straight line, then Lazy PRM for the time left.
+    thickness: of the material, relative to the model size (default: fold's; the paper's model
+    has none, Fig. 5 samples without).
     """
     from ..errors import PolyfoldError
     from ..fold.plan import plan_fold
@@ -82,6 +90,7 @@ def net_and_path(mesh, seed: int, time_limit: float, contact_tol: float, planner
     net, st = unfold(mesh, seed=seed, time_limit=time_limit)
     t1 = time.perf_counter()
     tree = FoldTree.from_net(net, contact_tol)
+    tree = tree.with_thickness(thickness * tree.scale)
     row = {"dof": int(len(tree.creases)), "pieces": int(net.n_pieces), "net_s": t1 - t0, "path": False,
            "lc": None, "path_s": float(time_limit), "note": "", "tree": tree, "planner": None}
     if net.n_pieces > 1:
@@ -119,21 +128,22 @@ def _planner_counts(rows: list[dict], counts: dict[str, int] | None = None) -> d
     return counts
 
 
-def _whole_row(mesh, seeds, time_limit: float, tol: float, planner: str) -> dict:
+def _whole_row(mesh, seeds, time_limit: float, tol: float, planner: str, thickness: float) -> dict:
     """Runs of one whole mesh: seconds per run, paths found, LC count, planners that found them."""
-    rows = [net_and_path(mesh, seed, time_limit, tol, planner) for seed in seeds]
+    rows = [net_and_path(mesh, seed, time_limit, tol, planner, thickness) for seed in seeds]
     return {"dof": rows[0]["dof"], "net_s": [r["net_s"] for r in rows], "path_s": [r["path_s"] for r in rows],
             "runs": len(rows), "paths": sum(r["path"] for r in rows), "lc": sum(bool(r["lc"]) for r in rows),
             "planners": _planner_counts(rows), "notes": sorted({r["note"] for r in rows if r["note"]}), "rows": rows}
 
 
-def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: list[float] | None = None) -> dict:
+def _parts_row(parts: list, runs: int, time_limit: float, tol: float, seg_s: list[float] | None,
+               thickness: float) -> dict:
     """Runs over a list of part meshes: per run the sums of net and path seconds."""
     per_run, dofs, ok = [], [], True
     trees = []
     planners: dict[str, int] = {}
     for seed in range(1, runs + 1):
-        rows = [net_and_path(p, seed, time_limit, tol) for p in parts]
+        rows = [net_and_path(p, seed, time_limit, tol, thickness=thickness) for p in parts]
         net_s = sum(r["net_s"] for r in rows)
         path_s = sum(r["path_s"] for r in rows)
         ok &= all(r["path"] for r in rows)
@@ -191,6 +201,7 @@ def table2(models: Path, st: BenchSettings, say) -> tuple[dict, list]:
     fish_labels = None
     for name, paper in PAPER_TABLE2.items():
         tol = CONTACT.get(name, CONTACT_TOL)
+        thick = THICKNESS.get(name, THICKNESS_REL)
         k = paper["parts"][0]
         if name == "fish-472 inflated":
             say(f"table 2: {name} (constrained inflation, the fish's own parts)")
@@ -217,16 +228,16 @@ def table2(models: Path, st: BenchSettings, say) -> tuple[dict, list]:
             extra = {"tau": seg.tau}
         whole = None
         if paper["whole"] is not None:
-            whole = _whole_row(mesh, range(1, st.runs + 1), st.time_limit, tol, "auto")
+            whole = _whole_row(mesh, range(1, st.runs + 1), st.time_limit, tol, "auto", thick)
             say(f"table 2: {name} whole, the paper's planner")
             whole["paper_planner"] = _whole_row(mesh, range(1, min(st.runs, PAPER_PLANNER_RUNS) + 1),
-                                                st.time_limit, tol, "paper")
+                                                st.time_limit, tol, "paper", thick)
             rows = whole.pop("rows")
             whole["paper_planner"].pop("rows")
             fig5_trees.append((name, "whole", rows[0]["tree"]))
-        pr = _parts_row(parts, st.runs, st.time_limit, tol, seg_s)
+        pr = _parts_row(parts, st.runs, st.time_limit, tol, seg_s, thick)
         fig5_trees += [(name, "parts", t) for t in pr.pop("trees")]
-        out[name] = {"whole": whole, "parts": pr, "contact_tol": tol, **extra}
+        out[name] = {"whole": whole, "parts": pr, "contact_tol": tol, "thickness": thick, **extra}
     return out, fig5_trees
 
 
@@ -240,6 +251,7 @@ def fig5(trees: list, st: BenchSettings, say) -> list[dict]:
     say(f"fig. 5: valid configuration ratios ({st.samples} samples per net and strategy)")
     rows = []
     for name, kind, tree in trees:
+        tree = tree.with_thickness(0.0)  # the paper's zero-thickness valid ratio
         dof = int(len(tree.creases))
         m = st.samples * (10 if dof < 20 and not st.quick else 1)
         r = {"model": name, "kind": kind, "dof": dof, "samples": m}
