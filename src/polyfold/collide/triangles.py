@@ -296,28 +296,145 @@ def _beyond_side(t, mask, reach):
 
 
 @njit(cache=True)
-def _wedge_clear(a, ga, b, mb, gap, reach):
-    """True when every part of b within gap of a's plane lies within reach of b's shared corners
-    (mb): b's other corners are beyond gap on one side of the plane and the wedge they leave at
-    the shared corners is short. (A quick answer for faces around a common vertex.)"""
-    if not ga.uok:
-        return False
-    sides, wedge = 0, 0.0
-    for c in range(3):
-        if mb & (1 << c):
-            continue
-        d = ga.u[0] * (b[c][0] - a[0][0]) + ga.u[1] * (b[c][1] - a[0][1]) + ga.u[2] * (b[c][2] - a[0][2])
-        if abs(d) <= gap:
-            return False
-        sides |= 1 if d > 0 else 2
-        for k in range(3):
-            if mb & (1 << k):
-                e = (b[c][0] - b[k][0], b[c][1] - b[k][1], b[c][2] - b[k][2])
-                wedge = max(wedge, math.sqrt(_dot(e, e)) * gap / abs(d))
-    return sides != 3 and wedge + gap <= reach
+def _corner_at(a, p, tol):
+    """The corner of a within tol of point p, or -1."""
+    for m in range(3):
+        e = (a[m][0] - p[0], a[m][1] - p[1], a[m][2] - p[2])
+        if _dot(e, e) <= tol * tol:
+            return m
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _in_cone(n, e1, e2, u):
+    """True when direction u lies in the closed cone of e1, e2 (< 180 degrees) seen along n (on
+    its sides too, within a relative 1e-9)."""
+    s1 = _dot(n, _cross(e1, u))
+    s2 = _dot(n, _cross(u, e2))
+    if _dot(n, _cross(e1, e2)) < 0.0:
+        s1, s2 = -s1, -s2
+    lu = math.sqrt(_dot(u, u))
+    eps1 = 1e-9 * math.sqrt(_dot(e1, e1)) * lu
+    eps2 = 1e-9 * math.sqrt(_dot(e2, e2)) * lu
+    return s1 >= -eps1 and s2 >= -eps2 and (_dot(e1, u) > 0.0 or _dot(e2, u) > 0.0)
 
 
 @njit(cache=True)
+def _beside(a, ga, b, mb, d, tol):
+    """`_wedge_clear` when b (one shared corner s, on a's plane) lies within the thickness of a's
+    plane: True when, seen along a's normal, b's corner at s and a's corner there are apart (no
+    side of one inside the other's corner), so b's projection meets a only at s."""
+    if not (mb == 1 or mb == 2 or mb == 4):
+        return False
+    k = 0 if mb == 1 else (1 if mb == 2 else 2)
+    if abs(d[k]) > tol:
+        return False
+    j = _corner_at(a, b[k], tol)
+    if j < 0:
+        return False
+    n = ga.u
+    s = a[j]
+    e1 = (a[(j + 1) % 3][0] - s[0], a[(j + 1) % 3][1] - s[1], a[(j + 1) % 3][2] - s[2])
+    e2 = (a[(j + 2) % 3][0] - s[0], a[(j + 2) % 3][1] - s[1], a[(j + 2) % 3][2] - s[2])
+    u1 = (b[(k + 1) % 3][0] - s[0], b[(k + 1) % 3][1] - s[1], b[(k + 1) % 3][2] - s[2])
+    u2 = (b[(k + 2) % 3][0] - s[0], b[(k + 2) % 3][1] - s[1], b[(k + 2) % 3][2] - s[2])
+    return not (_in_cone(n, e1, e2, u1) or _in_cone(n, e1, e2, u2) or _in_cone(n, u1, u2, e1)
+                or _in_cone(n, u1, u2, e2))
+
+
+@njit(cache=True)
+def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
+    """`_wedge_clear` when b (one shared corner s, on a's plane) crosses a's plane, or has a second
+    corner x within gap of it: b meets that plane along the segment from s to a point x of its
+    opposite side (or to that corner). True when that segment
+    leaves s outside a's corner (no crossing), so far from a's sides that the band of b within gap
+    of the plane reaches into a only within reach of s."""
+    if not (mb == 1 or mb == 2 or mb == 4):
+        return False
+    k = 0 if mb == 1 else (1 if mb == 2 else 2)
+    if abs(d[k]) > tol:
+        return False
+    c1, c2 = b[(k + 1) % 3], b[(k + 2) % 3]
+    d1, d2 = d[(k + 1) % 3], d[(k + 2) % 3]
+    if abs(d1) <= gap or abs(d2) <= gap:  # one corner within gap of the plane: the side to it
+        t = 0.0 if abs(d1) <= abs(d2) else 1.0
+    else:
+        t = d1 / (d1 - d2)
+    sb = b[k]
+    u = (c1[0] + t * (c2[0] - c1[0]) - sb[0], c1[1] + t * (c2[1] - c1[1]) - sb[1], c1[2] + t * (c2[2] - c1[2]) - sb[2])
+    lu = math.sqrt(_dot(u, u))
+    # a's corner at s: the corner of a nearest to b's shared corner
+    j, best = 0, math.inf
+    for m in range(3):
+        e = (a[m][0] - sb[0], a[m][1] - sb[1], a[m][2] - sb[2])
+        if _dot(e, e) < best:
+            j, best = m, _dot(e, e)
+    if best > tol * tol or lu == 0.0:
+        return False
+    e1 = (a[(j + 1) % 3][0] - a[j][0], a[(j + 1) % 3][1] - a[j][1], a[(j + 1) % 3][2] - a[j][2])
+    e2 = (a[(j + 2) % 3][0] - a[j][0], a[(j + 2) % 3][1] - a[j][1], a[(j + 2) % 3][2] - a[j][2])
+    n = ga.u
+    # sines of u's angles from a's two sides at s, signed so that inside the corner both are >= 0
+    l1, l2 = math.sqrt(_dot(e1, e1)), math.sqrt(_dot(e2, e2))
+    s1 = _dot(n, _cross(e1, u)) / (l1 * lu)
+    s2 = _dot(n, _cross(u, e2)) / (l2 * lu)
+    if _dot(n, _cross(e1, e2)) < 0.0:
+        s1, s2 = -s1, -s2
+    if s1 >= 0.0 and s2 >= 0.0:
+        return False  # the segment runs into a: they may cross
+    # the segment at distance r from s stays at least r sin(phi) from a (phi: its angle from the
+    # nearest side, or r itself beyond 90 degrees)
+    sin_phi = 1.0
+    if s1 < 0.0 and _dot(e1, u) > 0.0:
+        sin_phi = min(sin_phi, -s1)
+    if s2 < 0.0 and _dot(e2, u) > 0.0:
+        sin_phi = min(sin_phi, -s2)
+    nb = _cross(_edge(b, 0), _edge(b, 1))
+    lb = math.sqrt(_dot(nb, nb))
+    if lb == 0.0:
+        return False
+    cos_t = abs(_dot(n, nb)) / lb
+    sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
+    if sin_phi <= 0.0 or sin_t <= 1e-3:
+        return False
+    band = gap * (2.0 * cos_t / sin_t + 2.0)  # b's band within gap of the plane, projected, plus a's inset
+    return band / sin_phi + gap <= reach
+
+
+@njit(cache=True)
+def _wedge_clear(a, ga, b, mb, gap, reach, tol):
+    """True when b neither crosses a's plane nor comes within gap of it farther than reach from
+    its shared corners (mb): b's other corners lie beyond gap on one side, its shared corners not
+    beyond tol on the other, and the wedge the slab leaves at the shared corners is short. (The
+    quick answer for faces around a common vertex, most of the pairs a thick test meets.)"""
+    if not ga.uok:
+        return False
+    d = [0.0, 0.0, 0.0]
+    sides, flat = 0, 0
+    for c in range(3):
+        d[c] = ga.u[0] * (b[c][0] - a[0][0]) + ga.u[1] * (b[c][1] - a[0][1]) + ga.u[2] * (b[c][2] - a[0][2])
+        if not mb & (1 << c):
+            if abs(d[c]) <= gap:
+                flat += 1
+            sides |= 1 if d[c] > 0 else 2
+    if flat == 2:
+        return _beside(a, ga, b, mb, d, tol)
+    if flat or sides == 3:  # b meets a's plane along a segment from the shared corner
+        return _straddle_clear(a, ga, b, mb, d, gap, reach, tol)
+    up = sides == 1
+    wedge = 0.0
+    for k in range(3):
+        if mb & (1 << k):
+            if (d[k] < -tol) if up else (d[k] > tol):
+                return False  # the shared corner is across the plane: b may cross a there
+            for c in range(3):
+                if not mb & (1 << c):
+                    e = (b[c][0] - b[k][0], b[c][1] - b[k][1], b[c][2] - b[k][2])
+                    wedge = max(wedge, math.sqrt(_dot(e, e)) * gap / abs(d[c]))
+    return wedge + gap <= reach
+
+
+@njit(cache=True, inline="always")
 def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
     """The planners' pair test with the paper's thickness (ALGORITHMS.md 6.2, README "Paper
     thickness"): a, b cross (`faces_cross`), or come closer than thick with overlapping
@@ -326,8 +443,6 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
     are cut off at reach first (the rest tested in triangles); faces sharing a mesh edge (a glued
     seam, closing) lose the strip within reach of it, and once both its copies meet (closed) are
     only tested for crossing. (The goal itself is tested without thickness: `fold.plan`.)"""
-    if faces_cross(a, b, ga, gb, tol):
-        return True
     ma, mb, met, edge = 0, 0, 0, 0
     for i in range(3):
         for j in range(3):
@@ -341,7 +456,18 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
                 ma |= 1 << i
                 mb |= 1 << j
     if met >= 2:
-        return False  # a closed seam: the faces meet along it
+        return faces_cross(a, b, ga, gb, tol)  # a closed seam: the faces meet along it
+    if (ma and _wedge_clear(a, ga, b, mb, thick, reach, tol)
+            and _wedge_clear(b, gb, a, ma, thick, reach, tol)):
+        return False
+    return _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach)
+
+
+@njit(cache=True)
+def _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach):
+    """`thick_collides` past its quick answers (a call: rarely reached, keeps compiling fast)."""
+    if faces_cross(a, b, ga, gb, tol):
+        return True
     if ma == 0:
         return faces_near(a, b, ga, gb, thick)
     if edge >= 2:  # a mesh edge they share (a seam): what is left beyond reach of it
@@ -349,7 +475,16 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
         if sa[1] <= 0.0 or sb[1] <= 0.0:
             return False
         return faces_near(sa[0], sb[0], face_geometry(sa[0], tol), face_geometry(sb[0], tol), thick)
-    if _wedge_clear(a, ga, b, mb, thick, reach) and _wedge_clear(b, gb, a, ma, thick, reach):
+    if _one_bit(ma) and _one_bit(mb):  # the usual case: one shared corner, each face a quad
+        qa, qb = _corner_cut(a, ma, reach), _corner_cut(b, mb, reach)
+        for ta in qa:
+            sa = face_geometry(ta, tol)
+            if sa.sliver:
+                continue
+            for tb in qb:
+                sb = face_geometry(tb, tol)
+                if not sb.sliver and faces_near(ta, tb, sa, sb, thick):
+                    return True
         return False
     pa = _corners_cut(a, ma, reach)
     pb = _corners_cut(b, mb, reach)
@@ -364,3 +499,23 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
             if not sb.sliver and faces_near(ta, tb, sa, sb, thick):
                 return True
     return False
+
+
+@njit(cache=True, inline="always")
+def _one_bit(m):
+    return m == 1 or m == 2 or m == 4
+
+
+@njit(cache=True)
+def _corner_cut(t, mask, reach):
+    """`_corners_cut` of one corner (mask one bit), as the two triangles of the quad left."""
+    k = 0 if mask == 1 else (1 if mask == 2 else 2)
+    c, p, n = t[k], t[(k + 2) % 3], t[(k + 1) % 3]
+    dp = (p[0] - c[0], p[1] - c[1], p[2] - c[2])
+    dn = (n[0] - c[0], n[1] - c[1], n[2] - c[2])
+    lp, ln = math.sqrt(_dot(dp, dp)), math.sqrt(_dot(dn, dn))
+    sp = 0.0 if lp == 0.0 else min(reach, 0.5 * lp) / lp
+    sn = 0.0 if ln == 0.0 else min(reach, 0.5 * ln) / ln
+    cp = (c[0] + sp * dp[0], c[1] + sp * dp[1], c[2] + sp * dp[2])
+    cn = (c[0] + sn * dn[0], c[1] + sn * dn[1], c[2] + sn * dn[2])
+    return ((cp, cn, n), (cp, n, p))
