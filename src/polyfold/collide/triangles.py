@@ -409,10 +409,12 @@ def _wedge_clear(a, ga, b, mb, gap, reach, tol):
     quick answer for faces around a common vertex, most of the pairs a thick test meets.)"""
     if not ga.uok:
         return False
-    d = [0.0, 0.0, 0.0]
+    o = a[0]
+    d = (_dot(ga.u, (b[0][0] - o[0], b[0][1] - o[1], b[0][2] - o[2])),
+         _dot(ga.u, (b[1][0] - o[0], b[1][1] - o[1], b[1][2] - o[2])),
+         _dot(ga.u, (b[2][0] - o[0], b[2][1] - o[1], b[2][2] - o[2])))  # a tuple: a list would allocate
     sides, flat = 0, 0
     for c in range(3):
-        d[c] = ga.u[0] * (b[c][0] - a[0][0]) + ga.u[1] * (b[c][1] - a[0][1]) + ga.u[2] * (b[c][2] - a[0][2])
         if not mb & (1 << c):
             if abs(d[c]) <= gap:
                 flat += 1
