@@ -380,8 +380,20 @@ def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
     s2 = _dot(n, _cross(u, e2)) / (l2 * lu)
     if _dot(n, _cross(e1, e2)) < 0.0:
         s1, s2 = -s1, -s2
-    if s1 >= 0.0 and s2 >= 0.0:
+    eps = 1e-9
+    if s1 > eps and s2 > eps:
         return False  # the segment runs into a: they may cross
+    nb = _cross(_edge(b, 0), _edge(b, 1))
+    lb = math.sqrt(_dot(nb, nb))
+    if lb == 0.0:
+        return False
+    cos_t = abs(_dot(n, nb)) / lb
+    sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
+    if sin_t <= 1e-3:
+        return False
+    band = 2.0 * gap * cos_t / sin_t  # b's band within gap of the plane, seen along a's normal
+    if band <= gap:
+        return True  # the segment runs outside a or along its side: the band stays in a's rim
     # the segment at distance r from s stays at least r sin(phi) from a (phi: its angle from the
     # nearest side, or r itself beyond 90 degrees)
     sin_phi = 1.0
@@ -389,16 +401,9 @@ def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
         sin_phi = min(sin_phi, -s1)
     if s2 < 0.0 and _dot(e2, u) > 0.0:
         sin_phi = min(sin_phi, -s2)
-    nb = _cross(_edge(b, 0), _edge(b, 1))
-    lb = math.sqrt(_dot(nb, nb))
-    if lb == 0.0:
-        return False
-    cos_t = abs(_dot(n, nb)) / lb
-    sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
-    if sin_phi <= 0.0 or sin_t <= 1e-3:
-        return False
-    band = gap * (2.0 * cos_t / sin_t + 2.0)  # b's band within gap of the plane, projected, plus a's inset
-    return band / sin_phi + gap <= reach
+    if sin_phi > 0.0 and (band + 2.0 * gap) / sin_phi + gap <= reach:  # plus a's inset
+        return True
+    return _beside(a, ga, b, mb, d, tol)  # b's corner beside a's, seen along a's normal
 
 
 @njit(cache=True)
@@ -433,7 +438,30 @@ def _wedge_clear(a, ga, b, mb, gap, reach, tol):
                 if not mb & (1 << c):
                     e = (b[c][0] - b[k][0], b[c][1] - b[k][1], b[c][2] - b[k][2])
                     wedge = max(wedge, math.sqrt(_dot(e, e)) * gap / abs(d[c]))
-    return wedge + gap <= reach
+    # a short wedge; or, seen along a's normal, b's corner beside a's (nearly flat neighbours)
+    return wedge + gap <= reach or _beside(a, ga, b, mb, d, tol)
+
+
+@njit(cache=True, inline="always")
+def _net_shared(ids_a, ids_b):
+    for i in range(3):
+        for j in range(3):
+            if ids_a[i] == ids_b[j]:
+                return True
+    return False
+
+
+@njit(cache=True)
+def _apart(a, b, ma, mb, dist):
+    """True when every corner of a in ma is farther than dist from every corner of b in mb."""
+    for i in range(3):
+        if ma & (1 << i):
+            for j in range(3):
+                if mb & (1 << j):
+                    d = (a[i][0] - b[j][0], a[i][1] - b[j][1], a[i][2] - b[j][2])
+                    if _dot(d, d) <= dist * dist:
+                        return False
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -459,6 +487,8 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
                 mb |= 1 << j
     if met >= 2:
         return faces_cross(a, b, ga, gb, tol)  # a closed seam: the faces meet along it
+    if ma and not met and not _net_shared(ids_a, ids_b) and _apart(a, b, ma, mb, 2.0 * reach):
+        ma, mb, edge = 0, 0, 0  # copies of shared mesh vertices far apart: nothing shared here
     if (ma and _wedge_clear(a, ga, b, mb, thick, reach, tol)
             and _wedge_clear(b, gb, a, ma, thick, reach, tol)):
         return False
