@@ -443,28 +443,6 @@ def _wedge_clear(a, ga, b, mb, gap, reach, tol):
 
 
 @njit(cache=True, inline="always")
-def _net_shared(ids_a, ids_b):
-    for i in range(3):
-        for j in range(3):
-            if ids_a[i] == ids_b[j]:
-                return True
-    return False
-
-
-@njit(cache=True)
-def _apart(a, b, ma, mb, dist):
-    """True when every corner of a in ma is farther than dist from every corner of b in mb."""
-    for i in range(3):
-        if ma & (1 << i):
-            for j in range(3):
-                if mb & (1 << j):
-                    d = (a[i][0] - b[j][0], a[i][1] - b[j][1], a[i][2] - b[j][2])
-                    if _dot(d, d) <= dist * dist:
-                        return False
-    return True
-
-
-@njit(cache=True, inline="always")
 def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
     """The planners' pair test with the paper's thickness (ALGORITHMS.md 6.2, README "Paper
     thickness"): a, b cross (`faces_cross`), or come closer than thick with overlapping
@@ -487,8 +465,6 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
                 mb |= 1 << j
     if met >= 2:
         return faces_cross(a, b, ga, gb, tol)  # a closed seam: the faces meet along it
-    if ma and not met and not _net_shared(ids_a, ids_b) and _apart(a, b, ma, mb, 2.0 * reach):
-        ma, mb, edge = 0, 0, 0  # copies of shared mesh vertices far apart: nothing shared here
     if (ma and _wedge_clear(a, ga, b, mb, thick, reach, tol)
             and _wedge_clear(b, gb, a, ma, thick, reach, tol)):
         return False
