@@ -102,3 +102,23 @@ def test_another_tol_refreshes_the_cache(tree):
     for tol in (tree.tol, 0.05 * tree.scale, tree.tol, 0.0):
         fresh = config_collides(q, *args, tol, R, T, out)
         assert config_collides_cached(q, *args, np.full(tree.n_faces, -1), tol, work) == fresh
+
+
+def test_a_finer_segment_check_includes_the_resolutions_samples(tree):
+    """A move of 14.24 degrees at 1 degree: the resolution samples t = k / 15. Checked at half the
+    resolution the planners sample t = k / 30 (29 interior samples), which include them; sampling
+    ceil(14.24 / 0.5) = 29 (t = k / 29) missed t = 1/3, where a Loop-subdivided moneybox piece
+    collided: a path its planner accepted and the independent check (at 1 degree) rejected."""
+    import math
+
+    from polyfold.fold.checker import ValidityChecker
+
+    check = ValidityChecker(tree, math.radians(1.0))
+    q = np.zeros(tree.n_edges)
+    q[tree.creases[0]] = math.radians(14.24)
+    before = check.configs
+    check.segment(np.zeros(tree.n_edges), q, math.radians(0.5))
+    assert check.configs - before == 29
+    before = check.configs
+    check.segment(np.zeros(tree.n_edges), q)
+    assert check.configs - before == 14

@@ -80,8 +80,8 @@ Planner = Callable[[FoldTree, ValidityChecker, Deadline, PlannerSettings], "Foun
 
 def plan_linear(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settings: PlannerSettings) -> Found | None:
     """The straight line flat -> goal (the paper's LC test), checked at half the resolution at
-    once (its samples include the full-resolution ones; a blocked line fails as early, at its
-    first bisection samples)."""
+    once (its samples include the full-resolution ones, `ValidityChecker.segment`; a blocked line
+    fails as early, at its first bisection samples)."""
     straight = np.stack([np.zeros(len(tree.goal)), tree.goal.copy()])
     if first_blocked_segment(check, straight, check.step / 2) < 0:
         return Found(straight, "linear", 2, True)
