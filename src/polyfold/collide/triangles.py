@@ -13,6 +13,13 @@ updates, more than the cheap pair tests themselves. What a pair test needs from 
 its `FaceGeometry`, computed once per face and configuration (`face_geometry`) and kept in a row
 of a `geo` array (`store_face` / `load_face`, GEO_SIZE values per row, the face's box from
 GEO_LO on) by the broad phase (`sweep.py`).
+
+With the paper's thickness (README "Paper thickness") the planners ask `thick_collides` instead:
+crossing, or closer than the thickness with overlapping projections (`faces_near`, the same
+separating-axis machinery with a margin), where faces sharing a vertex may touch near it (quick
+answers `_wedge_clear`, `_straddle_clear`, `_beside` for most such pairs; corners cut off and a
+shared mesh edge's strip removed for the rest). The independent re-check of written paths is
+`verify.paths`, which shares none of this.
 """
 
 from __future__ import annotations

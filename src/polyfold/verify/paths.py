@@ -42,7 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-EXEMPT_REACH = 10.0  # faces sharing a point may come within the thickness this many thicknesses from it
+# faces sharing a point may come within the thickness this many thicknesses from it (the same
+# rule as the planners' collide.tolerance.EXEMPT_REACH, stated here again: nothing is imported)
+EXEMPT_REACH = 10.0
 CUT = ("B", "C")
 
 
