@@ -265,25 +265,6 @@ def faces_near(a, b, ga, gb, gap):
 
 
 @njit(cache=True)
-def _corners_cut(t, mask, reach):
-    """The corners of triangle t with each corner in mask (bit k: corner k) cut off at reach along
-    its two sides (at most half of each): what is left of a face away from the points it shares,
-    a convex polygon of 3-6 corners in order."""
-    out = []
-    for k in range(3):
-        c = t[k]
-        if not mask & (1 << k):
-            out.append(c)
-            continue
-        for o in (t[(k + 2) % 3], t[(k + 1) % 3]):  # the previous corner's side first: order kept
-            d = (o[0] - c[0], o[1] - c[1], o[2] - c[2])
-            ln = math.sqrt(_dot(d, d))
-            s = 0.0 if ln == 0.0 else min(reach, 0.5 * ln) / ln
-            out.append((c[0] + s * d[0], c[1] + s * d[1], c[2] + s * d[2]))
-    return out
-
-
-@njit(cache=True)
 def _beyond_side(t, mask, reach):
     """(triangle, scale): the part of triangle t farther than reach from its side whose two corners
     are in mask (the triangle shrunk towards the third corner by `scale`; scale <= 0: nothing left)."""
@@ -490,26 +471,14 @@ def _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach):
         if sa[1] <= 0.0 or sb[1] <= 0.0:
             return False
         return faces_near(sa[0], sb[0], face_geometry(sa[0], tol), face_geometry(sb[0], tol), thick)
-    if _one_bit(ma) and _one_bit(mb):  # the usual case: one shared corner, each face a quad
-        qa, qb = _corner_cut(a, ma, reach), _corner_cut(b, mb, reach)
-        for ta in qa:
-            sa = face_geometry(ta, tol)
-            if sa.sliver:
-                continue
-            for tb in qb:
-                sb = face_geometry(tb, tol)
-                if not sb.sliver and faces_near(ta, tb, sa, sb, thick):
-                    return True
-        return False
-    pa = _corners_cut(a, ma, reach)
-    pb = _corners_cut(b, mb, reach)
-    for i in range(1, len(pa) - 1):
-        ta = (pa[0], pa[i], pa[i + 1])
+    if not (_one_bit(ma) and _one_bit(mb)):
+        return faces_near(a, b, ga, gb, thick)  # (no such pair in a net: two shared net vertices are a crease)
+    qa, qb = _corner_cut(a, ma, reach), _corner_cut(b, mb, reach)  # one shared corner: each face a quad
+    for ta in qa:
         sa = face_geometry(ta, tol)
         if sa.sliver:
             continue
-        for j in range(1, len(pb) - 1):
-            tb = (pb[0], pb[j], pb[j + 1])
+        for tb in qb:
             sb = face_geometry(tb, tol)
             if not sb.sliver and faces_near(ta, tb, sa, sb, thick):
                 return True
@@ -523,7 +492,8 @@ def _one_bit(m):
 
 @njit(cache=True)
 def _corner_cut(t, mask, reach):
-    """`_corners_cut` of one corner (mask one bit), as the two triangles of the quad left."""
+    """Triangle t with its corner in mask (one bit) cut off at reach along its two sides (at most
+    half of each): what is left away from the point it shares, as the two triangles of a quad."""
     k = 0 if mask == 1 else (1 if mask == 2 else 2)
     c, p, n = t[k], t[(k + 2) % 3], t[(k + 1) % 3]
     dp = (p[0] - c[0], p[1] - c[1], p[2] - c[2])

@@ -135,8 +135,6 @@ def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: fl
     independent checker (`verify.paths`); a rejected path is planned once more at half the
     resolution. Returns (the FOLD dict with the path and polyfold:path_verified, the path, None)
     or (fold, None, why there is none). Raises PolyfoldError when no path can exist."""
-    from ..verify.paths import check_fold_path
-
     t0 = time.perf_counter()
     thickness = thickness_rel * tree.scale
     tree = tree.with_thickness(thickness)
@@ -148,8 +146,7 @@ def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: fl
         path = plan_fold(tree, planner=planner, resolution_deg=resolution, time_limit=max(left, 0.5), seed=seed)
         if path is None:
             return fold, None, why or f"no folding path found in {time_limit:g} s with planner {planner}"
-        written = with_path(fold, path, resolution_deg, contact_tol, thickness)
-        check = check_fold_path(written, thickness=thickness)
+        written, check = _checked(fold, path, resolution_deg, contact_tol, thickness)
         if check.ok:
             return dict(written, **{"polyfold:path_verified": True}), path, None
         why = f"the planned path failed the independent check ({check.why()})"
@@ -157,13 +154,18 @@ def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: fl
     return fold, None, why
 
 
-def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, thickness: float):
-    """The independent check (`verify.paths.check_fold_path`) of a piece's path as its FOLD file
-    holds it (degrees, the goal frame as written), at `thickness` model units."""
+def _checked(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float, thickness: float):
+    """(the FOLD dict with the path as written, the independent check of it at `thickness`)."""
     from ..verify.paths import check_fold_path
 
-    fold = with_path(pattern_fold(pattern), path, opts.resolution_deg, opts.contact_tol, thickness)
-    return check_fold_path(fold, thickness=thickness)
+    written = with_path(fold, path, resolution_deg, contact_tol, thickness)
+    return written, check_fold_path(written, thickness=thickness)
+
+
+def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, thickness: float):
+    """The independent check of a piece's path as its FOLD file holds it (degrees, the goal frame
+    as written), at `thickness` model units."""
+    return _checked(pattern_fold(pattern), path, opts.resolution_deg, opts.contact_tol, thickness)[1]
 
 
 def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None],
