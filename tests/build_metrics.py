@@ -59,6 +59,7 @@ ATTACHED = 0.3  # a tab is attached to an edge when it runs along this fraction 
 ON_LINE_MM = 0.02  # a fold line lies along an edge: both ends this close to its line
 LEADER_TOUCH_MM = 0.05  # a leader line ends this close to its label's box
 OVERLAP_MM2 = 1e-3  # label boxes sharing less area than this only touch
+ANCHORS = 4  # per edge of a seam run and length tolerance: edges near its label tried as the start
 NOT_LABELS = ("title", "footer", "scale", "legend")  # text classes that are not glue or piece labels
 
 
@@ -230,27 +231,87 @@ class _Page:
         `corners` (`Model.corners`): an edge whose face's third corner is printed where the mesh
         puts it is taken first (an edge of the same length nearer the label, e.g. of a sliver face
         beside it, is not the one)."""
+        for tol in self._tols(length):
+            found = self.segments(label_xy, length, corners, tol)
+            if found:
+                return found[0][:2]
+        return None
+
+    @staticmethod
+    def _tols(length: float) -> tuple[float, float]:
+        tol = LENGTH_TOL_MM + 1e-5 * length
+        return tol, 10 * tol
+
+    def segments(self, label_xy: np.ndarray, length: float, corners, tol: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every face edge `locate` could take at length tolerance tol, its pick first (cornered
+        ones, then the others, each nearest the label first): (end, end, cornered)."""
         d = np.linalg.norm(self.points - label_xy, axis=1)
         near = self.points[d <= length + 20.0]
         if len(near) < 2:
-            return None
+            return []
         i, j = np.triu_indices(len(near), 1)
-        error = np.abs(np.linalg.norm(near[i] - near[j], axis=1) - length)
-        for tol in (LENGTH_TOL_MM + 1e-5 * length, 10 * (LENGTH_TOL_MM + 1e-5 * length)):
-            ok = error <= tol
-            if not ok.any():
-                continue
-            a, b = near[i[ok]], near[j[ok]]
-            ab = b - a
-            t = np.clip(np.einsum("ij,ij->i", label_xy - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
-            dist = np.linalg.norm(a + t[:, None] * ab - label_xy, axis=1)
-            order = np.argsort(dist, kind="stable")
-            faced = [k for k in order if not self.has_faces
-                     or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0))]
-            cornered = [k for k in faced if self._cornered(a[k], b[k], corners, 10 * tol)]
+        ok = np.abs(np.linalg.norm(near[i] - near[j], axis=1) - length) <= tol
+        if not ok.any():
+            return []
+        a, b = near[i[ok]], near[j[ok]]
+        ab = b - a
+        t = np.clip(np.einsum("ij,ij->i", label_xy - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
+        dist = np.linalg.norm(a + t[:, None] * ab - label_xy, axis=1)
+        order = np.argsort(dist, kind="stable")
+        faced = [k for k in order if not self.has_faces
+                 or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0))]
+        cornered = [k for k in faced if self._cornered(a[k], b[k], corners, 10 * tol)]
+        first = set(cornered)
+        return [(a[k], b[k], k in first) for k in cornered + [k for k in faced if k not in first]]
+
+    def follow(self, p: np.ndarray, back: np.ndarray, length: float,
+               corners: list[tuple[float, float]]) -> np.ndarray | None:
+        """The next corner along a seam run: a printed point `length` mm from p (not `back`, the
+        corner before p) such that p to it is a face edge (a face all along one side), one whose
+        face's third corner is printed where the mesh puts it taken first."""
+        d = np.linalg.norm(self.points - p, axis=1)
+        tol = LENGTH_TOL_MM + 1e-5 * length
+        for tol in (tol, 10 * tol):  # as `locate`: then a corner merged with a tab corner close by
+            cand = self.points[(np.abs(d - length) <= tol) & (np.linalg.norm(self.points - back, axis=1) > tol)]
+            faced = [r for r in cand if not self.has_faces
+                     or any(set(self.side(p, r, s)) == {"face"} for s in (1.0, -1.0))]
+            cornered = [r for r in faced if self._cornered(p, r, corners, 10 * tol)]
             if cornered or faced:
-                k = (cornered or faced)[0]
-                return a[k], b[k]
+                return (cornered or faced)[0]
+        return None
+
+    def locate_run(self, label_xy: np.ndarray, chain: list[tuple[int, int]], model: "Model"
+                   ) -> list[tuple[np.ndarray, np.ndarray]] | None:
+        """The printed copy of a seam run (its mesh edges (v0, v1), (v1, v2), ... in order) whose
+        label is at label_xy: one of its edges found near the label (as `locate` finds them,
+        nearest the label first), then the others corner by corner along the outline (`follow`).
+        Per edge its ends (printed points of v_i, v_i+1), or None."""
+        verts = [chain[0][0]] + [b for _a, b in chain]
+        k = len(chain)
+        length = [float(np.linalg.norm(model.vertices[a] - model.vertices[b])) * model.scale for a, b in chain]
+        anchors = []  # as `locate` prefers them: tight length tolerance, cornered, nearest the label
+        for m in range(k):
+            for level, tol in enumerate(self._tols(length[m])):
+                for n, (a, b, cornered) in enumerate(self.segments(label_xy, length[m], model.corners(*chain[m]),
+                                                                   tol)[:ANCHORS]):
+                    anchors.append((level, not cornered, _distance(label_xy, a, b), m, n, (a, b)))
+        for *_key, m, _n, seg in sorted(anchors, key=lambda a: a[:5]):
+            for pa, pb in (seg, seg[::-1]):
+                pos: dict[int, np.ndarray] = {m: pa, m + 1: pb}
+                for i in range(m + 1, k):
+                    r = self.follow(pos[i], pos[i - 1], length[i], model.corners(verts[i], verts[i + 1]))
+                    if r is None:
+                        break
+                    pos[i + 1] = r
+                for i in range(m - 1, -1, -1):
+                    if i + 1 not in pos:
+                        break
+                    r = self.follow(pos[i + 1], pos[i + 2], length[i], model.corners(verts[i], verts[i + 1]))
+                    if r is None:
+                        break
+                    pos[i] = r
+                if len(pos) == k + 1:
+                    return [(pos[i], pos[i + 1]) for i in range(k)]
         return None
 
     def _cornered(self, a: np.ndarray, b: np.ndarray, corners, tol: float) -> bool:
@@ -289,6 +350,39 @@ class _Page:
             ring = np.asarray(part.exterior.coords)
             depth = max(depth or 0.0, float(((ring - a) @ n).max()))
         return depth
+
+
+def _distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance from point p to segment a-b."""
+    ab = b - a
+    t = float(np.clip(np.dot(p - a, ab) / max(float(np.dot(ab, ab)), 1e-300), 0.0, 1.0))
+    return float(np.linalg.norm(a + t * ab - p))
+
+
+def _chain(rows: list[dict]) -> tuple[list[tuple[int, int]], list[dict]] | None:
+    """The glue rows of one printed label as a chain of mesh edges: the edges (v0, v1), (v1, v2),
+    ... in order and the rows in that order (from a vertex on one edge only; a closed loop from
+    any), or None when they do not form one."""
+    ends = [(int(r["mesh_vertices"][0]), int(r["mesh_vertices"][1])) for r in rows]
+    at: dict[int, list[int]] = {}
+    for i, (a, b) in enumerate(ends):
+        at.setdefault(a, []).append(i)
+        at.setdefault(b, []).append(i)
+    loose = [v for v, ids in at.items() if len(ids) == 1]
+    v = min(loose) if loose else ends[0][0]
+    order, edges, used = [], [], set()
+    while len(order) < len(rows):
+        nxt = [i for i in at[v] if i not in used]
+        if not nxt:
+            return None
+        i = nxt[0]
+        used.add(i)
+        a, b = ends[i]
+        w = b if a == v else a
+        order.append(i)
+        edges.append((v, w))
+        v = w
+    return edges, [rows[i] for i in order]
 
 
 def _marks(sheet: Sheet, a: np.ndarray, b: np.ndarray) -> set[str]:
@@ -395,6 +489,30 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
             where.setdefault(lb.text, []).append((k, xy))
     untabbed, wrong, flat_cut, reduced, n_tabs = [], {f: [] for f in formats}, [], 0, 0
     unlocated = miscounted = unknown = strips_found = 0
+    # where each glue edge's copies are printed: a label stands for its edge, or for a seam run
+    # (assembly rows sharing one printed_label): the run's edges one after another along the
+    # outline, found from the label corner by corner
+    groups: dict[str, list[dict]] = {}
+    for row in assembly["glue"]:
+        groups.setdefault(str(row.get("printed_label", row["label"])), []).append(row)
+    located: dict[str, list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]] = {}
+    n_runs = 0
+    for printed, rows in groups.items():
+        spots = where.get(printed, [])
+        if len(spots) != 2:
+            miscounted += len(rows)
+        chain = _chain(rows)
+        if chain is None:
+            notes.append(f"printed label {printed}: its {len(rows)} glue edges are no chain")
+            continue
+        n_runs += len(rows) > 1
+        for page, xy in spots:
+            segs = pages[page].locate_run(xy, chain[0], model)
+            if segs is None:
+                unlocated += len(rows)
+                continue
+            for row, (p0, p1) in zip(chain[1], segs):
+                located.setdefault(str(row["label"]), []).append((page, p0, p1, xy))
     found: dict[str, list[Copy]] = {}
     for row in assembly["glue"]:
         label = str(row["label"])
@@ -407,16 +525,8 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
         if (deg is not None and abs(deg) < FLAT_DEG) or key in model.diagonals:
             flat_cut.append(label)
         length = float(np.linalg.norm(model.vertices[a] - model.vertices[b])) * model.scale
-        spots = where.get(label, [])
-        if len(spots) != 2:
-            miscounted += 1
         copies = []
-        for page, xy in spots:
-            seg = pages[page].locate(xy, length, model.corners(a, b))
-            if seg is None:
-                unlocated += 1
-                continue
-            p0, p1 = seg
+        for page, p0, p1, xy in located.get(label, []):
             sides = {s: pages[page].side(p0, p1, s) for s in (1.0, -1.0)}
             faces = {s: v.count("face") for s, v in sides.items()}
             (ux, uy), (wx, wy) = p1 - p0, xy - p0
@@ -446,8 +556,10 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
             for f, kinds in c.marks.items():
                 if not kinds or (want is not None and kinds != {want}) or len(kinds) > 1:
                     wrong[f].append(label)
+    if n_runs:
+        notes.append(f"{n_runs} seam runs printed with one label")
     if miscounted:
-        notes.append(f"{miscounted} glue labels not printed exactly twice")
+        notes.append(f"{miscounted} glue edges whose label is not printed exactly twice")
     if unlocated:
         notes.append(f"{unlocated} printed glue-label copies without an edge of the right length nearby")
     if unknown:

@@ -41,6 +41,7 @@ LEADER_STEP_MM = 0.4  # a leader is looked up in the raster at points this far a
 LEADER_TRIES = 1000  # most spots whose leader is checked against the raster (nearest first)
 LEADER_BATCH = 200  # spots whose leaders are checked at once
 ELSEWHERE_GIVE_UP = 20  # a piece where this many labels found no spot is too crowded to look further
+TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
 
 
 def label_font(min_cap_mm: float) -> float:
@@ -155,6 +156,7 @@ class LabelStats:
     on_tabs: int = 0
     outside: int = 0
     unplaced: int = 0
+    runs: int = 0  # labels that stand for a seam run of several edges (`PieceLabels.run`)
 
 
 def _nearest_on(poly, p: np.ndarray) -> np.ndarray:
@@ -163,6 +165,14 @@ def _nearest_on(poly, p: np.ndarray) -> np.ndarray:
 
     ring = poly.exterior
     return np.asarray(ring.interpolate(ring.project(Point(*p))).coords[0])
+
+
+def _end_away(side: CutSide, neighbour: CutSide) -> np.ndarray:
+    """The end of `side` away from `neighbour`, the next side along the same run (they share
+    the other end)."""
+    ends = np.array([neighbour.p0, neighbour.p1])
+    d0, d1 = (float(np.min(np.linalg.norm(ends - p, axis=1))) for p in (side.p0, side.p1))
+    return side.p0 if d0 > d1 else side.p1
 
 
 def _incentre(tri: np.ndarray) -> np.ndarray:
@@ -364,6 +374,61 @@ class PieceLabels:
         `partner`: the edge's other side when it is on this piece too; a label without a leader
         is then placed nearer its own side than the partner's, or a reader takes both labels for
         one edge (they often face each other across a notch, the tab between them)."""
+        self.run(text, [(side, tab_parts, tab_folds, partner)])
+
+    def run(self, text: str, sides: list[tuple[CutSide, tuple, np.ndarray | None, CutSide | None]]) -> None:
+        """One label for a seam run: consecutive sides along the outline (`edge`'s arguments per
+        side, in order) glued to the run's other copy. Stages 1-3 beside each side, middle side
+        first, then stage 4 from the sides in that order; a run of several sides gets a tick
+        across its outline at both ends (`tick`), placed first so no label covers them. A label
+        without a leader stays nearer its own side than every partner side on this piece."""
+        if len(sides) > 1:
+            self.tick(sides[0][0], _end_away(sides[0][0], sides[1][0]))
+            self.tick(sides[-1][0], _end_away(sides[-1][0], sides[-2][0]))
+            self.stats.runs += 1
+        mid = len(sides) // 2
+        order = sorted(range(len(sides)), key=lambda i: (abs(i - mid), i))
+        partners = [entry[3] for entry in sides if entry[3] is not None]
+        for i in order:
+            side, tab_parts, tab_folds, _partner = sides[i]
+            if self._near(side, text, tab_parts, tab_folds, partners):
+                return
+        side = sides[mid][0]
+        if self._elsewhere(text, [sides[i][0] for i in order]):
+            self.stats.outside += 1
+            return
+        s = self.size
+        u = _reading((side.p1 - side.p0) / max(side.length, 1e-12))
+        center = side.tri.mean(axis=0)  # 5. nowhere readable: said in the stats
+        self.stats.unplaced += 1
+        self._put(text, center, u, s, "edge-label", text_box(center, u, text, s))
+
+    def tick(self, side: CutSide, p: np.ndarray) -> None:
+        """A run's end mark: a short line from outline point p (an end of `side`) into its face,
+        along the bisector of the face's corner there (TICK_MM, or less in a small face), drawn
+        with the leaders and kept clear of labels."""
+        from shapely.geometry import LineString
+
+        tri = side.tri
+        k = int(np.argmin(np.linalg.norm(tri - p, axis=1)))
+        a, b = tri[(k + 1) % 3] - tri[k], tri[(k + 2) % 3] - tri[k]
+        la, lb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        if la == 0.0 or lb == 0.0:
+            return
+        w = a / la + b / lb
+        lw = float(np.linalg.norm(w))
+        if lw == 0.0:
+            return
+        end = tri[k] + w / lw * min(TICK_MM, 0.4 * min(la, lb))
+        self.leaders.append(np.array([tri[k], end]))
+        strip = LineString([tri[k], end]).buffer(LEADER_HALF_MM)
+        self.strips.add_geom(strip)
+        if self._taken is not None:
+            self._taken.mark(strip, LABEL_PAD_MM)
+
+    def _near(self, side: CutSide, text: str, tab_parts: tuple[np.ndarray, ...], tab_folds: np.ndarray | None,
+              partners: list[CutSide]) -> bool:
+        """Stages 1-3 for one side: inside its face, on its tab, just outside it."""
         s = self.size
         d = side.p1 - side.p0
         length = max(side.length, 1e-12)
@@ -376,23 +441,21 @@ class PieceLabels:
             box = text_box(center, u, text, s)
             if _inside_triangle(side.tri, box, LABEL_PAD_MM) and not self._hits(box):
                 self._put(text, center, u, s, "edge-label", box)
-                return
+                return True
         if self._on_tab(text, u, tab_parts, tab_folds, n_out, h):
             self.stats.on_tabs += 1
-            return
+            return True
         beyond = max((float(np.max((p - side.p0) @ n_out)) for p in tab_parts), default=0.0)
-        if self._outside(text, side, u, n_out, beyond, h, partner) or self._elsewhere(text, side):
+        if self._outside(text, side, u, n_out, beyond, h, partners):
             self.stats.outside += 1
-            return
-        center = side.tri.mean(axis=0)  # 4. nowhere readable: said in the stats
-        self.stats.unplaced += 1
-        self._put(text, center, u, s, "edge-label", text_box(center, u, text, s))
+            return True
+        return False
 
     def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float,
-                 partner: CutSide | None) -> bool:
+                 partners: list[CutSide]) -> bool:
         """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it, else up to
         LEADER_STEPS_MM away in a free spot with a leader line from the middle of the edge."""
-        from shapely.geometry import LineString, Polygon
+        from shapely.geometry import LineString, MultiLineString, Polygon
 
         d = side.p1 - side.p0
         mid = side.p0 + 0.5 * d
@@ -405,7 +468,7 @@ class PieceLabels:
                 w = np.array([n_out[0] * math.cos(a) - n_out[1] * math.sin(a), n_out[0] * math.sin(a) + n_out[1] * math.cos(a)])
                 spots.append((start + w * (dist + h / 2 + TAB_CLEAR_MM), w, True))
         own = LineString([side.p0, side.p1])
-        other = LineString([partner.p0, partner.p1]) if partner is not None else None
+        other = MultiLineString([[p.p0, p.p1] for p in partners]) if partners else None
         for center, w, leader in spots:
             box = text_box(center, u, text, self.size)
             poly = Polygon(box)
@@ -431,9 +494,9 @@ class PieceLabels:
             return True
         return False
 
-    def _elsewhere(self, text: str, side: CutSide) -> bool:
-        """4. The free spot nearest the middle of the edge (failing that, a quarter of the way
-        along it from either end), up to ELSEWHERE_MM away, the label level (failing that,
+    def _elsewhere(self, text: str, sides: list[CutSide]) -> bool:
+        """4. The free spot nearest the middle of an edge of `sides` (a run's, middle one first;
+        failing that, a quarter of the way along it from either end), up to ELSEWHERE_MM away, the label level (failing that,
         upright): inside a face of the piece (LABEL_PAD_MM from its sides) or off the faces (as in
         3), with a leader line from there on the edge that may cross the piece's lines but no
         label. Candidates come from the piece's `_Taken` raster, nearest first; each is checked
@@ -449,12 +512,13 @@ class PieceLabels:
         level, upward = np.array([1.0, 0.0]), _reading(np.array([0.0, 1.0]))
 
         def tries():
-            for t in (0.5, 0.25, 0.75):
-                mid = side.p0 + t * (side.p1 - side.p0)
-                for inside in (True, False):  # in a face first: off them a label takes paper
-                    for u, bw, bh in ((level, w, h), (upward, h, w)):
-                        for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside):
-                            yield mid, u, c
+            for side in sides:
+                for t in (0.5, 0.25, 0.75):
+                    mid = side.p0 + t * (side.p1 - side.p0)
+                    for inside in (True, False):  # in a face first: off them a label takes paper
+                        for u, bw, bh in ((level, w, h), (upward, h, w)):
+                            for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside):
+                                yield mid, u, c
 
         for mid, u, center in tries():
             box = text_box(center, u, text, self.size)

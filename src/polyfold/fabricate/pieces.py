@@ -9,6 +9,7 @@ side carries the glue tab (`tabs.choose_tab`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -22,6 +23,7 @@ from .paper import MIN_LABEL_MM
 from .tabs import CutSide, Room, Tab, choose_tab, full_depth
 
 OUTLINE_TOL_MM = 1e-3  # outline corners closer than this are one corner
+RUN_MAX_EDGES = 8  # a seam run printed with one label spans at most this many edges
 
 
 def _without_specks(outline):
@@ -97,6 +99,11 @@ class GlueEdge:
     tab_piece: int | None  # the piece whose side carries the tab; None: no tab fits either side
     tab_height_mm: float  # the tab's depth from its fold line
     fold_angle: float = 0.0  # the seam's signed fold angle rho (radians, + convex) in the model
+    printed: str = ""  # the label printed beside it: its own, or its seam run's (the run's lowest label)
+
+    def __post_init__(self) -> None:
+        if not self.printed:
+            object.__setattr__(self, "printed", self.label)
 
 
 @dataclass(frozen=True)
@@ -111,6 +118,7 @@ class LayoutStats:
     reduced_tabs: tuple[tuple[str, str], ...] = ()  # (edge label, reason: tabs.Tab.reason) of reduced tabs
     labels_on_tabs: int = 0  # glue labels printed on their tab (no room in the face)
     labels_outside: int = 0  # glue labels printed just outside their edge
+    seam_runs: int = 0  # runs of several glue edges printed with one label (too dense for one per edge)
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,6 +174,50 @@ def _pair_sides(drawn: list[_Drawn]) -> tuple[list[tuple[tuple[int, int], list[C
     open_edges = sum(1 for v in groups.values() if len(v) == 1)
     pairs.sort(key=lambda kv: (min(s.piece for s in kv[1]), kv[0]))
     return pairs, open_edges
+
+
+def seam_runs(pairs, cut_keys: list[tuple[int, int]], max_edges: int = RUN_MAX_EDGES) -> list[list[int]]:
+    """The glued pairs (indices into `pairs`) as seam runs, every pair in one run, runs in the
+    order of their first pair: a run is a chain of glued edges that follow each other along both
+    copies' outlines (consecutive edges meet at a mesh vertex where no other cut edge ends, so
+    the faces around it are two fans, one per copy), in chain order, cut into near-equal stretches
+    of at most `max_edges`. cut_keys: every cut mesh edge (glued, open or not), low/high ids."""
+    from collections import Counter
+
+    degree = Counter(v for key in set(cut_keys) for v in key)
+    at: dict[int, list[int]] = {}
+    for i, (key, _sides) in enumerate(pairs):
+        for v in key:
+            if degree[v] == 2:
+                at.setdefault(v, []).append(i)
+    links: dict[int, list[int]] = {}
+    for ids in at.values():
+        if len(ids) == 2:
+            links.setdefault(ids[0], []).append(ids[1])
+            links.setdefault(ids[1], []).append(ids[0])
+    seen: set[int] = set()
+    runs = []
+    for i in range(len(pairs)):
+        if i in seen:
+            continue
+        start, prev = i, -1  # to one end of the chain (around a closed loop: back at i)
+        while True:
+            step = [j for j in links.get(start, ()) if j != prev]
+            if not step or step[0] == i:
+                break
+            prev, start = start, step[0]
+        chain, prev = [start], -1
+        seen.add(start)
+        while True:
+            step = [j for j in links.get(chain[-1], ()) if j != prev and j not in seen]
+            if not step:
+                break
+            prev = chain[-1]
+            chain.append(step[0])
+            seen.add(step[0])
+        k = -(-len(chain) // max_edges)
+        runs += [list(part) for part in np.array_split(np.array(chain), k)]
+    return runs
 
 
 def seam_fold_angles(inputs: list[PieceInput]) -> tuple[dict[tuple[int, int], float], set[tuple[int, int]]]:
@@ -237,24 +289,72 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
 
 
 def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
-            min_label_mm: float) -> tuple[list[PieceLabels], LabelStats]:
-    """Every piece's name, then the glue label of both sides of every glued pair (`PieceLabels`)."""
+            min_label_mm: float, runs: list[list[int]], all_or_none: bool = False
+            ) -> tuple[list[PieceLabels], LabelStats] | None:
+    """Every piece's name, then one glue label per copy of every run of glued pairs (a run of
+    one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
+    all_or_none: None at the first glue label that finds no readable place."""
     size = label_font(min_label_mm)
     placed = [PieceLabels(room, size) for room in rooms]
     for i, d in enumerate(drawn):
         placed[i].piece(d.faces_xy, piece_name(i))
-    for idx, ((_key, sides), tab) in enumerate(zip(pairs, chosen)):
-        for s, side in enumerate(sides):
-            mine = tab is not None and tab.side == s
-            other = sides[1 - s]
-            placed[side.piece].edge(side, str(idx + 1), tab.polygons if mine else (), tab.folds if mine else None,
-                                    other if other.piece == side.piece else None)
+    for run in runs:
+        for copy in _run_copies(run, pairs, chosen):
+            labels = placed[copy[0][0].piece]
+            before = labels.stats.unplaced
+            labels.run(str(min(run) + 1), copy)
+            if all_or_none and labels.stats.unplaced > before:
+                return None
     stats = LabelStats()
     for p in placed:
         stats.on_tabs += p.stats.on_tabs
         stats.outside += p.stats.outside
         stats.unplaced += p.stats.unplaced
+        stats.runs += p.stats.runs
     return placed, stats
+
+
+def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tuple]]:
+    """The two copies of a run of glued pairs, each a list of `PieceLabels.run` entries (side, its
+    tab parts, their folds, the partner side when on the same piece) in run order: the sides of
+    the next pair that continue a copy share an end with its last side."""
+    copies: list[list[tuple]] = [[], []]
+    for n, idx in enumerate(run):
+        sides, tab = pairs[idx][1], chosen[idx]
+        order = (0, 1)
+        if n and _gap(copies[0][-1][0], sides[1]) < _gap(copies[0][-1][0], sides[0]):
+            order = (1, 0)
+        for c, s in enumerate(order):
+            side, other = sides[s], sides[1 - s]
+            mine = tab is not None and tab.side == s
+            copies[c].append((side, tab.polygons if mine else (), tab.folds if mine else None,
+                              other if other.piece == side.piece else None))
+    return copies
+
+
+def _gap(last: CutSide, side: CutSide) -> float:
+    """How far `side` is from continuing `last` along an outline: the distance between their
+    nearest ends (infinite on another piece)."""
+    if side.piece != last.piece:
+        return math.inf
+    ends = np.array([last.p0, last.p1])
+    return min(float(np.min(np.linalg.norm(ends - p, axis=1))) for p in (side.p0, side.p1))
+
+
+def _split_at(runs: list[list[int]], breaks: set[int]) -> list[list[int]]:
+    """Runs cut so that every pair in `breaks` is a run of its own."""
+    out = []
+    for run in runs:
+        part: list[int] = []
+        for i in run:
+            if i in breaks:
+                out += [part] if part else []
+                out.append([i])
+                part = []
+            else:
+                part.append(i)
+        out += [part] if part else []
+    return out
 
 
 def glue_strip(label: str, length: float, rho: float, part: int, size: float) -> SheetPiece:
@@ -292,7 +392,21 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
     g, chosen = _glue(pairs, drawn, rooms, tabs, rho)
-    placed, label_stats = _labels(pairs, drawn, rooms, chosen, min_label_mm)
+    bare = [room.copy() for room in rooms]
+    per_edge = _labels(pairs, drawn, rooms, chosen, min_label_mm, [[i] for i in range(len(pairs))], all_or_none=True)
+    if per_edge is not None:
+        placed, label_stats = per_edge
+    else:
+        # too dense for a readable label beside every edge: one per seam run (a glue strip's
+        # edge stays on its own, the strip carries its label)
+        runs = seam_runs(pairs, [key for d in drawn for key, _side in d.sides])
+        runs = _split_at(runs, {int(label) - 1 for label in g.untabbed})
+        # the shortest runs first: they sit where the mesh is densest and have the fewest places
+        runs.sort(key=lambda run: sum(pairs[i][1][0].length for i in run))
+        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs)
+        for run in runs:
+            for i in run:
+                g.glue[i] = replace(g.glue[i], printed=str(min(run) + 1))
     pieces = []
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
         tab_polys = [shapely.Polygon(t) for t in g.tabs[i]]
@@ -319,5 +433,5 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     stats = LayoutStats(glue_edges=len(pairs), tabs=g.n_tabs, tabs_shrunk=len(g.reduced), tabs_moved=g.moved,
                         untabbed=(), small_labels=label_stats.unplaced, open_edges=open_edges,
                         reduced_tabs=tuple(g.reduced), labels_on_tabs=label_stats.on_tabs,
-                        labels_outside=label_stats.outside)
+                        labels_outside=label_stats.outside, seam_runs=label_stats.runs // 2)
     return pieces, g.glue, stats

@@ -20,6 +20,7 @@ stays TAB_CLEAR_MM from everything else on its piece, so a blade never runs two 
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 
@@ -110,6 +111,12 @@ class Room:
         import shapely
 
         self.tree = shapely.STRtree(self.faces)
+
+    def copy(self) -> Room:
+        """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
+        out = copy.copy(self)
+        out.extra, out._bounds = list(self.extra), list(self._bounds)
+        return out
 
     def add(self, geoms) -> None:
         """Place shapely geometries (tabs, label boxes, leaders) on the piece."""

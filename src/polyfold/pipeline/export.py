@@ -85,7 +85,8 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
         glue=tuple(GlueRow(label=g.label, pieces=(pieces[g.pieces[0]].name, pieces[g.pieces[1]].name),
                            between_parts=pieces[g.pieces[0]].part != pieces[g.pieces[1]].part,
                            tab_on=pieces[g.tab_piece].name if g.tab_piece is not None else None,
-                           mesh_vertices=tuple(int(v) for v in g.mesh_edge)) for g in sheets.glue))
+                           mesh_vertices=tuple(int(v) for v in g.mesh_edge), printed_label=g.printed)
+                    for g in sheets.glue))
 
 
 def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],

@@ -111,6 +111,7 @@ class LayoutReport:
     reduced_tabs: tuple[tuple[str, str], ...] = ()  # (edge label, why): "flatter", "lower", "tapered", "split", "glue strip"
     labels_on_tabs: int = 0
     labels_outside: int = 0  # beside their edge, with a leader line when further away
+    seam_runs: int = 0  # runs of several glue edges printed with one label (no room for one per edge)
     min_label_mm: float = 2.0  # the least cap height asked for
     splits_for_packing: int = 0  # creases cut so that the pieces fill fewer pages
     packing_ran_out: bool = False  # the packer's time budget stopped its search
@@ -214,13 +215,15 @@ class AssemblyPiece:
 @dataclass(frozen=True)
 class GlueRow:
     """Two cut edges glued together: their label, the two pieces, whether they join two parts,
-    the piece whose side carries the tab (None: no tab fits), the mesh edge's two vertices."""
+    the piece whose side carries the tab (None: no tab fits), the mesh edge's two vertices, and
+    the label printed for them (their own, or that of the seam run they are in)."""
 
     label: str
     pieces: tuple[str, str]
     between_parts: bool
     tab_on: str | None
     mesh_vertices: tuple[int, int]
+    printed_label: str  # the label printed beside both copies: `label`, or its seam run's
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,9 @@ def make(
         if strips:
             say(f"{len(strips)} seam(s) had no room for a tab and get a glue strip (piece S + label): "
                 f"{', '.join(strips[:10])}{' ...' if len(strips) > 10 else ''}")
+        if lay.seam_runs:
+            say(f"no room for a {lay.min_label_mm:g} mm label beside every glue edge: {lay.seam_runs} seam run(s) of "
+                "consecutive edges have one label each, their ends ticked (see instructions.html)")
         if lay.small_labels:
             say(f"warning: {lay.small_labels} label(s) found no free place at {lay.min_label_mm:g} mm and are "
                 "printed over their face (try a larger --size or a smaller --min-label-mm)")
