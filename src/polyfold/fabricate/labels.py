@@ -16,6 +16,10 @@ label goes, in order:
    any face of the piece, its leader line crossing the piece's lines if it must;
 5. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
+
+One label may stand for a seam run (`PieceLabels.run`, chosen by `pieces.build_sheet_pieces`
+when a label per edge does not fit): consecutive sides of one copy, the label beside any of them
+(stages 1-3 from the middle side out, then 4), a tick (TICK_MM) into the face at both ends.
 """
 
 from __future__ import annotations

@@ -26,6 +26,11 @@ def _png_b64(mesh: Mesh, part_faces: list[np.ndarray], highlight: int | None) ->
     return base64.b64encode(png_bytes(img)).decode("ascii")
 
 
+def _edge(g) -> str:
+    """An edge's row name: its label, and the seam run's label printed for it."""
+    return g.label if g.printed == g.label else f"{g.label} (run {g.printed})"
+
+
 def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], pieces, glue, page_of_piece: list[int],
                       n_pages: int, opts: MakeOptions, sheet_files: list[str]) -> str:
     """instructions.html: the model with its parts in colour, the sheets, and per part its pieces
@@ -54,7 +59,11 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
          "and tucks under the other copy). Every edge label appears twice: glue the tab of one copy under "
          "the other copy. A label that has no room in its face is printed on its tab or beside its edge "
          "(with a thin leader line); a seam with no room for a tab has a glue strip (piece S and the "
-         "label): glue it behind both copies.</p>",
+         "label): glue it behind both copies.</p>"
+         + ("<p>Some seams are too dense for a label per edge: there, one label names a whole <b>seam "
+            "run</b>, several edges in a row between two short ticks drawn into the faces. Glue the run "
+            "between the ticks to the run with the same label between its ticks, edge by edge (the tables "
+            "list each edge with its run's label).</p>" if any(g.printed != g.label for g in glue) else ""),
          "<h2>Sheets</h2>"]
     for f in sheet_files:
         h.append(f"<img class='sheet' src='{escape(f)}' alt='{escape(f)}'>")
@@ -68,7 +77,7 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
             for g in sorted(inside, key=lambda g: int(g.label)):
                 a, b = pieces[g.pieces[0]].name, pieces[g.pieces[1]].name
                 tab = pieces[g.tab_piece].name if g.tab_piece is not None else "none (tape it)"
-                h.append(f"<tr><td>{g.label}</td><td>{a} &harr; {b}</td><td>{tab}</td></tr>")
+                h.append(f"<tr><td>{_edge(g)}</td><td>{a} &harr; {b}</td><td>{tab}</td></tr>")
             h.append("</table>")
         h.append("</div>")
     between = [g for g in glue if pieces[g.pieces[0]].part != pieces[g.pieces[1]].part]
@@ -77,7 +86,7 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
         for g in sorted(between, key=lambda g: int(g.label)):
             a, b = pieces[g.pieces[0]], pieces[g.pieces[1]]
             tab = pieces[g.tab_piece].name if g.tab_piece is not None else "none (tape it)"
-            h.append(f"<tr><td>{g.label}</td><td>{a.name} (part {a.part + 1}) &harr; {b.name} (part {b.part + 1})"
+            h.append(f"<tr><td>{_edge(g)}</td><td>{a.name} (part {a.part + 1}) &harr; {b.name} (part {b.part + 1})"
                      f"</td><td>{tab}</td></tr>")
         h.append("</table>")
     h.append("<p>Every piece's folding path is in its <code>piece-*.fold</code> file "
