@@ -21,8 +21,11 @@ and measures (`Measures`):
   on the edge in the SVG), a face (a slit) or nothing;
 - untabbed: glue edges with no tab beyond either copy and no glue strip (a cut outline with no
   face, carrying the label twice); a label with a leader line stands for the edge at the
-  leader's other end; reduced tabs: tabs shallower than the full
-  tab, min(0.4 x edge, 6 mm) (today's full size), measured as the tab's depth from its edge;
+  leader's other end (a bent leader: lines joined end to end); a label printed for a seam run
+  (assembly.json's printed_label shared by several edges) stands for the run's edges, followed
+  corner by corner along the outline from the one nearest the label; reduced tabs: tabs
+  shallower than the full tab, min(0.4 x edge, 6 mm) (today's full size), measured as the tab's
+  depth from its edge;
 - wrong-way fold marks (per format: svg, dxf, pdf): a tab whose fold line along its edge is not
   drawn as its seam folds (mountain on a convex seam, valley on a concave one, seen from the
   printed side = the outside), or is not drawn; seams within FLAT_DEG of flat take either;
@@ -352,6 +355,28 @@ class _Page:
         return depth
 
 
+def _leader_end(leaders: list, first, at_label: int) -> np.ndarray:
+    """The far end of a leader drawn as connected lines (a bent leader), from its line `first`
+    whose end `at_label` (0 or -1) touches the label: each next line starts where the last ended."""
+    used = {id(first)}
+    end = np.asarray(first[-1 if at_label == 0 else 0], dtype=float)
+    while True:
+        nxt = None
+        for line in leaders:
+            if id(line) in used:
+                continue
+            for k in (0, -1):
+                if np.linalg.norm(np.asarray(line[k], dtype=float) - end) < 1e-3:
+                    nxt = (line, k)
+                    break
+            if nxt:
+                break
+        if nxt is None:
+            return end
+        used.add(id(nxt[0]))
+        end = np.asarray(nxt[0][-1 if nxt[1] == 0 else 0], dtype=float)
+
+
 def _distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     """Distance from point p to segment a-b."""
     ab = b - a
@@ -484,7 +509,7 @@ def measure_folder(folder: str | Path, mesh_path: str | Path) -> Measures:
                 ends = [shapely.Point(*line[0]), shapely.Point(*line[-1])]
                 touch = [box.distance(e) < LEADER_TOUCH_MM for e in ends]
                 if touch[0] != touch[1]:
-                    xy = np.asarray(line[-1] if touch[0] else line[0], dtype=float)
+                    xy = _leader_end(sheet.leaders, line, 0 if touch[0] else -1)
                     break
             where.setdefault(lb.text, []).append((k, xy))
     untabbed, wrong, flat_cut, reduced, n_tabs = [], {f: [] for f in formats}, [], 0, 0

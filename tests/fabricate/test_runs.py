@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from shapely.geometry import LineString, Point, Polygon
 
-from polyfold.fabricate.labels import TICK_MM, PieceLabels, label_font
+from polyfold.fabricate.labels import TICK_MM, PieceLabels, label_font, text_width
 from polyfold.fabricate.pieces import seam_runs
 from polyfold.fabricate.tabs import CutSide, Room
 
@@ -78,3 +78,41 @@ def test_a_single_edge_run_has_no_ticks() -> None:
     assert labels.leaders == [] and labels.stats.runs == 0
     assert [item.text for item in labels.items] == ["12"]
     assert labels.items[0].size == pytest.approx(label_font(2.0))
+
+
+def test_grid_search_goes_around_a_wall_through_its_gap() -> None:
+    from polyfold.fabricate.labels import _grid_bfs
+
+    free = np.ones((20, 20), dtype=bool)
+    free[10, :] = False  # a wall across the grid ...
+    free[10, 17] = True  # ... with a gap near its right end
+    ok = np.zeros((1, 20, 20), dtype=bool)
+    ok[0, 15, 2] = True  # the only free spot: beyond the wall, on the left
+    dist, found = _grid_bfs(free, 5, 2, 100, ok, 5)
+    assert found.tolist() == [[0, 15, 2]]
+    assert dist[10, 17] > 0 and dist[10, 5] == -1  # through the gap, never through the wall
+    # the straight way would be 10 steps; around through the gap it is longer
+    assert dist[15, 2] > 10
+    # a step limit stops the search before it gets there
+    assert len(_grid_bfs(free, 5, 2, 10, ok, 5)[1]) == 0
+
+
+def test_a_bent_leader_leaves_a_pocket_of_labels_and_keeps_clear_of_them() -> None:
+    from polyfold.fabricate.labels import _Taken, text_box
+
+    face = np.array([[-40.0, -40.0], [40.0, -40.0], [0.0, 40.0]])
+    labels = PieceLabels(Room(np.array([Polygon(face)], dtype=object)), label_font(2.0))
+    # p in a corridor of labels too narrow for one, closed on the right, its left end facing a
+    # column of labels: the way to a free spot turns around a corner
+    at = ([(x, y) for x in (-7.0, -2.0, 3.0) for y in (-2.2, 2.2)] + [(6.5, 0.0)]
+          + [(-13.0, y) for y in (-6.0, -4.0, -2.0, 0.0, 2.0, 4.0, 6.0)])
+    boxes = [Polygon(text_box(np.array(q), np.array([1.0, 0.0]), "888", labels.size)) for q in at]
+    for b in boxes:
+        labels.boxes.add(np.asarray(b.exterior.coords)[:4])
+    p = np.zeros(2)
+    _k, centre, pts = next(_Taken(labels).routed_near(p, [(text_width("888", labels.size), 2.0)], 10))
+    assert np.allclose(pts[0], p) and len(pts) > 2  # bent
+    assert any(LineString([p, centre]).intersects(b) for b in boxes)  # the straight way is blocked
+    assert min(LineString(pts).distance(b) for b in boxes) > 0.1  # no stretch crosses or grazes a label
+    spot = Polygon(text_box(centre, np.array([1.0, 0.0]), "888", labels.size))
+    assert not any(spot.intersects(b) for b in boxes)

@@ -13,7 +13,9 @@ label goes, in order:
    further out than the tab room around the piece's convex hull (`tabs.TAB_ROOM_MM`), which
    fitting pieces to the page reserves;
 4. else the free spot nearest the edge, up to ELSEWHERE_MM away: off the faces as in 3, or inside
-   any face of the piece, its leader line crossing the piece's lines if it must;
+   any face of the piece, its leader line crossing the piece's lines if it must (never a label);
+   where no straight leader gets out between the labels around, a bent one (straight stretches
+   through the gaps, found breadth first on the piece's raster: `_Taken.routed_near`);
 5. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
 
@@ -25,9 +27,11 @@ when a label per edge does not fit): consecutive sides of one copy, the label be
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT
@@ -196,6 +200,40 @@ def _reading(u: np.ndarray) -> np.ndarray:
     return np.array([math.cos(a), -math.sin(a)])
 
 
+@njit(cache=True)
+def _grid_bfs(free, sr, sc, max_steps, ok, want):
+    """Breadth-first search over the True cells of `free` (ny, nx) from cell (sr, sc), 8
+    neighbours, at most max_steps steps: (steps to each cell, -1 unreached; (n, 3) the first
+    `want` cells reached, in the order reached, that are True in a layer k of ok (K, ny, nx), as
+    (k, row, col))."""
+    ny, nx = free.shape
+    dist = np.full((ny, nx), -1, dtype=np.int32)
+    queue = np.empty((ny * nx, 2), dtype=np.int64)
+    found = np.empty((want, 3), dtype=np.int64)
+    n_found = 0
+    dist[sr, sc] = 0
+    queue[0, 0], queue[0, 1] = sr, sc
+    head, tail = 0, 1
+    while head < tail and n_found < want:
+        r, c = queue[head, 0], queue[head, 1]
+        head += 1
+        d = dist[r, c]
+        if d >= max_steps:
+            continue
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                rr, cc = r + dr, c + dc
+                if 0 <= rr < ny and 0 <= cc < nx and dist[rr, cc] < 0 and free[rr, cc]:
+                    dist[rr, cc] = d + 1
+                    queue[tail, 0], queue[tail, 1] = rr, cc
+                    tail += 1
+                    for k in range(ok.shape[0]):
+                        if ok[k, rr, cc] and n_found < want:
+                            found[n_found, 0], found[n_found, 1], found[n_found, 2] = k, rr, cc
+                            n_found += 1
+    return dist, found[:n_found]
+
+
 class _Taken:
     """A raster (FREE_CELL_MM cells) of what a label may not touch on one piece, for finding free
     spots fast: every face side (outline, creases and the sides inside flat polygons alike),
@@ -263,6 +301,11 @@ class _Taken:
         if text:
             self._fill(self.texts, geom, LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM)
 
+    def close(self, geom) -> None:
+        """No later leader path through the cells of `geom` (a bent leader: `routed_near` paths
+        go around it, straight leaders rarely cross it; labels may still sit beside it)."""
+        self._fill(self.texts, geom, 0.5 * FREE_CELL_MM)
+
     def _fill(self, grid: np.ndarray, geom, grow: float) -> None:
         import shapely
 
@@ -306,6 +349,59 @@ class _Taken:
             if sum(len(f) for f in found) >= want:
                 break
         return np.concatenate(found)[:want] if found else np.zeros((0, 2))
+
+
+    def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
+                    ) -> Iterator[tuple[int, np.ndarray, np.ndarray]]:
+        """Free boxes (as `free_near`, one of `sizes` (w, h) each, centred in a face or off the
+        faces) that a bent leader reaches from p: a path of cells no label takes, breadth first
+        over 8 neighbours up to ELSEWHERE_MM long. Up to `want`, nearest along the path first:
+        (index into sizes, centre, the leader's points from p to the centre, kept at its turns:
+        each stretch is clear of labels), each path made when asked for."""
+        (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
+        free = ~self.texts[r0:r1 + 1, c0:c1 + 1]
+        sc, sr = self._cells(p[None])[0] - (c0, r0)
+        free[sr, sc] = True
+        # centres of free windows, per size (summed-area table of taken cells, as free_near)
+        sub = self.grid[r0:r1 + 1, c0:c1 + 1]
+        s_area = np.pad(np.cumsum(np.cumsum(sub, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
+        centres = []
+        for w, h in sizes:
+            hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
+            ok = np.zeros_like(sub)
+            kh, kw = 2 * hh + 1, 2 * hw + 1
+            if sub.shape[0] > kh and sub.shape[1] > kw:
+                count = s_area[kh:, kw:] - s_area[:-kh, kw:] - s_area[kh:, :-kw] + s_area[:-kh, :-kw]
+                ok[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
+            centres.append(ok)
+        dist, found = _grid_bfs(free, int(sr), int(sc), int(ELSEWHERE_MM / FREE_CELL_MM), np.stack(centres), want)
+        for k, r, c in found.tolist():
+            path = [(r, c)]
+            while dist[path[-1]] > 0:  # back to p, one step nearer each time (straightest first)
+                r, c = path[-1]
+                d = dist[r, c]
+                step_to = [(r + dr, c + dc) for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+                           if 0 <= r + dr < dist.shape[0] and 0 <= c + dc < dist.shape[1] and dist[r + dr, c + dc] == d - 1]
+                path.append(step_to[0])
+            pts = self.origin + (np.array(path[::-1])[:, ::-1] + np.array([c0, r0]) + 0.5) * FREE_CELL_MM
+            pts[0] = p
+            yield k, pts[-1].copy(), self._turns(pts)
+
+    def _turns(self, pts: np.ndarray) -> np.ndarray:
+        """A path of cell centres cut to its turns: from each kept point the farthest later one a
+        straight stretch reaches without crossing a label."""
+        keep = [0]
+        while keep[-1] < len(pts) - 1:
+            i = keep[-1]
+            j = len(pts) - 1
+            while j > i + 1:
+                t = np.linspace(0.0, 1.0, int(math.ceil(np.linalg.norm(pts[j] - pts[i]) / LEADER_STEP_MM)) + 1)
+                ij = self._cells(pts[i] + t[:, None] * (pts[j] - pts[i]))
+                if not self.texts[ij[:, 1], ij[:, 0]].any():
+                    break
+                j -= 1
+            keep.append(j)
+        return pts[keep]
 
 
 class PieceLabels:
@@ -500,14 +596,13 @@ class PieceLabels:
 
     def _elsewhere(self, text: str, sides: list[CutSide]) -> bool:
         """4. The free spot nearest the middle of an edge of `sides` (a run's, middle one first;
-        failing that, a quarter of the way along it from either end), up to ELSEWHERE_MM away, the label level (failing that,
-        upright): inside a face of the piece (LABEL_PAD_MM from its sides) or off the faces (as in
-        3), with a leader line from there on the edge that may cross the piece's lines but no
-        label. Candidates come from the piece's `_Taken` raster, nearest first; each is checked
-        exactly. After ELSEWHERE_GIVE_UP labels without a spot the piece is not searched again (a
-        mesh that dense needs a larger --size)."""
-        from shapely.geometry import LineString, Polygon
-
+        failing that, a quarter of the way along it from either end), up to ELSEWHERE_MM away,
+        the label level (failing that, upright): inside a face of the piece (LABEL_PAD_MM from its
+        sides) or off the faces (as in 3), with a leader line from there on the edge that may
+        cross the piece's lines but no label; failing a straight leader, a bent one from the
+        middle side (`_Taken.routed_near`). Candidates come from the piece's `_Taken` raster,
+        nearest first; each is checked exactly (`_leader_spot`). After ELSEWHERE_GIVE_UP labels
+        without a spot the piece is not searched again (a mesh that dense needs a larger --size)."""
         if self._no_spot >= ELSEWHERE_GIVE_UP:
             return False
         if self._taken is None:
@@ -525,27 +620,49 @@ class PieceLabels:
                                 yield mid, u, c
 
         for mid, u, center in tries():
-            box = text_box(center, u, text, self.size)
-            if self._hits(box):
-                continue
-            poly = Polygon(box)
-            in_face = any(_inside_triangle(np.asarray(self.room.faces[f].exterior.coords)[:3], box, LABEL_PAD_MM)
-                          for f in self.room.tree.query(poly))
-            if not in_face and (not self.allowed.contains(poly) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
-                continue
-            end = _nearest_on(poly, mid)
-            strip = LineString([mid, end]).buffer(LEADER_HALF_MM)
-            if self.boxes.hits_geom(strip):
-                continue
-            self.leaders.append(np.array([mid, end]))
-            self._put(text, center, u, self.size, "edge-label", box)
-            self.strips.add_geom(strip)  # later labels keep off it (leaders may cross)
-            self._taken.mark(strip, LABEL_PAD_MM)
-            if not in_face:
-                self._off_faces([poly])
-            return True
+            if self._leader_spot(text, u, center, np.array([mid, center]), bent=False):
+                return True
+        # no straight leader gets out between the labels around: a bent one from the middle side
+        mid = sides[0].p0 + 0.5 * (sides[0].p1 - sides[0].p0)
+        for k, center, pts in self._taken.routed_near(mid, [(w, h), (h, w)], ELSEWHERE_TRIES):
+            if self._leader_spot(text, (level, upward)[k], center, pts, bent=True):
+                return True
         self._no_spot += 1
         return False
+
+    def _leader_spot(self, text: str, u: np.ndarray, center: np.ndarray, path: np.ndarray, bent: bool) -> bool:
+        """Stage 4's exact check and placement: the label at `center` (reading along u) with a
+        leader along `path` (points from the edge into the box; cut where it meets the box), when
+        the box keeps clear of labels, leaders and lines (in a face) or of the piece (off the
+        faces, in its room) and the leader crosses no label. A bent leader is crossed by no
+        later bent leader (it reads as one line: no other runs through its turns)."""
+        from shapely.geometry import LineString, Point, Polygon
+
+        box = text_box(center, u, text, self.size)
+        if self._hits(box):
+            return False
+        poly = Polygon(box)
+        in_face = any(_inside_triangle(np.asarray(self.room.faces[f].exterior.coords)[:3], box, LABEL_PAD_MM)
+                      for f in self.room.tree.query(poly))
+        if not in_face and (not self.allowed.contains(poly) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
+            return False
+        grown = poly.buffer(LABEL_PAD_MM)
+        outside = [q for q in path[:-1] if not grown.contains(Point(*q))]
+        if not outside:
+            return False
+        line = np.array([*outside, _nearest_on(poly, outside[-1])])
+        strip = LineString(line).buffer(LEADER_HALF_MM)
+        if self.boxes.hits_geom(strip):
+            return False
+        self.leaders.extend(np.array([a, b]) for a, b in zip(line[:-1], line[1:]))
+        self._put(text, center, u, self.size, "edge-label", box)
+        self.strips.add_geom(strip)  # later labels keep off it (straight leaders may cross)
+        self._taken.mark(strip, LABEL_PAD_MM)
+        if bent:
+            self._taken.close(strip)
+        if not in_face:
+            self._off_faces([poly])
+        return True
 
     def _on_tab(self, text: str, u: np.ndarray, parts, folds, n_out: np.ndarray, h: float) -> bool:
         """2. On a part of the side's tab, along its fold line, inside it with LABEL_PAD_MM."""
