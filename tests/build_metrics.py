@@ -265,19 +265,22 @@ class _Page:
                  or any(set(self.side(a[k], b[k], s)) == {"face"} for s in (1.0, -1.0))]
         cornered = [k for k in faced if self._cornered(a[k], b[k], corners, 10 * tol)]
         first = set(cornered)
-        return [(a[k], b[k], k in first) for k in cornered + [k for k in faced if k not in first]]
+        ranked = cornered + [k for k in faced if k not in first]
+        # a cut edge (face on one side only) before a crease of the same length
+        ranked.sort(key=lambda k: not self._outline_side(a[k], b[k]))
+        return [(a[k], b[k], k in first) for k in ranked]
 
     def follow(self, p: np.ndarray, back: np.ndarray, length: float,
                corners: list[tuple[float, float]]) -> np.ndarray | None:
         """The next corner along a seam run: a printed point `length` mm from p (not `back`, the
-        corner before p) such that p to it is a face edge (a face all along one side), one whose
+        corner before p) such that p to it is a cut edge (a face all along one side only, not a
+        crease between two faces), one whose
         face's third corner is printed where the mesh puts it taken first."""
         d = np.linalg.norm(self.points - p, axis=1)
         tol = LENGTH_TOL_MM + 1e-5 * length
         for tol in (tol, 10 * tol):  # as `locate`: then a corner merged with a tab corner close by
             cand = self.points[(np.abs(d - length) <= tol) & (np.linalg.norm(self.points - back, axis=1) > tol)]
-            faced = [r for r in cand if not self.has_faces
-                     or any(set(self.side(p, r, s)) == {"face"} for s in (1.0, -1.0))]
+            faced = [r for r in cand if not self.has_faces or self._outline_side(p, r)]
             cornered = [r for r in faced if self._cornered(p, r, corners, 10 * tol)]
             if cornered or faced:
                 return (cornered or faced)[0]
@@ -316,6 +319,11 @@ class _Page:
                 if len(pos) == k + 1:
                     return [(pos[i], pos[i + 1]) for i in range(k)]
         return None
+
+    def _outline_side(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """True when segment a-b has a face all along one side and not all along the other."""
+        faced = [set(self.side(a, b, s)) == {"face"} for s in (1.0, -1.0)]
+        return faced[0] != faced[1]
 
     def _cornered(self, a: np.ndarray, b: np.ndarray, corners, tol: float) -> bool:
         """True when a printed point lies at one of the (from a, from b) distance pairs of
