@@ -302,8 +302,8 @@ class _Taken:
             self._fill(self.texts, geom, LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM)
 
     def close(self, geom) -> None:
-        """No later leader path through the cells of `geom` (a bent leader: `routed_near` paths
-        go around it, straight leaders rarely cross it; labels may still sit beside it)."""
+        """No later leader path through the cells at `geom` (a bent leader's turns: `routed_near`
+        paths go around them; labels may still sit beside them)."""
         self._fill(self.texts, geom, 0.5 * FREE_CELL_MM)
 
     def _fill(self, grid: np.ndarray, geom, grow: float) -> None:
@@ -634,9 +634,9 @@ class PieceLabels:
         """Stage 4's exact check and placement: the label at `center` (reading along u) with a
         leader along `path` (points from the edge into the box; cut where it meets the box), when
         the box keeps clear of labels, leaders and lines (in a face) or of the piece (off the
-        faces, in its room) and the leader crosses no label. A bent leader is crossed by no
-        later bent leader (it reads as one line: no other runs through its turns)."""
-        from shapely.geometry import LineString, Point, Polygon
+        faces, in its room) and the leader crosses no label. No later bent leader runs through
+        a bent leader's turns (it reads as one line, joined end to end; crossing is allowed)."""
+        from shapely.geometry import LineString, MultiPoint, Point, Polygon
 
         box = text_box(center, u, text, self.size)
         if self._hits(box):
@@ -658,8 +658,8 @@ class PieceLabels:
         self._put(text, center, u, self.size, "edge-label", box)
         self.strips.add_geom(strip)  # later labels keep off it (straight leaders may cross)
         self._taken.mark(strip, LABEL_PAD_MM)
-        if bent:
-            self._taken.close(strip)
+        if bent and len(line) > 2:
+            self._taken.close(MultiPoint(line[1:-1]))
         if not in_face:
             self._off_faces([poly])
         return True
