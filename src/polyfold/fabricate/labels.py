@@ -200,6 +200,21 @@ def _reading(u: np.ndarray) -> np.ndarray:
     return np.array([math.cos(a), -math.sin(a)])
 
 
+def _free_centres(taken: np.ndarray, w: float, h: float) -> np.ndarray:
+    """(ny, nx) bool: the cells of the raster `taken` that centre a w x h mm box of cells none of
+    which is taken (2 ceil(h / 2 cell) + 1 rows by 2 ceil(w / 2 cell) + 1 columns, all inside the
+    raster), counted by a summed-area table."""
+    hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
+    out = np.zeros(taken.shape, dtype=bool)
+    kh, kw = 2 * hh + 1, 2 * hw + 1
+    if taken.shape[0] < kh or taken.shape[1] < kw:
+        return out
+    s = np.pad(np.cumsum(np.cumsum(taken, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
+    count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
+    out[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
+    return out
+
+
 @njit(cache=True)
 def _grid_bfs(free, sr, sc, max_steps, ok, want):
     """Breadth-first search over the True cells of `free` (ny, nx) from cell (sr, sc), 8
@@ -323,15 +338,10 @@ class _Taken:
         face (`inside`) or off the faces."""
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         sub = self.grid[r0:r1 + 1, c0:c1 + 1]
-        hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
-        if sub.shape[0] <= 2 * hh or sub.shape[1] <= 2 * hw or sub.all():
+        if sub.all():
             return np.zeros((0, 2))
-        # taken cells in every window of (2 hh + 1) x (2 hw + 1) cells, by a summed-area table
-        s = np.pad(np.cumsum(np.cumsum(sub, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
-        kh, kw = 2 * hh + 1, 2 * hw + 1
-        count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
-        rows, cols = np.nonzero((count == 0) & (self.in_faces[r0 + hh:r1 + 1 - hh, c0 + hw:c1 + 1 - hw] == inside))
-        centres = self.origin + (np.stack([cols + c0 + hw, rows + r0 + hh], axis=1) + 0.5) * FREE_CELL_MM
+        rows, cols = np.nonzero(_free_centres(sub, w, h) & (self.in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
+        centres = self.origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
         d2 = ((centres - p) ** 2).sum(axis=1)
         near = np.flatnonzero(d2 <= ELSEWHERE_MM ** 2)
         if len(near) > LEADER_TRIES:
@@ -362,19 +372,9 @@ class _Taken:
         free = ~self.texts[r0:r1 + 1, c0:c1 + 1]
         sc, sr = self._cells(p[None])[0] - (c0, r0)
         free[sr, sc] = True
-        # centres of free windows, per size (summed-area table of taken cells, as free_near)
         sub = self.grid[r0:r1 + 1, c0:c1 + 1]
-        s_area = np.pad(np.cumsum(np.cumsum(sub, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
-        centres = []
-        for w, h in sizes:
-            hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
-            ok = np.zeros_like(sub)
-            kh, kw = 2 * hh + 1, 2 * hw + 1
-            if sub.shape[0] > kh and sub.shape[1] > kw:
-                count = s_area[kh:, kw:] - s_area[:-kh, kw:] - s_area[kh:, :-kw] + s_area[:-kh, :-kw]
-                ok[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
-            centres.append(ok)
-        dist, found = _grid_bfs(free, int(sr), int(sc), int(ELSEWHERE_MM / FREE_CELL_MM), np.stack(centres), want)
+        centres = np.stack([_free_centres(sub, w, h) for w, h in sizes])
+        dist, found = _grid_bfs(free, int(sr), int(sc), int(ELSEWHERE_MM / FREE_CELL_MM), centres, want)
         for k, r, c in found.tolist():
             path = [(r, c)]
             while dist[path[-1]] > 0:  # back to p, one step nearer each time (straightest first)
