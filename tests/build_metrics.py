@@ -23,7 +23,8 @@ and measures (`Measures`):
   face, carrying the label twice); a label with a leader line stands for the edge at the
   leader's other end (a bent leader: lines joined end to end); a label printed for a seam run
   (assembly.json's printed_label shared by several edges) stands for the run's edges, followed
-  corner by corner along the outline from the one nearest the label; reduced tabs: tabs
+  corner by corner along the outline from the one nearest the label, ending at the two ticks
+  (short leader lines) that mark the run's ends; reduced tabs: tabs
   shallower than the full tab, min(0.4 x edge, 6 mm) (today's full size), measured as the tab's
   depth from its edge;
 - wrong-way fold marks (per format: svg, dxf, pdf): a tab whose fold line along its edge is not
@@ -63,6 +64,7 @@ ON_LINE_MM = 0.02  # a fold line lies along an edge: both ends this close to its
 LEADER_TOUCH_MM = 0.05  # a leader line ends this close to its label's box
 OVERLAP_MM2 = 1e-3  # label boxes sharing less area than this only touch
 ANCHORS = 4  # per edge of a seam run and length tolerance: edges near its label tried as the start
+TICK_MAX_MM = 2.0  # a seam run's end mark: a leader line at most this long from a corner of its outline
 NOT_LABELS = ("title", "footer", "scale", "legend")  # text classes that are not glue or piece labels
 
 
@@ -223,6 +225,9 @@ class _Page:
         self.faces = shapely.union_all(faces).buffer(1e-3) if faces else shapely.Polygon()
         self.has_faces = bool(faces)
         self.tabs = shapely.difference(self.paper, self.faces)
+        # the ends of every short leader line: a seam run's end marks start at one of them
+        short = [line for line in svg.leaders if len(line) == 2 and np.linalg.norm(line[1] - line[0]) <= TICK_MAX_MM]
+        self.tick_ends = np.array([p for line in short for p in line]).reshape(-1, 2)
         shapely.prepare(self.paper)
         shapely.prepare(self.faces)
 
@@ -290,8 +295,9 @@ class _Page:
                    ) -> list[tuple[np.ndarray, np.ndarray]] | None:
         """The printed copy of a seam run (its mesh edges (v0, v1), (v1, v2), ... in order) whose
         label is at label_xy: one of its edges found near the label (as `locate` finds them,
-        nearest the label first), then the others corner by corner along the outline (`follow`).
-        Per edge its ends (printed points of v_i, v_i+1), or None."""
+        nearest the label first), then the others corner by corner along the outline (`follow`),
+        the run's two ends at its end marks (`_ticked`). Per edge its ends (printed points of v_i,
+        v_i+1), or None."""
         verts = [chain[0][0]] + [b for _a, b in chain]
         k = len(chain)
         length = [float(np.linalg.norm(model.vertices[a] - model.vertices[b])) * model.scale for a, b in chain]
@@ -316,9 +322,14 @@ class _Page:
                     if r is None:
                         break
                     pos[i] = r
-                if len(pos) == k + 1:
+                # the run found must end at its two end marks: its edges are often alike in length
+                if len(pos) == k + 1 and (k == 1 or (self._ticked(pos[0]) and self._ticked(pos[k]))):
                     return [(pos[i], pos[i + 1]) for i in range(k)]
         return None
+
+    def _ticked(self, p: np.ndarray) -> bool:
+        """Whether a short leader line (a seam run's end mark) starts or ends at point p."""
+        return bool(len(self.tick_ends)) and bool((np.linalg.norm(self.tick_ends - p, axis=1) <= ON_LINE_MM).any())
 
     def _outline_side(self, a: np.ndarray, b: np.ndarray) -> bool:
         """True when segment a-b has a face all along one side and not all along the other."""

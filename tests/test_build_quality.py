@@ -5,7 +5,8 @@ under 2 mm or overlapping another label or a line, no flat region cut, no outlin
 micrometre. On shared models chosen
 for what makes these hard (a fish of slivers and fans, bunnies and a horse crowded with labels, a
 cube and an L-prism of flat polygons), on a generated noisy sphere and on a Loop-subdivided bunny
-at 60 mm, too dense for a label per glue edge (labelled by seam run); bench/bench_build.py runs
+at 60 mm, too dense for a label per glue edge (labelled by seam run); on horse-302 at 60 mm, where
+one label has no readable place until its piece is cut (`splits_for_labels`); bench/bench_build.py runs
 all of them (hull-ellipsoid-rand-236 is left out here: the reader cannot find one edge among its
 0.1 mm slivers)."""
 
@@ -44,7 +45,8 @@ def _loop_bunny(path: Path, models_dir: Path) -> Path:
     return path
 
 
-CASES = [(name, 150.0) for name in MODELS] + [("noisy-sphere-320", 150.0), ("bunny-128-loop1", 60.0)]
+CASES = [(name, 150.0) for name in MODELS] + [("noisy-sphere-320", 150.0), ("bunny-128-loop1", 60.0), ("horse-302", 60.0)]
+CUT_FOR_LABELS = {("horse-302", 60.0)}  # labelled by seam run, one label without a place on the first drawing
 
 
 @pytest.mark.parametrize(("name", "size"), CASES)
@@ -58,8 +60,11 @@ def test_sheets_pass_the_build_checks(name: str, size: float, models_dir: Path, 
         mesh = models_dir / f"{name}.obj"
     result = make(mesh, tmp_path / "out", MakeOptions(size=size, time_limit=30))
     m = measure_folder(tmp_path / "out", mesh)
-    runs = result.report.stages.layout.seam_runs
-    assert (runs > 0) == name.endswith("loop1")
+    lay = result.report.stages.layout
+    runs = lay.seam_runs
+    assert (runs > 0) == (name.endswith("loop1") or (name, size) in CUT_FOR_LABELS)
+    assert lay.small_labels == 0
+    assert (lay.splits_for_labels > 0) == ((name, size) in CUT_FOR_LABELS)
     expected = {f"{runs} seam runs printed with one label"} if runs else set()
     assert set(m.notes) - {"pypdf not installed: PDF not measured"} == expected  # every copy found
     assert m.untabbed_labels == []

@@ -46,3 +46,26 @@ def test_text_widths_are_helveticas() -> None:
     assert text_width("I", 10.0) == pytest.approx(2.78)
     box = text_box(np.zeros(2), np.array([1.0, 0.0]), "10", 2.0)
     assert np.ptp(box[:, 0]) == pytest.approx(2.224) and np.ptp(box[:, 1]) == pytest.approx(CAP_HEIGHT * 2.0)
+
+
+def test_a_label_beside_its_edge_is_nearer_that_edge_than_any_other() -> None:
+    # edge A (y = 0) of a face too small for a label, the paper beyond it a 3.4 mm gap up to the cut
+    # edge B of another face: a label right beside A would sit nearer B, and a reader would take
+    # it for B's; it goes further out with a leader instead (or nearer A)
+    small = np.array([[0.0, 0.0], [3.0, 0.0], [1.5, -2.0]])
+    big = np.array([[8.0, 3.4], [-5.0, 3.4], [1.5, 20.0]])
+    room = Room(np.array([Polygon(small), Polygon(big)], dtype=object))
+    a = CutSide(0, 0, 0, small[1], small[0], small)  # outward +y
+    sides = np.array([[small[0], small[1]], [small[1], small[2]], [small[2], small[0]],
+                      [big[0], big[1]], [big[1], big[2]], [big[2], big[0]]])
+    labels = PieceLabels(room, label_font(2.0), sides)
+    labels.edge(a, "12")
+    assert labels.stats.unplaced == 0
+    (item,) = labels.items
+    p = np.array([item.x, item.y])
+    if not labels.leaders:
+        from_a = LineString([a.p0, a.p1]).distance(Point(*p))
+        from_b = LineString([big[0], big[1]]).distance(Point(*p))
+        assert from_a < from_b
+    else:  # a leader from A's middle to the label
+        assert LineString([a.p0, a.p1]).distance(Point(*labels.leaders[0][0])) < 1e-9

@@ -54,7 +54,7 @@ def test_a_run_gets_one_label_and_a_tick_into_its_face_at_each_end() -> None:
     tris = [np.array([[x, 0.0], [x + 4.0, 0.0], [x + 2.0, 3.0]]) for x in (0.0, 4.0, 8.0)]
     room = Room(np.array([Polygon(t) for t in tris], dtype=object))
     labels = PieceLabels(room, label_font(2.0))
-    sides = [(CutSide(0, f, 0, t[0], t[1], t), (), None, None) for f, t in enumerate(tris)]
+    sides = [(CutSide(0, f, 0, t[0], t[1], t), (), None) for f, t in enumerate(tris)]
     labels.run("7", sides)
     assert (labels.stats.runs, labels.stats.unplaced) == (1, 0)
     assert [item.text for item in labels.items] == ["7"]

@@ -14,7 +14,7 @@ from polyfold.fabricate.fit import model_scale
 from polyfold.fabricate.pack import pack_outlines
 from polyfold.fabricate.paper import GAP_MM
 from polyfold.fabricate.pieces import build_sheet_pieces
-from polyfold.fabricate.split import MIN_PART, MIN_PART_FACES, _Tree, plan_pages
+from polyfold.fabricate.split import LABEL_SPLIT_LEAST, MIN_PART, MIN_PART_FACES, _Tree, plan_label_cuts, plan_pages
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.geometry import merged_edges
 from polyfold.pipeline.options import MakeOptions, paper_size
@@ -80,6 +80,34 @@ def test_plan_cuts_only_creases_and_names_every_part_once(bunny):
             faces = piece_net(cut, k)[1]  # tabs), and at least two faces
             assert faces_area(piece, faces) >= lo * (1 - 1e-9) and len(faces) >= MIN_PART_FACES
     assert n_parts == len(p.order) == len(bunny["pieces"]) + sum(len(c) for c in p.cuts)
+
+
+def test_a_crowded_spot_is_cut_through_by_a_crease_that_leaves_two_real_parts(bunny):
+    pieces, nets = bunny["pieces"], [inp.net for inp in bunny["inputs"]]
+    big = int(np.argmax([len(p.faces_xy) for p in pieces]))
+    piece = pieces[big]
+    # the spot: the face nearest the middle of the piece (a label with no place, at its centroid)
+    centroids = piece.faces_xy.mean(axis=1)
+    mid = int(np.argmin(np.linalg.norm(centroids - centroids.mean(axis=0), axis=1)))
+    spot = centroids[mid]
+    size = np.linalg.norm(piece.faces_xy[mid] - np.roll(piece.faces_xy[mid], 1, axis=0), axis=1).max()
+    cuts = plan_label_cuts(pieces, nets, [(big, float(spot[0]), float(spot[1]))])
+    assert [len(c) for c in cuts] == [1 if i == big else 0 for i in range(len(pieces))]
+    (f,) = cuts[big]
+    net = nets[big]
+    assert net.parent_edge[f] >= 0  # a crease
+    # it runs past the spot: one of the spot's face's sides or a crease within a face's size of it
+    k = int(np.argmax(net.mesh.topology.face_edges[f] == net.parent_edge[f]))
+    a, b = piece.faces_xy[f, k], piece.faces_xy[f, (k + 1) % 3]
+    t = np.clip(np.dot(spot - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+    assert np.linalg.norm(a + t * (b - a) - spot) < size
+    cut = cut_creases(net, cuts[big])
+    assert cut.n_pieces == 2
+    whole = faces_area(piece, np.arange(len(piece.faces_xy)))
+    for part in range(2):
+        faces = piece_net(cut, part)[1]
+        assert len(faces) >= MIN_PART_FACES
+        assert faces_area(piece, faces) >= 0.5 * LABEL_SPLIT_LEAST * whole  # (tab room and labels aside)
 
 
 def faces_area(piece, faces) -> float:

@@ -50,7 +50,7 @@ def test_bumpy_is_split_to_fill_its_pages(models_dir, tmp_path):
     lay = report.stages.layout
     assert lay.pages <= 4 and lay.splits_for_packing > 0 and lay.utilisation > 0.4
     net_pieces = [r for r in report.pieces if r.faces > 0]  # not the glue strips
-    assert len(net_pieces) == 1 + lay.splits_for_page + lay.splits_for_packing  # one part, one net
+    assert len(net_pieces) == 1 + lay.splits_for_page + lay.splits_for_labels + lay.splits_for_packing  # one part, one net
     assert sum(r.faces for r in report.pieces) == report.input.faces
 
 

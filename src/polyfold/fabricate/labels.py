@@ -8,7 +8,8 @@ label goes, in order:
    face's incentre);
 2. on the side's glue tab, when this side carries it;
 3. just outside the edge (beyond the tab on the side that has one), clear of the piece's faces,
-   tabs and labels, else a little further in a free spot with a leader line from the edge: an
+   tabs and labels and nearer the edge than any other cut side of the piece (`cut_sides`), else
+   a little further in a free spot with a leader line from the edge: an
    off-face label, which the packer keeps clear of other pieces (`SheetPiece.footprint`), never
    further out than the tab room around the piece's convex hull (`tabs.TAB_ROOM_MM`), which
    fitting pieces to the page reserves;
@@ -16,7 +17,9 @@ label goes, in order:
    any face of the piece, its leader line crossing the piece's lines if it must (never a label);
    where no straight leader gets out between the labels around, a bent one (straight stretches
    through the gaps, found breadth first on the piece's raster: `_Taken.routed_near`);
-5. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced`.
+5. when nothing fits: inside the face at the centroid, counted in `LabelStats.unplaced` and
+   listed in `crowded` (make cuts such a piece there and draws it again:
+   `pipeline.sheets._split_for_labels`).
 Every box keeps LABEL_PAD_MM from the lines around it and from other labels.
 
 One label may stand for a seam run (`PieceLabels.run`, chosen by `pieces.build_sheet_pieces`
@@ -175,6 +178,13 @@ def _nearest_on(poly, p: np.ndarray) -> np.ndarray:
     return np.asarray(ring.interpolate(ring.project(Point(*p))).coords[0])
 
 
+def _segment_distances(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """(k,) distances from point p (2,) to the segments (k, 2, 2)."""
+    a, ab = segments[:, 0], segments[:, 1] - segments[:, 0]
+    t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(a + t[:, None] * ab - p, axis=1)
+
+
 def _end_away(side: CutSide, neighbour: CutSide) -> np.ndarray:
     """The end of `side` away from `neighbour`, the next side along the same run (they share
     the other end)."""
@@ -200,11 +210,16 @@ def _reading(u: np.ndarray) -> np.ndarray:
     return np.array([math.cos(a), -math.sin(a)])
 
 
+def _half_cells(size: float) -> int:
+    """Cells a box reaches on each side of its centre cell along a side `size` mm long."""
+    return int(math.ceil(size / 2 / FREE_CELL_MM - 1e-9))
+
+
 def _free_centres(taken: np.ndarray, w: float, h: float) -> np.ndarray:
     """(ny, nx) bool: the cells of the raster `taken` that centre a w x h mm box of cells none of
     which is taken (2 ceil(h / 2 cell) + 1 rows by 2 ceil(w / 2 cell) + 1 columns, all inside the
     raster), counted by a summed-area table."""
-    hw, hh = int(math.ceil(w / 2 / FREE_CELL_MM)), int(math.ceil(h / 2 / FREE_CELL_MM))
+    hw, hh = _half_cells(w), _half_cells(h)
     out = np.zeros(taken.shape, dtype=bool)
     kh, kw = 2 * hh + 1, 2 * hw + 1
     if taken.shape[0] < kh or taken.shape[1] < kw:
@@ -276,6 +291,7 @@ class _Taken:
         self.grid = (cx[None, :] < lo[:, None]) | (cx[None, :] > hi[:, None])  # (ny, nx), True = taken
         self.texts = np.zeros_like(self.grid)  # the labels alone (a leader may not cross them)
         self._last = np.array([nx - 1, ny - 1], dtype=np.int32)
+        self._free: dict[tuple[int, int], np.ndarray] = {}  # `free`'s maps by half box size in cells
         # face sides: points every half cell along them, then grown by a disc
         tri = shapely.get_coordinates(np.asarray(labels.room.faces, dtype=object)).reshape(-1, 4, 2)[:, :3]
         a, b = tri.reshape(-1, 2), np.roll(tri, -1, axis=1).reshape(-1, 2)
@@ -331,16 +347,35 @@ class _Taken:
         cy = self.origin[1] + (np.arange(r0, r1 + 1) + 0.5) * FREE_CELL_MM
         gx, gy = np.meshgrid(cx, cy)
         grid[r0:r1 + 1, c0:c1 + 1] |= shapely.contains_xy(g, gx, gy)
+        if grid is self.grid:
+            self._refresh(r0, r1, c0, c1)
+
+    def free(self, w: float, h: float) -> np.ndarray:
+        """(ny, nx) `_free_centres` of the whole raster for w x h mm boxes, kept up to date as
+        cells are taken (`_refresh`): a label is looked for a dozen times between two placements."""
+        key = (_half_cells(w), _half_cells(h))
+        if key not in self._free:
+            self._free[key] = _free_centres(self.grid, w, h)
+        return self._free[key]
+
+    def _refresh(self, r0: int, r1: int, c0: int, c1: int) -> None:
+        """`free` again where cells r0..r1 x c0..c1 may have been taken: at the centres whose boxes
+        reach them, from the cells those boxes cover."""
+        ny, nx = self.grid.shape
+        for (hw, hh), free in self._free.items():
+            t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
+            s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
+            part = _free_centres(self.grid[s0:s1 + 1, v0:v1 + 1], (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
+            free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
 
     def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
         """Centres (up to want, 2) of level w x h mm boxes that touch no taken cell and whose
         leader from p crosses no label, within ELSEWHERE_MM of p, nearest first; centred in a
         face (`inside`) or off the faces."""
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
-        sub = self.grid[r0:r1 + 1, c0:c1 + 1]
-        if sub.all():
+        if self.grid[r0:r1 + 1, c0:c1 + 1].all():
             return np.zeros((0, 2))
-        rows, cols = np.nonzero(_free_centres(sub, w, h) & (self.in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
+        rows, cols = np.nonzero(self.free(w, h)[r0:r1 + 1, c0:c1 + 1] & (self.in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
         centres = self.origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
         d2 = ((centres - p) ** 2).sum(axis=1)
         near = np.flatnonzero(d2 <= ELSEWHERE_MM ** 2)
@@ -372,8 +407,7 @@ class _Taken:
         free = ~self.texts[r0:r1 + 1, c0:c1 + 1]
         sc, sr = self._cells(p[None])[0] - (c0, r0)
         free[sr, sc] = True
-        sub = self.grid[r0:r1 + 1, c0:c1 + 1]
-        centres = np.stack([_free_centres(sub, w, h) for w, h in sizes])
+        centres = np.stack([self.free(w, h)[r0:r1 + 1, c0:c1 + 1] for w, h in sizes])
         dist, found = _grid_bfs(free, int(sr), int(sc), int(ELSEWHERE_MM / FREE_CELL_MM), centres, want)
         for k, r, c in found.tolist():
             path = [(r, c)]
@@ -408,10 +442,13 @@ class PieceLabels:
     """The labels of one piece, placed one by one so none overlaps another (see the module
     docstring). `room` is the piece's `tabs.Room`: off-face labels are added to it."""
 
-    def __init__(self, room: Room, size: float) -> None:
+    def __init__(self, room: Room, size: float, cut_sides: np.ndarray | None = None) -> None:
         import shapely
 
         self.room = room
+        # (k, 2, 2) ends of every cut side of the piece: a label without a leader off the faces is
+        # placed nearer its own side than any other, or a reader takes it for that one's
+        self.cut_sides = np.zeros((0, 2, 2)) if cut_sides is None else np.asarray(cut_sides, dtype=float)
         # off-face labels stay in the room fitting a piece to the page leaves for its tabs
         self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
         self.size = size
@@ -423,6 +460,7 @@ class PieceLabels:
         self.stats = LabelStats()
         self._taken = None  # `_Taken` raster of the piece, made at the first `_elsewhere`
         self._no_spot = 0  # labels `_elsewhere` found no spot for
+        self.crowded: list[np.ndarray] = []  # where labels with no readable place went (their face's centroid)
 
     def _hits(self, box: np.ndarray) -> bool:
         """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
@@ -466,32 +504,28 @@ class PieceLabels:
         f = int(np.argmax(r))
         center = faces_xy[f].mean(axis=0)
         self.stats.unplaced += 1
+        self.crowded.append(center)
         self._put(text, center, u, self.size, "piece-label", text_box(center, u, text, self.size))
 
     def edge(self, side: CutSide, text: str, tab_parts: tuple[np.ndarray, ...] = (),
-             tab_folds: np.ndarray | None = None, partner: CutSide | None = None) -> None:
-        """The glue label of one side of a glued edge (see the module docstring for the order).
-        `partner`: the edge's other side when it is on this piece too; a label without a leader
-        is then placed nearer its own side than the partner's, or a reader takes both labels for
-        one edge (they often face each other across a notch, the tab between them)."""
-        self.run(text, [(side, tab_parts, tab_folds, partner)])
+             tab_folds: np.ndarray | None = None) -> None:
+        """The glue label of one side of a glued edge (see the module docstring for the order)."""
+        self.run(text, [(side, tab_parts, tab_folds)])
 
-    def run(self, text: str, sides: list[tuple[CutSide, tuple, np.ndarray | None, CutSide | None]]) -> None:
+    def run(self, text: str, sides: list[tuple[CutSide, tuple, np.ndarray | None]]) -> None:
         """One label for a seam run: consecutive sides along the outline (`edge`'s arguments per
         side, in order) glued to the run's other copy. Stages 1-3 beside each side, middle side
         first, then stage 4 from the sides in that order; a run of several sides gets a tick
-        across its outline at both ends (`tick`), placed first so no label covers them. A label
-        without a leader stays nearer its own side than every partner side on this piece."""
+        across its outline at both ends (`tick`), placed first so no label covers them."""
         if len(sides) > 1:
             self.tick(sides[0][0], _end_away(sides[0][0], sides[1][0]))
             self.tick(sides[-1][0], _end_away(sides[-1][0], sides[-2][0]))
             self.stats.runs += 1
         mid = len(sides) // 2
         order = sorted(range(len(sides)), key=lambda i: (abs(i - mid), i))
-        partners = [entry[3] for entry in sides if entry[3] is not None]
         for i in order:
-            side, tab_parts, tab_folds, _partner = sides[i]
-            if self._near(side, text, tab_parts, tab_folds, partners):
+            side, tab_parts, tab_folds = sides[i]
+            if self._near(side, text, tab_parts, tab_folds):
                 return
         side = sides[mid][0]
         if self._elsewhere(text, [sides[i][0] for i in order]):
@@ -501,6 +535,7 @@ class PieceLabels:
         u = _reading((side.p1 - side.p0) / max(side.length, 1e-12))
         center = side.tri.mean(axis=0)  # 5. nowhere readable: said in the stats
         self.stats.unplaced += 1
+        self.crowded.append(center)
         self._put(text, center, u, s, "edge-label", text_box(center, u, text, s))
 
     def tick(self, side: CutSide, p: np.ndarray) -> None:
@@ -526,8 +561,7 @@ class PieceLabels:
         if self._taken is not None:
             self._taken.mark(strip, LABEL_PAD_MM)
 
-    def _near(self, side: CutSide, text: str, tab_parts: tuple[np.ndarray, ...], tab_folds: np.ndarray | None,
-              partners: list[CutSide]) -> bool:
+    def _near(self, side: CutSide, text: str, tab_parts: tuple[np.ndarray, ...], tab_folds: np.ndarray | None) -> bool:
         """Stages 1-3 for one side: inside its face, on its tab, just outside it."""
         s = self.size
         d = side.p1 - side.p0
@@ -546,16 +580,16 @@ class PieceLabels:
             self.stats.on_tabs += 1
             return True
         beyond = max((float(np.max((p - side.p0) @ n_out)) for p in tab_parts), default=0.0)
-        if self._outside(text, side, u, n_out, beyond, h, partners):
+        if self._outside(text, side, u, n_out, beyond, h):
             self.stats.outside += 1
             return True
         return False
 
-    def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float,
-                 partners: list[CutSide]) -> bool:
-        """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it, else up to
-        LEADER_STEPS_MM away in a free spot with a leader line from the middle of the edge."""
-        from shapely.geometry import LineString, MultiLineString, Polygon
+    def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float) -> bool:
+        """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it (nearer it
+        than any other cut side), else up to LEADER_STEPS_MM away in a free spot with a leader line
+        from the middle of the edge."""
+        from shapely.geometry import LineString, Polygon
 
         d = side.p1 - side.p0
         mid = side.p0 + 0.5 * d
@@ -567,13 +601,11 @@ class PieceLabels:
                 a = math.radians(turn)
                 w = np.array([n_out[0] * math.cos(a) - n_out[1] * math.sin(a), n_out[0] * math.sin(a) + n_out[1] * math.cos(a)])
                 spots.append((start + w * (dist + h / 2 + TAB_CLEAR_MM), w, True))
-        own = LineString([side.p0, side.p1])
-        other = MultiLineString([[p.p0, p.p1] for p in partners]) if partners else None
         for center, w, leader in spots:
+            if not leader and not self._nearest_to(center, side):
+                continue
             box = text_box(center, u, text, self.size)
             poly = Polygon(box)
-            if not leader and other is not None and other.distance(poly.centroid) <= own.distance(poly.centroid):
-                continue
             if not self.allowed.contains(poly) or self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
                 continue
             extra = [poly]
@@ -593,6 +625,17 @@ class PieceLabels:
             self._off_faces(extra)
             return True
         return False
+
+    def _nearest_to(self, p: np.ndarray, side: CutSide) -> bool:
+        """Whether point p is nearer `side` than every other cut side of the piece, by LABEL_PAD_MM
+        (a label beside an edge names the edge a reader sees nearest to it)."""
+        if not len(self.cut_sides):
+            return True
+        d = _segment_distances(p, self.cut_sides)
+        ends = np.array([side.p0, side.p1])
+        own = (np.abs(self.cut_sides - ends).max(axis=(1, 2)) < 1e-9) | (np.abs(self.cut_sides - ends[::-1]).max(axis=(1, 2)) < 1e-9)
+        mine = float(_segment_distances(p, ends[None])[0])
+        return bool(np.all(d[~own] > mine + LABEL_PAD_MM))
 
     def _elsewhere(self, text: str, sides: list[CutSide]) -> bool:
         """4. The free spot nearest the middle of an edge of `sides` (a run's, middle one first;

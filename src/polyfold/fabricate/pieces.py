@@ -119,6 +119,7 @@ class LayoutStats:
     labels_on_tabs: int = 0  # glue labels printed on their tab (no room in the face)
     labels_outside: int = 0  # glue labels printed just outside their edge
     seam_runs: int = 0  # runs of several glue edges printed with one label (too dense for one per edge)
+    crowded: tuple[tuple[int, float, float], ...] = ()  # (piece, x, y mm in its frame) of every small label
 
 
 @dataclass(frozen=True, eq=False)
@@ -295,7 +296,8 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
     all_or_none: None at the first glue label that finds no readable place."""
     size = label_font(min_label_mm)
-    placed = [PieceLabels(room, size) for room in rooms]
+    placed = [PieceLabels(room, size, np.array([[side.p0, side.p1] for _key, side in d.sides]).reshape(-1, 2, 2))
+              for room, d in zip(rooms, drawn)]
     for i, d in enumerate(drawn):
         placed[i].piece(d.faces_xy, piece_name(i))
     for run in runs:
@@ -316,8 +318,8 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
 
 def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tuple]]:
     """The two copies of a run of glued pairs, each a list of `PieceLabels.run` entries (side, its
-    tab parts, their folds, the partner side when on the same piece) in run order: the sides of
-    the next pair that continue a copy share an end with its last side."""
+    tab parts, their folds) in run order: the sides of the next pair that continue a copy share an
+    end with its last side."""
     copies: list[list[tuple]] = [[], []]
     for n, idx in enumerate(run):
         sides, tab = pairs[idx][1], chosen[idx]
@@ -325,10 +327,8 @@ def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tu
         if n and _gap(copies[0][-1][0], sides[1]) < _gap(copies[0][-1][0], sides[0]):
             order = (1, 0)
         for c, s in enumerate(order):
-            side, other = sides[s], sides[1 - s]
             mine = tab is not None and tab.side == s
-            copies[c].append((side, tab.polygons if mine else (), tab.folds if mine else None,
-                              other if other.piece == side.piece else None))
+            copies[c].append((sides[s], tab.polygons if mine else (), tab.folds if mine else None))
     return copies
 
 
@@ -433,5 +433,6 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     stats = LayoutStats(glue_edges=len(pairs), tabs=g.n_tabs, tabs_shrunk=len(g.reduced), tabs_moved=g.moved,
                         untabbed=(), small_labels=label_stats.unplaced, open_edges=open_edges,
                         reduced_tabs=tuple(g.reduced), labels_on_tabs=label_stats.on_tabs,
-                        labels_outside=label_stats.outside, seam_runs=label_stats.runs // 2)
+                        labels_outside=label_stats.outside, seam_runs=label_stats.runs // 2,
+                        crowded=tuple((i, float(x), float(y)) for i, p in enumerate(placed) for x, y in p.crowded))
     return pieces, g.glue, stats

@@ -255,3 +255,39 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
         bisect.insort(queue, (-float(tree.area[rest].sum()), seq, t, rest), key=lambda q: q[:2])
         seq += 1
     return PagePlan(tuple(np.array(sorted(c), dtype=np.int64) for c in cuts[:len(nets)]), tuple(placed), n_pages)
+
+
+# the smaller side of a cut for labels keeps at least this fraction of the piece's area: an even cut
+# opens the most outline to paper, a sliver would only add a seam
+LABEL_SPLIT_LEAST = 0.2
+
+
+def plan_label_cuts(pieces: Sequence[SheetPiece], nets: Sequence[Net | None],
+                    crowded: Sequence[tuple[int, float, float]]) -> tuple[np.ndarray, ...]:
+    """Where to cut the pieces some of whose labels found no readable place (`crowded`: piece, x,
+    y mm in its frame, as `pieces.LayoutStats.crowded`): per such piece one crease, the one
+    nearest to those places (in whole mm) among those whose two sides each keep at least
+    LABEL_SPLIT_LEAST of its area, the evener first. Those places are where the piece's edges are
+    densest, usually the hub of a fan of thin faces; a cut through it puts half the fan's edges on
+    an outline with open paper beside them. cuts[i]: faces of nets[i] whose crease to their parent
+    is cut (none for the other pieces)."""
+    where: dict[int, list[tuple[float, float]]] = {}
+    for i, x, y in crowded:
+        where.setdefault(i, []).append((x, y))
+    cuts = [np.zeros(0, dtype=np.int64) for _ in pieces]
+    for i, pts in where.items():
+        if i >= len(nets) or nets[i] is None:
+            continue
+        tree = _Tree(pieces[i], nets[i])
+        total = float(tree.area.sum())
+        options = [(area, f) for area, f, below in tree.sides(np.ones(len(tree.parent), dtype=bool),
+                                                              LABEL_SPLIT_LEAST * total, total) if below]
+        if not options:
+            continue
+        area, faces = np.array([a for a, _ in options]), np.array([f for _, f in options])
+        k = np.argmax(tree.face_edges[faces] == tree.parent_edge[faces][:, None], axis=1)
+        creases = shapely.linestrings(np.stack([tree.xy[faces, k], tree.xy[faces, (k + 1) % 3]], axis=1))
+        near = np.round(shapely.distance(creases, shapely.multipoints(np.array(pts))))
+        best = np.lexsort((np.abs(area / total - 0.5), near))[0]
+        cuts[i] = np.array([faces[best]], dtype=np.int64)
+    return tuple(cuts)

@@ -108,7 +108,7 @@ def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, 
         tabs_shrunk=st.tabs_shrunk, tabs_moved=st.tabs_moved, untabbed_edges=tuple(st.untabbed),
         small_labels=st.small_labels, open_edges=st.open_edges, smallest_edge_mm=edge, smallest_face_mm=face,
         reduced_tabs=st.reduced_tabs, labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside,
-        seam_runs=st.seam_runs, min_label_mm=opts.min_label_mm, splits_for_packing=split.cuts,
+        seam_runs=st.seam_runs, min_label_mm=opts.min_label_mm, splits_for_packing=split.cuts, splits_for_labels=split.label_cuts,
         packing_ran_out=split.ran_out or sheets.packing.ran_out)
 
 

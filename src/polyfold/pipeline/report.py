@@ -114,6 +114,7 @@ class LayoutReport:
     seam_runs: int = 0  # runs of several glue edges printed with one label (no room for one per edge)
     min_label_mm: float = 2.0  # the least cap height asked for
     splits_for_packing: int = 0  # creases cut so that the pieces fill fewer pages
+    splits_for_labels: int = 0  # creases cut where labels found no readable place (before the page split)
     packing_ran_out: bool = False  # the packer's time budget stopped its search
 
 

@@ -30,7 +30,7 @@ from ..fabricate.pack import ORDER_TRIES, Packing, pack_outlines
 from ..fabricate.page import place
 from ..fabricate.paper import FOOTER_MM, GAP_MM, MARK_CLEAR_MM
 from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
-from ..fabricate.split import PagePlan, plan_pages
+from ..fabricate.split import PagePlan, plan_label_cuts, plan_pages
 from ..mesh.mesh import Mesh
 from ..unfold.net import cut_creases, piece_net
 from .folding import FoldedPiece
@@ -123,6 +123,7 @@ class PageSplit:
     ran_out: bool
     drawn: tuple[list[SheetPiece], list[GlueEdge], LayoutStats]  # build_sheet_pieces of `parts`' pieces
     inputs: list[PieceInput]  # what was drawn
+    label_cuts: int = 0  # creases cut before that where labels found no readable place (in `parts`)
 
     def same_pieces(self, folded: list[FoldedPiece]) -> bool:
         """Whether the folded pieces are the very pieces planned (folding split none)."""
@@ -166,6 +167,34 @@ def _owner(inputs: list[PieceInput], n_faces: int) -> np.ndarray:
     return owner
 
 
+LABEL_ROUNDS = 3  # rounds of cuts for labels with no readable place (each redraws every piece)
+
+
+def _split_for_labels(mesh: Mesh, parts: list[Part], inputs: list[PieceInput], drawn, draw,
+                      say: Callable[[str, str], None]):
+    """The parts, their pieces and drawing with a crease cut in every piece some of whose labels
+    found no readable place (`fabricate.split.plan_label_cuts`), redrawn, for up to LABEL_ROUNDS
+    rounds while that leaves fewer such labels; and the creases cut. The rounds are made whatever
+    the time limit says: they are bounded redraws, not a search, unfolding a dense mesh takes the
+    time limit to itself, and an unreadable label is worse than a late sheet."""
+    cuts = 0
+    for _ in range(LABEL_ROUNDS):
+        crowded = drawn[2].crowded
+        if not crowded:
+            break
+        plan = plan_label_cuts(drawn[0], [inp.net for inp in inputs], crowded)
+        if not any(len(c) for c in plan):
+            break
+        say("layout", f"cutting {sum(len(c) > 0 for c in plan)} piece(s) where {len(crowded)} label(s) found no room")
+        cut_parts, n_cut = _cut_plan(parts, inputs, PagePlan(plan, (), 0))
+        cut_inputs = part_piece_inputs(mesh, cut_parts)
+        cut_drawn = draw(cut_inputs)
+        if len(cut_drawn[2].crowded) >= len(crowded):
+            break
+        parts, inputs, drawn, cuts = cut_parts, cut_inputs, cut_drawn, cuts + n_cut
+    return parts, inputs, drawn, cuts
+
+
 def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptions,
                     box: tuple[float, float, float, float], deadline: Deadline,
                     say: Callable[[str, str], None]) -> PageSplit:
@@ -197,6 +226,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     t0 = time.perf_counter()
     drawn = draw(inputs)  # lay_out's drawing when folding splits nothing: not this stage's cost
     draw_seconds = time.perf_counter() - t0
+    parts, inputs, drawn, label_cuts = _split_for_labels(mesh, parts, inputs, drawn, draw, say)
     pieces = drawn[0]
     packing = pack(pieces, None, pack_budget(deadline))
     # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
@@ -269,7 +299,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     for pos, i in enumerate(order):
         if i < len(inputs):  # glue strips come after the net pieces and have no faces
             rank[inputs[i].face_ids] = pos
-    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs)
+    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs,
+                     label_cuts)
 
 
 @dataclass(frozen=True, eq=False)

@@ -73,6 +73,9 @@ def make(
                 f"{BUILDABLE_EDGE_MM:g} mm")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
+        if lay.splits_for_labels:
+            say(f"split {lay.splits_for_labels} crease(s) where labels had no room: pieces cut through their most "
+                "crowded spot")
         if lay.splits_for_packing:
             say(f"split {lay.splits_for_packing} more crease(s) so the pieces fill fewer pages")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
