@@ -7,7 +7,7 @@ import numpy as np
 
 from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
-from .files import StagedFolder
+from .files import StagedFolder, check_folder
 from .meshes import mesh_bytes, obj_text
 from .png import png_bytes
 
@@ -20,8 +20,16 @@ def input_face_labels(seg: Segmentation, face_source: np.ndarray, n_input_faces:
     return out
 
 
+OUTPUTS = ("part-*.obj", "labels.json", "segments.ply", "segments.glb", "segments.png")  # every name it may write
+
+
+def check_segmentation_folder(out_dir, inputs: tuple) -> None:
+    """Before segmenting: `files.check_folder` for the names `write_segmentation` may write."""
+    check_folder(out_dir, OUTPUTS, inputs)
+
+
 def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces: int | None = None,
-                       source_name: str = "mesh", png: bool = True) -> list[str]:
+                       source_name: str = "mesh", png: bool = True, inputs: tuple = ()) -> list[str]:
     """Write the parts into `out_dir` and return the file names written.
 
     part-K.obj (one per part, faces in the part's order), labels.json ({"labels": part of each
@@ -29,13 +37,14 @@ def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces:
     mesh, one colour per part, as face colours), segments.glb (same colours as vertex colours on
     unshared vertices, since glTF has no face colours) and, unless png=False, segments.png.
     Everything is staged (`files.StagedFolder`) and moved in together, so an error never leaves
-    half the files; stale part-K.obj files of an earlier run are removed."""
+    half the files; the files of an earlier run that this one does not write are removed, no
+    other file is touched and none of `inputs` (the files read) is replaced."""
     import json
 
     from .raster import part_colors, render_mesh
 
     colors = part_colors(seg.n_parts)[seg.labels]
-    with StagedFolder(out_dir, "segment") as stage:
+    with StagedFolder(out_dir, "segment", inputs=inputs) as stage:
         for k, part in enumerate(seg.parts):
             stage.write(f"part-{k}.obj", obj_text(part.vertices, part.faces, [
                 f"part {k} of {seg.n_parts} of {source_name}, segmented by polyfold (tau {seg.tau:.6g})",
@@ -49,4 +58,4 @@ def write_segmentation(seg: Segmentation, mesh: Mesh, out_dir, *, n_input_faces:
             stage.write(name, mesh_bytes(name[-4:], mesh.vertices, mesh.faces, face_colors=colors))
         if png:
             stage.write("segments.png", png_bytes(render_mesh(mesh.vertices, mesh.faces, colors)))
-        return list(stage.commit(stale=["part-*.obj"]))
+        return list(stage.commit())

@@ -5,8 +5,9 @@ The folder: sheets.pdf (all pages), sheet-NN.svg (print), cut-NN.svg (cutting ma
 score lines only) and sheet-NN.dxf per page, part-K.obj per part, piece-X.fold per piece (net,
 folding path, source faces; in mm where it is printed, with its page and sheet transform:
 `formats.fold.piece_fold`), assembly.json, instructions.html and report.json. Every printed page
-has a scale bar in its footer; with --marks, registration marks. Files of an earlier run that
-this run does not produce are removed (they would be mistaken for this run's).
+has a scale bar in its footer; with --marks, registration marks. Files an earlier run wrote that
+this run does not produce are removed (they would be mistaken for this run's); no other file is
+touched, and the input mesh is never replaced (`formats.files.StagedFolder`).
 """
 
 from __future__ import annotations
@@ -35,7 +36,9 @@ from .parts import Part
 from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, PieceReport
 from .sheets import Sheets, pack_box
 
-STALE = ("sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "piece-*.fold", "part-*.obj")
+# every name make may write into its folder (`files.check_folder` before the run)
+OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "piece-*.fold", "assembly.json",
+           "instructions.html", "report.json")
 
 
 def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
@@ -91,12 +94,13 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
 
 def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],
                       folded: list[FoldedPiece], sheets: Sheets,
-                      finish: Callable[[tuple[PieceReport, ...], list[str]], MakeReport]
-                      ) -> tuple[tuple[str, ...], MakeReport]:
+                      finish: Callable[[tuple[PieceReport, ...], list[str]], MakeReport],
+                      inputs: tuple[Path, ...] = ()) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
-    written, and the report. finish(piece rows, outputs so far) gives the report, written last."""
+    written, and the report. finish(piece rows, outputs so far) gives the report, written last.
+    inputs: the files make read (never replaced)."""
     pages = sheet_pages(sheets, model, opts)
-    with StagedFolder(out_dir, "make") as stage:
+    with StagedFolder(out_dir, "make", inputs=inputs) as stage:
         stage.write("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))
         svgs = []
         for k, page in enumerate(pages):
@@ -121,4 +125,4 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             sheets.packing.n_pages, opts, svgs))
         report = finish(rows, list(stage.names))
         stage.write("report.json", report.to_json())
-        return stage.commit(stale=STALE), report
+        return stage.commit(), report

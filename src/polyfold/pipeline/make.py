@@ -21,9 +21,10 @@ from ..errors import PolyfoldError
 from ..fabricate.check import check_pages
 from ..fabricate.fit import model_scale, smallest_printed
 from ..fabricate.paper import GAP_MM
+from ..formats.files import check_folder
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
-from .export import write_make_folder
+from .export import OUTPUTS, write_make_folder
 from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
@@ -120,6 +121,8 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     failed sheet check. progress(stage, message) as the work goes."""
     say = progress or _progress_noop
     width, height = check_options(opts)
+    inputs = (Path(source),) if isinstance(source, (str, os.PathLike)) else ()
+    check_folder(out_dir, OUTPUTS, inputs)
     deadline = Deadline.after(opts.time_limit)
     t0 = time.perf_counter()
     mesh, input_report, load_report, name = _load(source, name, say)
@@ -150,5 +153,5 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0)
 
-    files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish)
+    files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs)
     return MakeResult(out_dir=Path(out_dir), files=files, report=report)

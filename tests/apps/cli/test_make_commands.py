@@ -47,6 +47,8 @@ def test_make_bunny_default_cli(models_dir, tmp_path):
     (out).mkdir()
     (out / "sheet-09.svg").write_text("stale")
     (out / "cut-09.svg").write_text("stale")
+    (out / ".polyfold-manifest.json").write_text('{"files": ["sheet-09.svg", "cut-09.svg"]}')  # an earlier run's
+    (out / "notes.svg").write_text("mine")  # the user's: kept
     proc = run_cli("make", src, "-o", out)
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
@@ -54,9 +56,11 @@ def test_make_bunny_default_cli(models_dir, tmp_path):
     assert REPORT_KEYS <= set(report) and STAGES <= set(report["stages"])
     n_pages = report["stages"]["layout"]["pages"]
     pieces = report["pieces"]
-    assert set(report["outputs"]) == {p.name for p in out.iterdir()}
+    assert set(report["outputs"]) | {"notes.svg"} == {p.name for p in out.iterdir() if not p.name.startswith(".")}
     assert not (out / "sheet-09.svg").exists() and not (out / "cut-09.svg").exists()
-    assert not list(out.glob(".polyfold-*"))
+    assert (out / "notes.svg").read_text() == "mine"
+    assert json.loads((out / ".polyfold-manifest.json").read_text())["files"] == report["outputs"]
+    assert not [p for p in out.iterdir() if p.is_dir()]  # no staged folder left
     # sheets in every format, one per page
     svgs = sorted(out.glob("sheet-*.svg"))
     assert len(svgs) == n_pages == len(list(out.glob("sheet-*.dxf"))) == len(list(out.glob("cut-*.svg")))

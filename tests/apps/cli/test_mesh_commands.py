@@ -140,6 +140,7 @@ def test_segment_cli_writes_every_output(models_dir, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "part-99.obj").write_text("stale\n")
+    (out / ".polyfold-manifest.json").write_text('{"files": ["part-99.obj"]}')  # an earlier run's
     proc = run_cli("segment", src, "-o", out, "--tau", 0.05)
     assert proc.returncode == 0, proc.stderr
     doc = json.loads((out / "labels.json").read_text())
@@ -150,7 +151,7 @@ def test_segment_cli_writes_every_output(models_dir, tmp_path):
     assert len(labels) == 128 and labels.min() == 0 and labels.max() == n_parts - 1
     assert not (out / "part-99.obj").exists()
     assert sorted(p.name for p in out.glob("part-*.obj")) == sorted(f"part-{k}.obj" for k in range(n_parts))
-    assert not list(out.glob(".polyfold-*"))
+    assert not [p for p in out.iterdir() if p.is_dir()]  # no staged folder left
     # the parts, in the whole mesh's frame, are exactly the labelled faces of the input
     whole = load_mesh(src).mesh
     centroids = whole.vertices[whole.faces].mean(axis=1)

@@ -53,10 +53,11 @@ def inflate(
     """Inflate a mesh to remove hyperbolic (saddle) vertices while keeping its faces (paper Sec. 3)."""
     if mode not in ("constrained", "uniform"):
         fail(f"--mode must be 'constrained' or 'uniform', not {mode!r}", 2)
-    from ...formats.files import atomic_write
+    from ...formats.files import atomic_write, check_outputs
     from ...formats.meshes import write_mesh
     from ...inflate.inflate import inflate as inflate_mesh
 
+    check_outputs([output, log], [mesh])
     t0 = time.perf_counter()
     loaded = load(mesh)
     show = sys.stderr.isatty()
@@ -98,9 +99,10 @@ def segment(
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
     from ...deadline import Deadline
-    from ...formats.segmentation import write_segmentation
+    from ...formats.segmentation import check_segmentation_folder, write_segmentation
     from ...segment.segment import DEFAULT_TAU, segment as segment_mesh
 
+    check_segmentation_folder(output, (mesh,))
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit)
     loaded = load(mesh, quiet)
@@ -111,7 +113,8 @@ def segment(
                else "even tau 0 gives fewer: the parts are already convex" if seg.n_parts < parts
                else "the mesh has that many separate components")
         say(f"warning: {mesh.name}: {seg.n_parts} parts instead of {parts} ({why})")
-    write_segmentation(seg, loaded.mesh, output, n_input_faces=loaded.n_input_faces, source_name=mesh.name, png=png)
+    write_segmentation(seg, loaded.mesh, output, n_input_faces=loaded.n_input_faces, source_name=mesh.name, png=png,
+                       inputs=(mesh,))
     if not quiet:
         print(f"{'part':>4} {'faces':>6} {'concavity':>10}")
         for k, (p, c) in enumerate(zip(seg.parts, seg.concavity)):

@@ -60,9 +60,11 @@ def unfold(
         fail(f"--max-pieces must be 'auto' or '1', not {max_pieces!r}", 2)
     from ...deadline import Deadline
     from ...errors import NoNetFound
+    from ...formats.files import check_outputs
     from ...formats.fold import write_fold
     from ...pipeline.nets import NetsOptions, unfold_nets
 
+    check_outputs([output, svg, png], [mesh])
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit)
     loaded = load(mesh, quiet)
@@ -140,9 +142,11 @@ def fold_cmd(
     """Plan a continuous, collision-free folding path from the flat net to the folded shape, at the
     material's thickness, and check it again with an independent checker before writing it."""
     from ...errors import NoNetFound
+    from ...formats.files import check_outputs
     from ...formats.fold import fold_tree, read_fold, write_fold
     from ...pipeline.folding import plan_checked
 
+    check_outputs([output], [net])
     fold = read_fold(net)
     tree = fold_tree(fold, contact_tol)
     written, path, why = plan_checked(fold, tree, planner=planner.value, resolution_deg=resolution_deg,
