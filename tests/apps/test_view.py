@@ -1,5 +1,7 @@
 """apps/view.py, `polyfold view` (issue 7): the address checks, the command line (URL printed, MESH
-input, bad input) and the page itself in a real headless browser (Debian's Chromium driven by
+input, bad input), the gate in front of viser (apps/view_guard.py, issue 20: Host, Origin and
+token checked on every request and websocket handshake; a foreign page in the browser gets
+nothing and writes nothing) and the page itself in a real headless browser (Debian's Chromium driven by
 Playwright; never a downloaded browser). (The folder loader and the folding poses it shows:
 pipeline/test_folder.py.)
 
@@ -90,7 +92,7 @@ def _read_url(proc: subprocess.Popen, timeout: float) -> tuple[str, list[str]]:
         if not line:
             break
         lines.append(line.rstrip("\n"))
-        m = re.fullmatch(r"polyfold: viewer at (http://127\.0\.0\.1:\d+)", lines[-1])
+        m = re.fullmatch(r"polyfold: viewer at (http://127\.0\.0\.1:\d+/\?token=[\w-]{40,})", lines[-1])
         if m:
             return m.group(1), lines
     raise AssertionError("no URL line:\n" + "\n".join(lines))
@@ -108,11 +110,18 @@ def test_cli_view_mesh(models_dir: Path, tmp_path: Path) -> None:
         url, lines = _read_url(proc, timeout=120)
         assert not any("Traceback" in line for line in lines)
         assert [p.name for p in temp.iterdir() if p.name.startswith("polyfold-view-")], "no temporary make folder"
-        with urllib.request.urlopen(url + "/", timeout=10) as resp:
+        with pytest.raises(urllib.error.HTTPError) as err:  # the page without its token
+            urllib.request.urlopen(url.split("?")[0], timeout=10)
+        assert err.value.code == 403
+        err.value.close()
+        # the token URL sets the cookie and redirects to the page (urllib follows, with the cookie)
+        opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor())
+        with opener.open(url, timeout=10) as resp:
             assert resp.status == 200 and b"<html" in resp.read(4096).lower()
+        base = url.split("/?")[0]
         for path in ("/assembly.json", "/report.json", "/piece-A.fold", "/part-0.obj", "/../assembly.json"):
             with pytest.raises(urllib.error.HTTPError) as err:
-                urllib.request.urlopen(url + path, timeout=10)
+                opener.open(base + path, timeout=10)
             assert err.value.code == 404, path
             err.value.close()  # an open response would hold the connection (and the shutdown)
         proc.send_signal(signal.SIGTERM)
@@ -177,7 +186,7 @@ def test_viewer_in_browser(make_dir: Path) -> None:
     viewer = serve(make_dir, port=0)
     problems: list[str] = []
     try:
-        assert re.fullmatch(r"http://127\.0\.0\.1:\d+", viewer.url)
+        assert re.fullmatch(r"http://127\.0\.0\.1:\d+/\?token=[\w-]{40,}", viewer.url)
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
             try:
@@ -255,3 +264,102 @@ def test_viewer_in_browser(make_dir: Path) -> None:
     finally:
         viewer.stop()
     assert not problems, "\n".join(problems)
+
+
+# ----------------------------------------------------------------------------------------------
+# The gate: only the viewer's own page, with its token
+
+
+def _ask(port: int, path: str, headers: dict[str, str]) -> tuple[int, bytes]:
+    import http.client
+
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    try:
+        conn.request("GET", path, headers=headers)
+        resp = conn.getresponse()
+        return resp.status, resp.read()
+    finally:
+        conn.close()
+
+
+def test_the_gate_lets_in_only_the_page_with_its_token(make_dir: Path) -> None:
+    import base64
+
+    viewer = serve(make_dir, port=0)
+    try:
+        port, token = viewer.port, viewer.gate.token
+        own = f"http://127.0.0.1:{port}"
+        cookie = {"Cookie": f"polyfold-view-{port}={token}"}
+        ws = {"Upgrade": "websocket", "Connection": "Upgrade", "Sec-WebSocket-Version": "13",
+              "Sec-WebSocket-Key": base64.b64encode(os.urandom(16)).decode(), "Sec-WebSocket-Protocol": "viser-v1"}
+        refused = [
+            ("/", {}),  # no token
+            ("/?token=wrong", {}),
+            ("/", {"Cookie": f"polyfold-view-{port}=wrong"}),
+            ("/", {**cookie, "Host": f"evil.example:{port}"}),  # DNS rebinding: a foreign name
+            ("/", {**cookie, "Origin": "http://evil.example"}),
+            ("/", {**ws, **cookie, "Origin": "http://evil.example"}),  # a foreign page's websocket
+            ("/", {**ws, **cookie}),  # a websocket without Origin
+            ("/", {**ws, "Origin": own}),  # without the token
+        ]
+        for path, headers in refused:
+            status, body = _ask(port, path, headers)
+            assert status == 403 and b"<html" not in body.lower(), (path, headers)
+        assert viewer.gate.refused == len(refused)
+        assert _ask(port, f"/?token={token}", {})[0] == 302
+        status, body = _ask(port, "/", cookie)
+        assert status == 200 and b"<html" in body.lower()
+        assert _ask(port, "/", {**ws, **cookie, "Origin": own})[0] == 101  # the page's own websocket
+    finally:
+        viewer.stop()
+
+
+FOREIGN_PAGE = """<!doctype html><html><body><script>
+window.results = {};
+const target = "127.0.0.1:%d";
+fetch("http://" + target + "/?token=guess", {mode: "no-cors"}).then(() => results.fetch = "sent").catch(() => results.fetch = "failed");
+const ws = new WebSocket("ws://" + target + "/", ["viser-v1.1.1"]);
+ws.onopen = () => results.ws = "open";
+ws.onmessage = () => results.message = "got data";
+ws.onerror = () => results.ws = "refused";
+</script></body></html>"""
+
+
+@needs_chromium
+def test_a_foreign_page_in_the_browser_gets_nothing(make_dir: Path, tmp_path: Path) -> None:
+    """A page from another origin, open in the same browser as the viewer (after the user opened the
+    viewer, so its cookie is there): its websocket is refused, nothing reaches it, nothing is written."""
+    import http.server
+    import threading
+
+    from playwright.sync_api import sync_playwright
+
+    before = sorted(p.name for p in make_dir.rglob("*"))
+    viewer = serve(make_dir, port=0)
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "index.html").write_text(FOREIGN_PAGE % viewer.port)
+    handler = lambda *a, **k: http.server.SimpleHTTPRequestHandler(*a, directory=str(site), **k)  # noqa: E731
+    foreign = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=foreign.serve_forever, daemon=True).start()
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+            try:
+                context = browser.new_context()
+                page = context.new_page()
+                page.goto(viewer.url)  # the user's own tab: the viewer works, its cookie is set
+                page.wait_for_selector("canvas", timeout=30000)
+                evil = context.new_page()
+                evil.goto(f"http://127.0.0.1:{foreign.server_address[1]}/index.html")
+                evil.wait_for_function("window.results.ws !== undefined", timeout=15000)
+                evil.wait_for_timeout(500)
+                results = evil.evaluate("window.results")
+            finally:
+                browser.close()
+        assert results.get("ws") == "refused" and "message" not in results, results
+        assert viewer.gate.refused >= 1
+    finally:
+        foreign.shutdown()
+        viewer.stop()
+    assert sorted(p.name for p in make_dir.rglob("*")) == before  # nothing written

@@ -7,6 +7,10 @@ folding animation along the verified path of every piece, an inflation panel (mo
 stiffness ratio, steps; hyperbolic vertices in red, their count as "HV: N") and buttons that run
 `make` / export the inflated mesh into the folder.
 
+Only its own page gets in: every request and websocket handshake must come with the right Host,
+Origin and session token (the printed URL's `?token=`, then a SameSite cookie), else 403 before
+viser sees it (`view_guard`).
+
 The folder itself is read by `pipeline.folder.load_folder` (a frozen `MakeFolder`, whose pieces
 pose themselves along their folding paths); here: `check_host`, `serve` (starts the server and
 returns at once), `wait` (blocks until Ctrl+C, for the CLI) and the `Viewer` (the page).
@@ -32,6 +36,7 @@ from ..formats.meshes import obj_text
 from ..mesh.mesh import Mesh
 from ..pipeline.folder import MakeFolder, ViewPiece, load_folder, make_folder
 from ..pipeline.options import MakeOptions
+from .view_guard import Gate, guarded_start
 
 DEFAULT_HOST = "127.0.0.1"
 DEBOUNCE_S = 0.3  # inflation re-runs wait until the sliders rest this long
@@ -132,17 +137,16 @@ def _wait_until(done: Callable[[], bool], timeout: float) -> bool:
 class Viewer:
     """A running viewer: the viser server, its scene and GUI. Create with `serve`."""
 
-    def __init__(self, server, folder: MakeFolder, source: Mesh, source_path: Path | None, root: Path) -> None:
+    def __init__(self, server, folder: MakeFolder, source: Mesh, source_path: Path | None, root: Path,
+                 gate: Gate) -> None:
         self.server = server
+        self.gate = gate  # what every request must show (view_guard)
         self.folder = folder
         self.root = root.resolve()  # make / export write only inside this folder
         self.source = source  # the mesh the inflation panel inflates
         self.source_path = source_path
-        host = server.get_host()
-        if host in ("0.0.0.0", "::"):  # all interfaces: this machine reaches it on loopback
-            host = "127.0.0.1"
-        self.url = f"http://[{host}]:{server.get_port()}" if ":" in host else f"http://{host}:{server.get_port()}"
         self.port = int(server.get_port())
+        self.url = gate.url(self.port)  # with the session token: the page opens only from this URL
         self.inflation = None  # last InflateResult
         self.inflation_runs = 0
         self.make_runs = 0
@@ -536,11 +540,12 @@ def serve(folder: MakeFolder | str | Path, host: str = DEFAULT_HOST, port: int =
         raise PolyfoldError(f"--port must be 0..65535, not {port}")
     if not isinstance(folder, MakeFolder):
         folder = load_folder(folder)
-    with _quiet_stdout():
+    gate = Gate(host)
+    with _quiet_stdout(), guarded_start(gate):
         server = viser.ViserServer(host=host, port=int(port), label="polyfold", verbose=False)
     try:
         return Viewer(server, folder, source if source is not None else folder.whole,
-                      Path(source_path) if source_path is not None else None, folder.path)
+                      Path(source_path) if source_path is not None else None, folder.path, gate)
     except BaseException:
         with _quiet_stdout():
             server.stop()

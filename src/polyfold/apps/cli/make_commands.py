@@ -129,8 +129,8 @@ def view(
         viewer = serve(folder, host if host is not None else DEFAULT_HOST, port,
                        allow_remote=host is not None, source=source, source_path=source_path)
         if host is not None and not _is_loopback(viewer.server.get_host()):
-            say(f"warning: listening on {host}: anyone who can reach this machine can view the model "
-                f"and run make into {folder.path}")
+            say(f"warning: listening on {host}: anyone who can reach this machine and has the URL below (its "
+                f"token) can view the model and run make into {folder.path}")
         say(f"viewer at {viewer.url}")
         sys.stderr.flush()
         wait(viewer)
