@@ -253,3 +253,66 @@ def test_study_cspace_cli(inputs, tmp_path, models_dir) -> None:
     assert float(torus["discrete_ratio"]) < 1.0  # a non-convex net collides in some configurations
     text = _svg_texts(tmp_path / "study-cspace.svg")
     assert "DOF" in text and "discrete" in text and "continuous" in text
+
+
+def _marked(marker: str) -> list[int]:
+    """Live processes whose environment holds marker (a batch, its forkserver, its tasks)."""
+    pids = []
+    for env in Path("/proc").glob("[0-9]*/environ"):
+        try:
+            if marker.encode() in env.read_bytes():
+                stat = (env.parent / "stat").read_text()
+                if stat.rsplit(")", 1)[1].split()[0] != "Z":  # not a zombie
+                    pids.append(int(env.parent.name))
+        except OSError:
+            continue
+    return pids
+
+
+@pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc")
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGKILL"])
+def test_a_killed_batch_leaves_no_process_and_no_temp_folder(inputs, tmp_path, sig) -> None:
+    """What `timeout`, schedulers and the OOM killer send: the hanging task, the forkserver and the
+    resource tracker all go with the batch; its temporary folder too (after SIGKILL: at the next
+    batch)."""
+    import signal
+    import subprocess
+    import sys
+    import uuid
+
+    marker = f"POLYFOLD_TEST_MARKER={uuid.uuid4().hex}"
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    env = {**os.environ, FAULT_ENV: FAULTS, "TMPDIR": str(temp), marker.split("=")[0]: marker.split("=")[1]}
+    proc = subprocess.Popen([sys.executable, "-m", "polyfold", "batch", str(inputs / "hang-me.obj"), "-o",
+                             str(tmp_path / "out"), "--no-fold", "--workers", "1", "-q"], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    end = time.monotonic() + 60
+    while not list(temp.glob("polyfold-batch-*/0.log")) and time.monotonic() < end:  # the task is running
+        time.sleep(0.2)
+    assert len(_marked(marker)) >= 3  # batch, forkserver, the task (and the resource tracker)
+    proc.send_signal(getattr(signal, sig))
+    proc.wait(timeout=30)
+    end = time.monotonic() + 15
+    while _marked(marker) and time.monotonic() < end:
+        time.sleep(0.2)
+    assert _marked(marker) == []  # nothing survives the batch
+    if sig == "SIGTERM":
+        assert proc.returncode != 0 and "Traceback" not in proc.stderr.read().decode()
+    else:  # the next batch removes the dead one's folder
+        run = subprocess.run([sys.executable, "-m", "polyfold", "batch", str(inputs / "cube-12.obj"), "-o",
+                              str(tmp_path / "out2"), "--no-fold", "-q"], env={**env, FAULT_ENV: ""},
+                             capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0, run.stderr
+    assert not list(temp.glob("polyfold-batch-*"))
+
+
+def test_the_output_folder_is_never_an_input(inputs, tmp_path) -> None:
+    root = tmp_path / "tree"
+    shutil.copytree(inputs, root / "in")
+    pattern = str(root / "**" / "cube-12.obj")
+    out = root / "out"  # inside the '**' glob: its part-K.obj and the like must not come back in
+    first = run_batch(pattern, out, OPTS)
+    shutil.copy(inputs / "cube-12.obj", out / "cube-12.obj")  # even a mesh named like an input
+    again = run_batch(pattern, out, OPTS, force=True)
+    assert [Path(r.mesh) for r in first.rows] == [Path(r.mesh) for r in again.rows] == [root / "in" / "cube-12.obj"]

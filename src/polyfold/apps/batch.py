@@ -85,21 +85,25 @@ class BatchResult:
 # Inputs and rows
 
 
-def expand(patterns: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
+def expand(patterns: str | os.PathLike | Sequence[str | os.PathLike], exclude: str | os.PathLike | None = None
+           ) -> list[Path]:
     """Glob patterns (expanded here, '**' allowed) or plain paths -> mesh files, sorted, no
-    duplicates. Raises PolyfoldError when nothing matches."""
+    duplicates, none inside the folder `exclude` (a batch's own output folder: its part-K.obj are
+    not inputs). Raises PolyfoldError when nothing matches."""
     from ..errors import PolyfoldError
 
     if isinstance(patterns, (str, os.PathLike)):
         patterns = [patterns]
     found: dict[str, Path] = {}
+    skip = os.path.join(os.path.realpath(exclude), "") if exclude is not None else None
     for pat in patterns:
         # an existing file is taken as named, even when its name holds glob characters ([, *, ?)
         hits = [os.fspath(pat)] if os.path.isfile(pat) else glob.glob(os.fspath(pat), recursive=True)
         for hit in hits:
             p = Path(hit)
-            if p.is_file() and p.suffix.lower() in MESH_SUFFIXES:
-                found.setdefault(os.path.realpath(p), p)
+            real = os.path.realpath(p)
+            if p.is_file() and p.suffix.lower() in MESH_SUFFIXES and not (skip and real.startswith(skip)):
+                found.setdefault(real, p)
     if not found:
         raise PolyfoldError(f"no mesh files ({', '.join(sorted(MESH_SUFFIXES))}) match {' '.join(map(str, patterns))}")
     return sorted(found.values(), key=lambda p: str(p))
@@ -208,7 +212,7 @@ def run_batch(patterns: str | os.PathLike | Sequence[str | os.PathLike], out_dir
     opts = opts or MakeOptions()
     check_options(opts)  # one error for options make would reject on every mesh, not N
     t0 = time.perf_counter()
-    meshes = expand(patterns)
+    meshes = expand(patterns, exclude=out_dir)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = out_names(meshes)

@@ -9,6 +9,15 @@ Isolation: a task runs in its own process -- a forkserver child locally, a subpr
 (segfault, os._exit) or a hang in one task becomes that task's status and never stops the others.
 A hard wall-clock limit per task kills a task that hangs.
 
+Nothing outlives the batch: every task process leads its own process group (whatever it starts
+is killed with it, `_kill`), exits when the batch process is gone (even by SIGKILL; then the
+forkserver and the resource tracker, whose pipes only the batch and its tasks hold, exit too), asks
+the kernel to kill it when the process that forked it dies (PR_SET_PDEATHSIG) and sets an alarm a
+little past its hard limit (in case nobody is left to kill it). SIGTERM to the
+batch process ends it like Ctrl+C: its tasks are killed and its temporary folder removed; a
+temporary folder left by a batch that was SIGKILLed is removed by the next batch
+(`_remove_stale_temps`: the folder names its process id).
+
 Test hook (tests/apps/test_batch.py only): POLYFOLD_BATCH_FAULT="crash:NAME,segv:NAME,hang:NAME"
 makes the task of the mesh file named NAME call os._exit(1), segfault, or sleep forever. The
 parent reads it when a batch starts (`faults`) and puts it into the task spec, so it also reaches
@@ -45,6 +54,9 @@ SCHEDULER_ENV = "POLYFOLD_SCHEDULER"
 PRELOAD = ("polyfold.apps.isolation", "polyfold.apps.batch", "polyfold.apps.study", "polyfold.pipeline.make",
            "polyfold.formats.meshes", "polyfold.inflate.inflate", "polyfold.fold.cspace")
 
+WATCH_S = 0.5  # a task process looks this often whether its batch process is still there
+ALARM_GRACE_S = 10.0  # a task's own alarm rings this long after its hard limit (the parent kills first)
+TEMP_PREFIX = "polyfold-batch-"  # + the batch process id + "-": its temporary folder
 ENTRY = "polyfold.apps.isolation"  # `python -m ENTRY SPEC RESULT LOG` runs one task (the Dask path)
 OnDone = Callable[[int, dict], None]  # (index of the spec, its outcome)
 
@@ -101,11 +113,49 @@ def run_task(spec: dict) -> dict:
         return {"status": "error", "error": one_line(exc), "values": {}}
 
 
+def _leash(hard_limit: float, batch_pid: int | None) -> None:
+    """In a task process: lead its own process group, die with the process that forked it
+    (Linux: the Dask worker's subprocess), die by SIGALRM a little past the hard limit, and exit
+    within WATCH_S of the batch process (batch_pid) going (a forkserver child: the forkserver
+    stays while its children hold its pipe, so it is the batch that is watched)."""
+    import math
+    import signal
+
+    try:
+        os.setpgid(0, 0)
+    except OSError:
+        pass  # already a group leader (the Dask path's subprocess may be)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    signal.alarm(max(1, math.ceil(hard_limit + ALARM_GRACE_S)))
+    if batch_pid is not None:  # the forkserver outlives the batch while a task runs: watch the batch itself
+        import threading
+
+        def watch() -> None:
+            while True:
+                try:
+                    os.kill(batch_pid, 0)
+                except ProcessLookupError:
+                    os._exit(1)
+                except PermissionError:
+                    return
+                time.sleep(WATCH_S)
+
+        threading.Thread(target=watch, name="polyfold-batch-watch", daemon=True).start()
+
+
 def child_main(spec: dict, result_path: str, log_path: str) -> None:
-    """Entry of a task process: output to the log (not the parent's terminal), a traceback of
-    every fatal signal into it (faulthandler), the outcome as JSON into result_path."""
+    """Entry of a task process: on a leash (`_leash`), output to the log (not the parent's
+    terminal), a traceback of every fatal signal into it (faulthandler), the outcome as JSON into
+    result_path."""
     import faulthandler
 
+    _leash(float(spec.get("hard_limit", 3600.0)), spec.get("batch_pid"))
     log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
     sys.stdout.flush()
     sys.stderr.flush()
@@ -193,16 +243,26 @@ def _run_local(specs: list[dict], workers: int, on_done: OnDone) -> None:
     as each finishes. A process past its spec's hard_limit is killed (status timeout)."""
     from multiprocessing.connection import wait
 
+    import signal
+    import threading
+
     ctx = _mp_context()
-    tmp = tempfile.mkdtemp(prefix="polyfold-batch-")
+    _remove_stale_temps()
+    tmp = tempfile.mkdtemp(prefix=f"{TEMP_PREFIX}{os.getpid()}-")
     todo = deque(enumerate(specs))
     running: dict = {}  # sentinel -> (index, process, start, hard deadline, result path, log path)
+
+    def on_term(signum, frame):  # noqa: ARG001 - SIGTERM (timeout, schedulers) ends the batch like Ctrl+C
+        raise KeyboardInterrupt
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, on_term) if main else None
     try:
         while todo or running:
             while todo and len(running) < workers:
                 i, spec = todo.popleft()
                 res, log = os.path.join(tmp, f"{i}.json"), os.path.join(tmp, f"{i}.log")
-                proc = ctx.Process(target=child_main, args=(spec, res, log), daemon=True,
+                proc = ctx.Process(target=child_main, args=({**spec, "batch_pid": os.getpid()}, res, log), daemon=True,
                                    name=f"polyfold-batch-{i}")
                 proc.start()
                 t0 = time.perf_counter()
@@ -215,8 +275,7 @@ def _run_local(specs: list[dict], workers: int, on_done: OnDone) -> None:
                     proc.join()
                     outcome = process_outcome(proc.exitcode, res, log, now - t0)
                 elif now >= hard.at:
-                    proc.kill()
-                    proc.join()
+                    _kill(proc)
                     outcome = timeout_outcome(specs[i]["hard_limit"], now - t0)
                 else:
                     continue
@@ -224,9 +283,37 @@ def _run_local(specs: list[dict], workers: int, on_done: OnDone) -> None:
                 on_done(i, outcome)
     finally:  # interrupted: leave no task process behind
         for _, proc, _, _, _, _ in running.values():
-            proc.kill()
-            proc.join()
+            _kill(proc)
         shutil.rmtree(tmp, ignore_errors=True)
+        if main:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _kill(proc) -> None:
+    """Kill a task process and everything in its process group; wait for it."""
+    import signal
+
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (OSError, TypeError):
+        pass  # not (yet) a group leader, or gone
+    proc.kill()
+    proc.join()
+
+
+def _remove_stale_temps() -> None:
+    """Remove the temporary folders of batches whose process is gone (killed with SIGKILL)."""
+    root = Path(tempfile.gettempdir())
+    for folder in root.glob(f"{TEMP_PREFIX}*-*"):
+        pid = folder.name[len(TEMP_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or not folder.is_dir() or int(pid) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid), 0)
+        except ProcessLookupError:
+            shutil.rmtree(folder, ignore_errors=True)
+        except PermissionError:
+            pass  # another user's live process
 
 
 def dask_task(spec: dict) -> dict:
