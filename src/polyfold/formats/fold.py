@@ -83,6 +83,19 @@ def write_fold(path: str | os.PathLike, fold: dict) -> None:
     atomic_write(path, dumps(fold))
 
 
+def _json_kind(value) -> str:
+    """What a JSON value is, in words (for messages)."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    return "a list" if isinstance(value, list) else type(value).__name__
+
+
 def read_fold(path: str | os.PathLike) -> dict:
     """Read a FOLD file; raises PolyfoldError with a one-line message when it is not usable."""
     name = os.path.basename(os.fspath(path))
@@ -93,6 +106,10 @@ def read_fold(path: str | os.PathLike) -> dict:
         raise PolyfoldError(f"{name}: no such file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise PolyfoldError(f"{name}: not a readable FOLD (JSON) file: {exc}") from None
+    except RecursionError:
+        raise PolyfoldError(f"{name}: not a readable FOLD (JSON) file: nested too deeply") from None
+    if not isinstance(fold, dict):
+        raise PolyfoldError(f"{name}: a FOLD file is a JSON object, this one holds {_json_kind(fold)}")
     for key in REQUIRED:
         if key not in fold:
             raise PolyfoldError(f"{name}: FOLD file has no {key!r}")
@@ -182,6 +199,19 @@ def _fold_angles(fold: dict, n_e: int) -> np.ndarray:
     return deg
 
 
+def _check_no_overlap(tris: np.ndarray, parent: np.ndarray, piece: np.ndarray, tol: float) -> None:
+    """A malformed-net error naming two faces of one piece that overlap in the flat net (a net
+    that overlaps itself flat has no collision-free folding path to plan)."""
+    from ..collide.flat import find_overlaps
+
+    pairs = find_overlaps(tris, parent, tol)
+    pairs = pairs[piece[pairs[:, 0]] == piece[pairs[:, 1]]] if len(pairs) else pairs
+    if len(pairs):
+        a, b = (int(x) for x in pairs[0])
+        raise malformed_net(f"faces {a} and {b} overlap in the flat net ({len(pairs)} overlapping pair"
+                            f"{'s' * (len(pairs) > 1)})")
+
+
 def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     """The FoldTree of a FOLD net (as written by `pattern_fold`).
 
@@ -237,6 +267,7 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
     except Exception as exc:  # noqa: BLE001 (raised below, after the checks that come first)
         late = exc
     tree = build_tree(xy, faces, edges, kind, parent_in, piece_in, deg, folded, contact_tol, scale, stage, late)
+    _check_no_overlap(xy[faces], tree.parent, tree.piece, tree.tol)
     mesh_vertex = fold.get("polyfold:vertices_meshVertex")
     if isinstance(mesh_vertex, list) and len(mesh_vertex) == n_v:
         try:
@@ -245,6 +276,16 @@ def fold_tree(fold: dict, contact_tol: float = CONTACT_TOL) -> FoldTree:
             return tree
         return dataclasses.replace(tree, mesh_faces=np.ascontiguousarray(ids[faces]))
     return tree
+
+
+def read_net(path: str | os.PathLike, contact_tol: float = CONTACT_TOL) -> tuple[dict, FoldTree]:
+    """A FOLD file and its fold tree (`read_fold`, `fold_tree`); a net it cannot use is a
+    PolyfoldError naming the file."""
+    fold = read_fold(path)
+    try:
+        return fold, fold_tree(fold, contact_tol)
+    except PolyfoldError as exc:
+        raise type(exc)(f"{os.path.basename(os.fspath(path))}: {exc}") from None
 
 
 # ----------------------------------------------------------------------------------------------
@@ -269,8 +310,11 @@ def with_path(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: fl
     out["polyfold:path_linear"] = bool(path.linear)
     out["polyfold:path_resolutionDeg"] = float(resolution_deg)
     out["polyfold:path_contactTol"] = float(contact_tol)
-    folded = np.asarray(fold["file_frames"][0]["vertices_coords"], dtype=np.float64)
-    out["polyfold:path_thicknessRel"] = float(thickness) / max(bbox_diagonal(folded), 1e-300)
+    # relative to the model size as the tree measures it: the foldedForm, else the flat net
+    flat = np.asarray(fold["vertices_coords"], dtype=np.float64)
+    folded = _folded_coords(fold, len(flat))
+    size = bbox_diagonal(folded if folded is not None else flat)
+    out["polyfold:path_thicknessRel"] = float(thickness) / max(size, 1e-300)
     out["polyfold:path_verified"] = bool(verified)
     return out
 

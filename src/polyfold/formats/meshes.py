@@ -17,6 +17,9 @@ from ..mesh.repair import LoadedMesh, RawMesh, check_input, mesh_error, repair
 from .files import atomic_write
 
 
+MAX_INDEX = 2**40  # a vertex index beyond this is a broken file, not a mesh (numpy's int64 holds it)
+
+
 def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
     """Fan-triangulate polygons; returns (tris, source polygon per tri, number of polygons > 3)."""
     tris: list[tuple[int, int, int]] = []
@@ -86,6 +89,9 @@ def _parse_obj(text: str, name: str) -> RawMesh:
                     raise mesh_error(name, f"line {lineno}: face {face} has a bad vertex reference {tok!r}") from None
                 if k == 0:
                     raise mesh_error(name, f"line {lineno}: face {face} uses vertex index 0 (OBJ indices start at 1)")
+                if abs(k) > MAX_INDEX:
+                    raise mesh_error(name, f"line {lineno}: face {face} uses vertex index {tok.split('/', 1)[0]}, "
+                                           f"far beyond the file's vertices")
                 # Negative indices count back from the last vertex defined so far.
                 j = k - 1 if k > 0 else len(verts) + k
                 if j < 0:
@@ -149,17 +155,52 @@ def _parse_off(text: str, name: str) -> RawMesh:
     return RawMesh(vertices, tris, source, n_big, flines, vlines)
 
 
-def _load_trimesh(path: str, name: str) -> RawMesh:
+def _stl_counts(data: bytes, name: str) -> None:
+    """A binary STL whose header promises more triangles than the file holds: MeshError."""
+    if len(data) < 84 or data[:5].lower() == b"solid" and b"facet" in data[:1024]:
+        return  # (too short for a binary STL, or ASCII: trimesh's reader and "no faces" say it)
+    promised = int.from_bytes(data[80:84], "little")
+    held = (len(data) - 84) // 50
+    if held < promised:
+        raise mesh_error(name, f"file ends early: the header promises {promised} triangles, the file holds {held}")
+
+
+def _ply_counts(data: bytes, name: str) -> None:
+    """An ASCII PLY whose data lines are fewer than its header's element counts: MeshError naming
+    them (trimesh reads what is there without a word)."""
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0 or b"format ascii" not in data[:end]:
+        return
+    counts = []
+    for line in data[:end].decode("ascii", errors="replace").splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[0] == "element" and parts[2].isdigit():
+            counts.append((parts[1], int(parts[2])))
+    rows = [ln for ln in data[end:].split(b"\n")[1:] if ln.strip()]
+    need = sum(n for _, n in counts)
+    if len(rows) < need:
+        plural = {"vertex": "vertices"}
+        promised = " and ".join(f"{n} {kind if n == 1 else plural.get(kind, kind + 's')}" for kind, n in counts)
+        raise mesh_error(name, f"file ends early: the header promises {promised}, the file has {len(rows)} data lines")
+
+
+def _load_trimesh(path: str, name: str, data: bytes) -> RawMesh:
     import trimesh  # imported lazily: slow to import, and only needed for these formats
 
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".stl":
+        _stl_counts(data, name)
+    elif ext == ".ply":
+        _ply_counts(data, name)
     try:
         # process=False keeps vertices and faces exactly in file order; force='mesh' concatenates
         # the geometries of a scene (GLB/GLTF).
         tm = trimesh.load(path, process=False, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds of errors on broken files
-        raise mesh_error(name, f"cannot read: {type(exc).__name__}: {exc}") from None
+    except Exception as exc:  # trimesh raises many kinds of errors on broken files: say what, not how
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise mesh_error(name, f"not a readable {ext[1:].upper()} file ({why})") from None
     if not hasattr(tm, "faces") or tm.faces is None or len(tm.faces) == 0:
-        raise mesh_error(name, "no faces")
+        raise mesh_error(name, f"no faces could be read (not a valid {ext[1:].upper()} file?)")
     faces = np.asarray(tm.faces, dtype=np.int64).reshape(-1, 3)
     return RawMesh(np.asarray(tm.vertices, dtype=np.float64).reshape(-1, 3), faces, np.arange(len(faces)), 0)
 
@@ -172,11 +213,15 @@ def _read(path: str, name: str) -> RawMesh:
     parse = READERS[ext]
     try:
         with open(path, "rb") as fh:
-            data = fh.read() if parse is not None else b""
+            data = fh.read()
     except OSError as exc:
         raise mesh_error(name, f"cannot read: {exc.strerror or exc}") from None
     if parse is None:
-        return _load_trimesh(path, name)
+        return _load_trimesh(path, name, data)
+    nul = data.find(b"\0")
+    if nul >= 0:  # binary data in a text format: no guessing what the rest means
+        line = data.count(b"\n", 0, nul) + 1
+        raise mesh_error(name, f"line {line}: a NUL byte (binary data in a text {ext[1:].upper()} file?)")
     # Comments may hold any encoding; the data we need is ASCII.
     return parse(data.decode("utf-8", errors="replace"), name)
 

@@ -174,6 +174,9 @@ def inflate(
     return _result(mesh, surface, log, guard.notes, reason, done, hv)
 
 
+MAX_PARAMETER = 1e6  # pressures, moduli and stiffnesses above this are typing errors (the UI range is 0.1-10)
+
+
 def _check_arguments(mesh: Mesh, mode: str, vertex_rule: str, step: float, max_steps: int, log_every: int,
                      stall_window: int, nonnegative: dict[str, float]) -> None:
     """Raise PolyfoldError on an argument `inflate` cannot run with (nonnegative: name -> value of
@@ -185,6 +188,8 @@ def _check_arguments(mesh: Mesh, mode: str, vertex_rule: str, step: float, max_s
     for name, value in nonnegative.items():
         if not (math.isfinite(value) and value >= 0):
             raise PolyfoldError(f"{name} must be a finite number >= 0, not {value!r}")
+        if value > MAX_PARAMETER:
+            raise PolyfoldError(f"{name} must be at most {MAX_PARAMETER:g} (forces that large overflow), not {value!r}")
     if not (math.isfinite(step) and step > 0.9):
         raise PolyfoldError(f"step must be > 0.9 (dt = ln(step + 0.1) / 1000 > 0), not {step!r}")
     if max_steps < 0 or log_every < 1 or stall_window < 0:
@@ -333,6 +338,9 @@ class _Log:
 def _result(mesh: Mesh, surface: _Surface, log: _Log, notes: tuple, reason: str, done: int, hv: int) -> InflateResult:
     """The InflateResult of a run that stopped for `reason` after `done` steps at HV hv (the state
     in surface.X); logs that state if it is not the last row yet."""
+    if not np.isfinite(surface.X).all():  # (the guards compare positions: NaN slips past them)
+        raise PolyfoldError(f"inflation diverged by step {done} (positions no longer finite): lower the pressure "
+                            "or the stiffness ratio")
     IF = surface.inflation_rate(surface.X)
     out_mesh = Mesh(surface.X * surface.scale + surface.center, surface.F.copy(), mesh.face_source.copy())
     if not log.history or log.history[-1][0] != done:

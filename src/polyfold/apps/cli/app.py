@@ -62,7 +62,26 @@ def load(path: Path, quiet: bool = False):
 
 
 def main() -> None:
-    app()
+    """The `polyfold` command: a usage error (unknown option, bad or missing value) is one line
+    and exit 2, like every other error, not click's box."""
+    try:
+        from typer._click import exceptions as click_errors  # typer 0.2x carries its own click
+    except ImportError:  # pragma: no cover - older typer on the plain click package
+        from click import exceptions as click_errors
+
+    try:
+        code = app(standalone_mode=False)
+    except click_errors.NoArgsIsHelpError as exc:  # `polyfold` or `polyfold bench` alone: the help
+        exc.show()
+        code = exc.exit_code
+    except click_errors.UsageError as exc:
+        where = exc.ctx.command_path if exc.ctx is not None else "polyfold"
+        say(f"error: {where}: {exc.format_message()} (see {where} --help)")
+        code = 2
+    except (click_errors.Abort if hasattr(click_errors, "Abort") else typer.Abort, typer.Abort):
+        say("error: interrupted")
+        code = 130
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 # The verbs register themselves on `app` when imported, in this order: --help lists them in the

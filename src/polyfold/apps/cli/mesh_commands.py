@@ -90,7 +90,7 @@ def segment(
     output: Path = typer.Option(..., "-o", "--output", help="Folder for part-K.obj, labels.json, segments.ply/.glb/.png."),
     tau: Optional[float] = typer.Option(None, "--tau", min=0.0, help="Concavity bound per part, fraction of the bounding-box diagonal (default 0.05)."),
     parts: Optional[int] = typer.Option(None, "--parts", min=1, help="Pick tau so that there are this many parts (instead of --tau)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the surface samples of the concavity measure."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed of the surface samples of the concavity measure."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="With --parts: seconds for the search of tau (then the closest count found)."),
     png: bool = typer.Option(True, "--png/--no-png", help="Also draw segments.png."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or table, only errors."),

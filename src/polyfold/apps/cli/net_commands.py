@@ -41,7 +41,7 @@ def unfold(
     svg: Optional[Path] = typer.Option(None, "--svg", help="Also write an SVG cut sheet (mm units)."),
     png: Optional[Path] = typer.Option(None, "--png", help="Also write a PNG preview."),
     method: Method = typer.Option(Method.auto, "--method", help="Search method."),
-    seed: int = typer.Option(1, "--seed", help="Random seed (results are reproducible per seed)."),
+    seed: int = typer.Option(1, "--seed", min=0, help="Random seed (results are reproducible per seed)."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the whole search."),
     max_pieces: str = typer.Option("auto", "--max-pieces", help="'auto': fall back to several pieces; '1': fail instead."),
     size: float = typer.Option(100.0, "--size", min=1e-6, help="Longest model dimension on the sheet, in mm."),
@@ -135,7 +135,7 @@ def fold_cmd(
     planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then crease-by-crease unfolding, then Lazy PRM."),
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="Collision-check step along path segments, degrees."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
-    seed: int = typer.Option(1, "--seed", help="Random seed of the sampling planner."),
+    seed: int = typer.Option(1, "--seed", min=0, help="Random seed of the sampling planner."),
     contact_tol: float = contact_tol_option(),
     thickness: float = options.THICKNESS_REL_OPTION,
 ) -> None:
@@ -143,12 +143,11 @@ def fold_cmd(
     material's thickness, and check it again with an independent checker before writing it."""
     from ...errors import NoNetFound
     from ...formats.files import check_outputs
-    from ...formats.fold import fold_tree, read_fold, write_fold
+    from ...formats.fold import read_net, write_fold
     from ...pipeline.folding import plan_checked
 
     check_outputs([output], [net])
-    fold = read_fold(net)
-    tree = fold_tree(fold, contact_tol)
+    fold, tree = read_net(net, contact_tol)
     written, path, why = plan_checked(fold, tree, planner=planner.value, resolution_deg=resolution_deg,
                                       time_limit=time_limit, seed=seed, contact_tol=contact_tol,
                                       thickness_rel=thickness)
@@ -168,13 +167,13 @@ def cspace(
     net: Path = typer.Argument(..., help="Net as a FOLD file."),
     samples: int = typer.Option(1000, "--samples", min=1, help="Configurations to sample."),
     strategy: Strategy = typer.Option(Strategy.discrete, "--strategy", help="discrete: each crease flat or at its goal; continuous: uniform between."),
-    seed: int = typer.Option(1, "--seed"),
+    seed: int = typer.Option(1, "--seed", min=0),
     contact_tol: float = contact_tol_option(),
 ) -> None:
     """Print the valid configuration ratio |C_valid| / |C_sampled| of a net (paper Fig. 5)."""
     from ...fold.cspace import sample_ratio
-    from ...formats.fold import fold_tree, read_fold
+    from ...formats.fold import read_net
 
-    tree = fold_tree(read_fold(net), contact_tol)
+    _, tree = read_net(net, contact_tol)
     valid, total = sample_ratio(tree, samples, strategy.value, seed)
     print(f"{net.name}: DOF {len(tree.creases)}, strategy {strategy.value}, valid {valid} / {total} = {valid / total:.6g}")
