@@ -36,6 +36,27 @@ def test_off_quads(tmp_path: Path) -> None:
     assert signed_volume(loaded.mesh) == pytest.approx(1.0)
 
 
+def test_a_concave_polygon_is_cut_into_triangles_inside_it(tmp_path: Path) -> None:
+    # an L-shaped prism: its two hexagonal caps are concave at one corner; fanned from their first
+    # corner, some triangles would lie outside the L and fold back over the others
+    ring = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    lines = [f"v {x} {y} {z}" for z in (0, 1) for x, y in ring]
+    lines += ["f " + " ".join(str(k) for k in (6, 5, 4, 3, 2, 1)), "f " + " ".join(str(k) for k in range(7, 13))]
+    lines += [f"f {k + 1} {(k + 1) % 6 + 1} {(k + 1) % 6 + 7} {k + 7}" for k in range(6)]
+    (tmp_path / "l.obj").write_text("\n".join(lines) + "\n")
+    loaded = load_mesh(tmp_path / "l.obj")
+    mesh = loaded.mesh
+    assert mesh.n_faces == 2 * 4 + 6 * 2 and len(loaded.components) == 1
+    assert signed_volume(mesh) == pytest.approx(3.0)  # the L's area (3) times its height (1)
+    from shapely.geometry import Polygon
+
+    for cap in (0, 1):  # each cap's triangles tile the L exactly, none outside it
+        tris = [t for t, src in zip(mesh.faces, mesh.face_source) if src == cap]
+        polys = [Polygon(mesh.vertices[t][:, :2]) for t in tris]
+        assert len(polys) == 4 and sum(p.area for p in polys) == pytest.approx(3.0)
+        assert all(Polygon(ring).buffer(1e-9).contains(p) for p in polys)
+
+
 def test_obj_negative_indices_and_slashes(tmp_path: Path) -> None:
     lines = ["o cube", "vt 0 0", "vn 0 0 1"]
     lines += ["v " + " ".join(map(str, v)) for v in CUBE_V]

@@ -20,8 +20,11 @@ from .files import atomic_write
 MAX_INDEX = 2**40  # a vertex index beyond this is a broken file, not a mesh (numpy's int64 holds it)
 
 
-def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
-    """Fan-triangulate polygons; returns (tris, source polygon per tri, number of polygons > 3)."""
+def _triangulate(polygons: list[list[int]], vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Triangulate polygons; returns (tris, source polygon per tri, number of polygons > 3). A
+    convex polygon is fanned from its first corner; a concave one (seen in the plane of its
+    Newell normal) is cut into triangles inside it (`_concave`), never into triangles that fold
+    back over each other as a fan would."""
     tris: list[tuple[int, int, int]] = []
     source: list[int] = []
     n_big = 0
@@ -31,6 +34,11 @@ def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
             p = p + [p[-1]] * (3 - len(p))
         elif len(p) > 3:
             n_big += 1
+            inside = _concave(p, vertices)
+            if inside is not None:
+                tris += inside
+                source += [i] * len(inside)
+                continue
         for j in range(1, len(p) - 1):
             tris.append((p[0], p[j], p[j + 1]))
             source.append(i)
@@ -39,6 +47,50 @@ def _fan(polygons: list[list[int]]) -> tuple[np.ndarray, np.ndarray, int]:
         np.array(source, dtype=np.int64),
         n_big,
     )
+
+
+def _concave(poly: list[int], vertices: np.ndarray) -> list[tuple[int, int, int]] | None:
+    """The triangles of a concave, simple polygon (vertex ids in poly), inside it and turning as it
+    does: shapely's constrained Delaunay triangulation in the polygon's plane. None when the
+    polygon is convex, degenerate or not simple (then it is fanned), or an index is out of range
+    (reported later with its face)."""
+    if max(poly) >= len(vertices) or min(poly) < 0 or len(set(poly)) != len(poly):
+        return None
+    pts = vertices[poly]
+    if not np.isfinite(pts).all():
+        return None
+    nxt = np.roll(pts, -1, axis=0)
+    normal = np.array([((pts[:, 1] - nxt[:, 1]) * (pts[:, 2] + nxt[:, 2])).sum(),
+                       ((pts[:, 2] - nxt[:, 2]) * (pts[:, 0] + nxt[:, 0])).sum(),
+                       ((pts[:, 0] - nxt[:, 0]) * (pts[:, 1] + nxt[:, 1])).sum()])  # Newell: area-weighted
+    length = float(np.linalg.norm(normal))
+    if length == 0.0:
+        return None
+    n = normal / length
+    u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    xy = np.stack([pts @ u, pts @ np.cross(n, u)], axis=1)  # counter-clockwise seen along n
+    e1, e2 = np.roll(xy, -1, axis=0) - xy, np.roll(xy, -2, axis=0) - np.roll(xy, -1, axis=0)
+    turn = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    if (turn >= -1e-12 * float(np.abs(turn).max(initial=0.0))).all():
+        return None  # convex: the fan is inside it
+    import shapely
+
+    outline = shapely.Polygon(xy)
+    if not outline.is_valid:
+        return None
+    parts = shapely.get_parts(shapely.constrained_delaunay_triangles(outline))
+    if len(parts) != len(poly) - 2:
+        return None
+    out = []
+    for tri in parts:
+        corners = shapely.get_coordinates(tri)[:3]
+        ids = [int(np.argmin(((xy - c) ** 2).sum(axis=1))) for c in corners]
+        a, b, c = (xy[k] for k in ids)
+        if (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0:
+            ids[1], ids[2] = ids[2], ids[1]  # turn as the polygon turns
+        out.append(tuple(poly[k] for k in ids))
+    return out
 
 
 def _logical_lines(text: str):
@@ -100,8 +152,8 @@ def _parse_obj(text: str, name: str) -> RawMesh:
             polys.append(idx)
             flines.append(lineno)
         # Other tags (vt, vn, g, o, s, usemtl, mtllib, l, p, ...) carry nothing a net needs.
-    tris, source, n_big = _fan(polys)
     vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
+    tris, source, n_big = _triangulate(polys, vertices)
     return RawMesh(vertices, tris, source, n_big, flines, vlines)
 
 
@@ -150,8 +202,8 @@ def _parse_off(text: str, name: str) -> RawMesh:
             raise mesh_error(name, f"line {lineno}: face {i} should be a vertex count followed by that many indices") from None
         polys.append(idx)
         flines.append(lineno)
-    tris, source, n_big = _fan(polys)
     vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
+    tris, source, n_big = _triangulate(polys, vertices)
     return RawMesh(vertices, tris, source, n_big, flines, vlines)
 
 

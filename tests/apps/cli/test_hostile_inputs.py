@@ -139,3 +139,20 @@ def test_any_json_is_a_net_or_one_line(doc, tmp_path: Path) -> None:
         fold_tree(read_fold(path))
     except PolyfoldError as exc:
         assert "\n" not in str(exc).strip()
+
+
+def test_a_file_system_that_says_no_is_one_line_and_exit_2(capsys) -> None:
+    import errno
+
+    import typer
+
+    from polyfold.apps.cli.app import guard
+
+    @guard
+    def full_disk() -> None:
+        raise OSError(errno.ENOSPC, "No space left on device", "/out/sheet-01.svg")
+
+    with pytest.raises(typer.Exit) as exit_:
+        full_disk()
+    assert exit_.value.exit_code == 2
+    assert one_line(capsys.readouterr().err) == "polyfold: error: /out/sheet-01.svg: No space left on device"

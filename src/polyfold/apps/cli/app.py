@@ -44,6 +44,12 @@ def guard(func):
             fail("interrupted", 130)
         except typer.Exit:
             raise
+        except OSError as exc:
+            if exc.filename is None:
+                fail(one_line(exc), 3)
+            # the file system said no (full, read-only, no permission, vanished folder): the
+            # user's to fix, like bad input; every writer stages its files, so nothing half-written
+            fail(f"{exc.filename}: {exc.strerror or exc}", 2)
         except Exception as exc:  # last resort: still one line, no traceback
             fail(one_line(exc), 3)
 
