@@ -290,3 +290,39 @@ def test_random_flips_are_undone(data) -> None:
     assert loaded.oriented is (k == 0)
     if 0 < k < len(faces) - k:
         assert loaded.warnings[0].startswith(f"flipped {k} face")
+
+
+def _cube_obj(path: Path, boxes: list[tuple[float, float]]) -> Path:
+    """An OBJ of axis-aligned cubes, each (side, x offset), coordinates written exactly (repr)."""
+    corners = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    tris = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4),
+            (2, 6, 3), (3, 6, 7), (0, 4, 2), (2, 4, 6), (1, 3, 5), (3, 7, 5)]
+    lines = []
+    for k, (side, dx) in enumerate(boxes):
+        lines += [f"v {x * side + dx!r} {y * side!r} {z * side!r}" for x, y, z in corners]
+        lines += [f"f {a + 1 + 8 * k} {b + 1 + 8 * k} {c + 1 + 8 * k}" for a, b, c in tris]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_tolerances_follow_each_part_not_the_whole_file(tmp_path: Path) -> None:
+    # a 1 mm cube beside a 1 km one: neither is degenerate, nor welded into a point
+    loaded = load_mesh(_cube_obj(tmp_path / "two.obj", [(1e-3, 0.0), (1e6, 1e7)]))
+    assert loaded.mesh.n_faces == 24 and len(loaded.components) == 2
+    assert not [w for w in loaded.warnings if "degenerate" in w or "welded" in w]
+    for comp, side in zip(sorted(loaded.components, key=lambda c: np.ptp(c.vertices)), (1e-3, 1e6)):
+        assert signed_volume(comp) == pytest.approx(side ** 3, rel=1e-9)
+    # a face whose corners lie on one line is still dropped, whatever its size
+    bad = tmp_path / "sliver.obj"
+    bad.write_text(_cube_obj(tmp_path / "c.obj", [(1.0, 0.0)]).read_text() + "v 5 0 0\nv 6 0 0\nv 7 0 0\nf 9 10 11\n")
+    assert any("dropped 1 degenerate face" in w for w in load_mesh(bad).warnings)
+
+
+@pytest.mark.parametrize("side", [1e300, 1e-300, 1e150, 1e-150])
+def test_a_model_of_extreme_size_is_scaled_not_dropped(side: float, tmp_path: Path) -> None:
+    loaded = load_mesh(_cube_obj(tmp_path / "cube.obj", [(side, 0.0)]))
+    assert loaded.mesh.n_faces == 12 and len(loaded.components) == 1
+    (note,) = [w for w in loaded.warnings if "scaled by 2^" in w]
+    k = int(note.split("2^")[1].split()[0])
+    assert np.ptp(loaded.mesh.vertices, axis=0).max() == pytest.approx(side * 2.0 ** k)  # exactly rescaled
+    assert 0.5 <= np.ptp(loaded.mesh.vertices, axis=0).max() <= 2.0

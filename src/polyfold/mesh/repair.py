@@ -24,10 +24,13 @@ from .geometry import concavity, face_areas
 from .mesh import boundary_loops, edge_topology, face_components, Mesh, Topology
 
 
-DEGENERATE_AREA = 1e-12  # a face is degenerate when its area <= this * bbox_diag**2
+DEGENERATE_AREA = 1e-12  # a face is degenerate when its area <= this * (its longest side)**2: its corners
+# (nearly) on one line, whatever its size; a tiny face of a tiny part beside a huge one is not degenerate
 
 
-WELD_TOLERANCE = 1e-9  # vertices whose positions agree after rounding to this * bbox_diag are welded
+WELD_TOLERANCE = 1e-9  # vertices whose positions agree after rounding to this * bbox_diag are welded,
+WELD_EDGE = 1e-3  # or to this * the shortest side of a face, when less (a tiny part beside a huge one)
+SIZE_RANGE = (1e-30, 1e30)  # a model whose size is outside this is scaled by a power of two into it
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,12 +104,15 @@ def _repeated_index(faces: np.ndarray) -> np.ndarray:
     return (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
 
 
-def _weld_map(vertices: np.ndarray, faces: np.ndarray, diag: float) -> np.ndarray:
-    """Map (n,) from each vertex to the lowest-index referenced vertex at the same rounded position."""
+def _weld_map(vertices: np.ndarray, faces: np.ndarray, step: float) -> np.ndarray:
+    """Map (n,) from each vertex to the lowest-index referenced vertex at the same position
+    rounded to `step` (relative to the model's size: the test is scale-free)."""
     used = np.unique(faces)
     lo = vertices[used].min(axis=0)
-    # Rounding relative to the bbox makes the test scale-free; offsets from `lo` keep it in int64.
-    key = np.round((vertices[used] - lo) / (WELD_TOLERANCE * diag)).astype(np.int64)
+    if step <= 0.0:
+        step = 1.0  # every side has length 0: all corners coincide anyway
+    # offsets from `lo` keep the keys in int64 (a model's span over `step` is at most ~1e12)
+    key = np.round((vertices[used] - lo) / step).astype(np.int64)
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     remap = np.arange(len(vertices), dtype=np.int64)
     remap[used] = used[first][inverse.reshape(-1)]
@@ -286,11 +292,30 @@ class _Work:
 
 
 def _drop_degenerate(w: _Work) -> None:
-    """Drop faces with a repeated index or (near) zero area relative to the model size."""
-    diag = _bbox_diagonal(w.vertices, w.faces)
-    bad = _repeated_index(w.faces) | (face_areas(w.vertices, w.faces) <= DEGENERATE_AREA * diag**2)
+    """Drop faces with a repeated index or (near) zero area for their size (DEGENERATE_AREA)."""
+    longest = _side_lengths(w.vertices, w.faces).max(axis=1)
+    bad = _repeated_index(w.faces) | (face_areas(w.vertices, w.faces) <= DEGENERATE_AREA * longest**2)
     _note_degenerate(w, w.source[bad])
     w.keep(~bad)
+
+
+def _side_lengths(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) lengths of the sides of every face."""
+    tri = vertices[faces]
+    return np.linalg.norm(tri - np.roll(tri, -1, axis=1), axis=2)
+
+
+def _normalise(w: _Work) -> None:
+    """Scale a model whose size (largest bounding-box side) lies outside SIZE_RANGE by a power of
+    two (exact) into it: its squares and products would overflow or vanish in float64."""
+    used = w.vertices[np.unique(w.faces)]
+    size = float((used.max(axis=0) - used.min(axis=0)).max())
+    if size == 0.0 or SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
+        return
+    k = -int(round(np.log2(size)))
+    w.vertices = np.ldexp(w.vertices, k)
+    w.notes["scaled"] = (f"the model's size {size:.3g} is outside {SIZE_RANGE[0]:g}..{SIZE_RANGE[1]:g}: "
+                         f"coordinates scaled by 2^{k} (outputs are in those units)")
 
 
 def _note_degenerate(w: _Work, dropped: np.ndarray) -> None:
@@ -317,7 +342,10 @@ def _weld(w: _Work) -> None:
     A weld that would make an edge non-manifold without closing anything is undone for the
     vertices of that edge: two separate vertices at one position (a pinched surface) stay apart.
     """
-    welded = _weld_map(w.vertices, w.faces, _bbox_diagonal(w.vertices, w.faces))[w.faces]
+    sides = _side_lengths(w.vertices, w.faces)
+    shortest = float(sides[sides > 0].min()) if (sides > 0).any() else 0.0
+    step = min(WELD_TOLERANCE * _bbox_diagonal(w.vertices, w.faces), WELD_EDGE * shortest)
+    welded = _weld_map(w.vertices, w.faces, step)[w.faces]
     welded = _unweld_nonmanifold(welded, w.corners)
     w.faces = welded
     collapsed = _repeated_index(w.faces)
@@ -479,7 +507,7 @@ def _note_components(w: _Work, components: tuple[Mesh, ...]) -> None:
         w.notes["intersect"] = f"{len(crossing)} pairs of components intersect each other (e.g. components {i} and {j})"
 
 
-_NOTE_ORDER = ("triangulated", "degenerate", "welded", "duplicate", "unused", "split", "flipped", "inverted", "components", "intersect")
+_NOTE_ORDER = ("scaled", "triangulated", "degenerate", "welded", "duplicate", "unused", "split", "flipped", "inverted", "components", "intersect")
 
 
 def repair(parsed: RawMesh, path: str) -> LoadedMesh:
@@ -492,6 +520,7 @@ def repair(parsed: RawMesh, path: str) -> LoadedMesh:
     if parsed.n_triangulated:
         w.notes["triangulated"] = f"triangulated {_plural(parsed.n_triangulated, 'polygon')} with more than 3 corners"
 
+    _normalise(w)
     _drop_degenerate(w)
     if len(w.faces):
         _weld(w)

@@ -96,6 +96,9 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     return report
 
 
+MIN_DRAWN_MM = 1e-3  # a face narrower than this on paper (a micrometre) cannot be drawn, let alone cut
+
+
 def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, splits: int, split: PageSplit,
                    seconds: float) -> LayoutReport:
     st = sheets.stats
@@ -132,6 +135,11 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
         scale = model_scale([mesh], opts.size)
     except PolyfoldError as exc:
         raise PolyfoldError(f"{name}: {exc}") from None
+    edge, face = smallest_printed(mesh, scale)
+    if min(edge, face) < MIN_DRAWN_MM:  # a part far smaller than the rest: nothing to cut or fold
+        raise PolyfoldError(f"{name}: at --size {opts.size:g} mm its smallest face prints {min(edge, face):.3g} mm "
+                            f"across, too small to draw (under {MIN_DRAWN_MM:g} mm): a part far smaller than the "
+                            f"rest? make it on its own, or at a larger --size")
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
     box = pack_box(width, height, opts)
