@@ -17,3 +17,17 @@ def test_left_expired_and_shares():
     assert past.expired() and past.left() == 0.0 and past.share(3).expired()
     never = Deadline.never()
     assert never.at == math.inf and not never.expired() and never.within(1.0).at < math.inf
+
+
+def test_check_raises_out_of_time_only_when_expired():
+    import pytest
+
+    from polyfold.errors import OutOfTime
+
+    Deadline.never().check("anything")
+    Deadline.after(10).check("anything")
+    with pytest.raises(OutOfTime, match="while drawing") as err:
+        Deadline(time.perf_counter() - 1e-3).check("drawing")
+    assert err.value.doing == "drawing" and err.value.exit_code == 1
+    d = Deadline.after(5.0)
+    assert abs((d.at - d.before(2.0).at) - 2.0) < 1e-9

@@ -19,6 +19,17 @@ class NoNetFound(PolyfoldError):
     exit_code = 1
 
 
+class OutOfTime(PolyfoldError):
+    """A run reached its hard time limit in work it cannot skip (`Deadline.check`); `doing` says
+    what it was doing. The caller adds what to do about it (e.g. a smaller mesh)."""
+
+    exit_code = 1
+
+    def __init__(self, message: str, doing: str = "") -> None:
+        super().__init__(message)
+        self.doing = doing
+
+
 def one_line(exc: BaseException) -> str:
     """An exception as the one line a user sees: a PolyfoldError's message (its first line), any
     other exception as 'internal error (Type): first line'."""

@@ -16,6 +16,7 @@ from polyfold.errors import NoNetFound
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.geometry import merged_edges
 from polyfold.unfold.problem import HEURISTICS, UnfoldProblem
+from polyfold.unfold import kernels as K
 from polyfold.unfold.search import split_into_pieces, unfold
 
 PLATONIC = ["tetrahedron-4", "cube-12", "octahedron-8", "dodecahedron-36", "icosahedron-20"]
@@ -123,6 +124,47 @@ def test_fallback_splits_into_overlap_free_pieces(models_dir):
     # every overlapping pair is separated: some crease on its tree path is cut
     for f, g in pairs:
         assert cut[_tree_path(parent, order, f, g)].any()
+
+
+def test_fallback_in_blocks_still_separates_every_pair(models_dir, monkeypatch):
+    # a net of tens of thousands of faces has ~1e9 creases on its overlap paths: it is cut into
+    # blocks first; made to happen here on a small instance by lowering the cap
+    import polyfold.unfold.search as search
+
+    mesh = single_component(models_dir, "bumpy-528")
+    problem = UnfoldProblem.from_mesh(mesh)
+    parent, parent_edge, order, coords = problem.decode(HEURISTICS["flat-tree"](problem, np.random.default_rng(0)))
+    pairs = problem.overlaps(coords, parent)
+    whole = split_into_pieces(parent, parent_edge, order, pairs)
+    monkeypatch.setattr(search, "MAX_PATH_CREASES", 50)
+    monkeypatch.setattr(search, "PATH_BLOCK_FACES", 64)
+    cut = split_into_pieces(parent, parent_edge, order, pairs)
+    for f, g in pairs:
+        assert cut[_tree_path(parent, order, f, g)].any()
+    pieces = K.piece_labels(order, np.where(cut, -1, parent))
+    sizes = np.bincount(pieces)
+    assert cut.sum() > whole.sum() and sizes.max() < 3 * 64 + 1  # blocks, each under 3 blocks' faces
+
+
+def test_dfs_intervals_and_subtree_areas_match_a_plain_walk():
+    from polyfold.unfold.net import _dfs_intervals
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        n = int(rng.integers(1, 200))
+        perm = rng.permutation(n)
+        parent = np.full(n, -1, dtype=np.int64)
+        for k in range(1, n):
+            if rng.random() > 0.1:
+                parent[perm[k]] = perm[rng.integers(0, k)]
+        tin, tout = _dfs_intervals(parent)
+        assert sorted(tin.tolist()) == list(range(n))
+        for f in range(n):  # g in f's subtree iff f is g or an ancestor of g
+            for g in range(n):
+                a, up = g, False
+                while a >= 0 and not up:
+                    up, a = a == f, parent[a]
+                assert (tin[f] <= tin[g] < tout[f]) == up
 
 
 def test_time_limit_fallback_and_max_pieces(models_dir):

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..mesh.geometry import face_areas
 from ..mesh.mesh import Mesh
@@ -97,7 +98,7 @@ def _model_factor(points_mm: np.ndarray, page_size, margin: float, pad: float) -
 
 
 def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin: float,
-                 pad: float = TAB_ROOM_MM) -> tuple[Net, int]:
+                 pad: float = TAB_ROOM_MM, deadline: Deadline = Deadline.never()) -> tuple[Net, int]:
     """Cut creases of `net` until every piece, grown by `pad` mm (room for tabs), fits the page.
 
     Greedy: peel off a subtree that fits (the largest whose rest also fits, else the largest),
@@ -106,8 +107,8 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
     (`join_pieces`: a subtree peeled off a flat polygon's rim alone, say). Returns the new net and
     the number of pieces added (creases cut less pieces joined). Raises PieceTooLarge (a
     PolyfoldError) when a single face or flat polygon is too large, with the scale factor that
-    would fit."""
-    net, cuts = _peel_to_fit(net, scale, page_size, margin, pad)
+    would fit; OutOfTime past `deadline` (`Deadline.check`)."""
+    net, cuts = _peel_to_fit(net, scale, page_size, margin, pad, deadline)
     if cuts == 0:
         return net, 0
     net, joins = join_pieces(net, scale, page_size, margin, pad, limit=cuts)
@@ -115,20 +116,28 @@ def split_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
 
 
 def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin: float,
-                 pad: float) -> tuple[Net, int]:
+                 pad: float, deadline: Deadline) -> tuple[Net, int]:
     """`split_to_fit`'s peeling: (net, creases cut)."""
     xy = net.coords * scale
     cuts = 0
     cuttable = net.cuttable  # cutting a crease changes no other crease's
+    # a set of faces whose area exceeds the printable area cannot fit: no hull to build for it
+    printable = (page_size[0] - 2 * margin) * (page_size[1] - 2 * margin) / scale ** 2
+    fits: set[int] = set()  # roots of pieces known to fit (peeling never changes such a piece)
     for _ in range(len(net.piece)):
+        deadline.check("cutting the pieces to fit the page")
         sub_area, tin, tout = subtree_areas(net)
         by_tin = np.argsort(tin)
         todo = None
-        for p in range(net.n_pieces):
-            faces = np.flatnonzero(net.piece == p)
-            if _hull_scale(xy[faces].reshape(-1, 2), page_size, margin, pad) < 1.0:
-                todo = faces
-                break
+        for root in np.flatnonzero(net.parent < 0).tolist():
+            if root in fits:
+                continue
+            faces = np.sort(by_tin[tin[root]:tout[root]])
+            if sub_area[root] <= printable and _hull_scale(xy[faces].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+                fits.add(root)
+                continue
+            todo = faces
+            break
         if todo is None:
             return net, cuts
         cand = todo[cuttable[todo]]
@@ -141,13 +150,14 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
         chosen, fitting = None, []
         in_piece = np.zeros(len(net.piece), dtype=bool)
         in_piece[todo] = True
-        for c in cand:
+        whole = float(sub_area[todo[net.parent[todo] < 0][0]])
+        for c in cand[sub_area[cand] <= printable]:
             members = by_tin[tin[c]:tout[c]]
             if _hull_scale(xy[members].reshape(-1, 2), page_size, margin, pad) >= 1.0:
                 fitting.append(int(c))
                 rest = in_piece.copy()
                 rest[members] = False
-                if _hull_scale(xy[rest].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+                if whole - sub_area[c] <= printable and _hull_scale(xy[rest].reshape(-1, 2), page_size, margin, pad) >= 1.0:
                     chosen = int(c)
                     break
                 if len(fitting) >= MAX_PEEL_TRIES:
@@ -156,6 +166,8 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
             chosen = fitting[0]
         if chosen is None:  # not even one face fits on its own below the root: cut the root off
             chosen = int(cand[-1])
+        else:
+            fits.add(chosen)
         net = cut_creases(net, np.array([chosen]))
         cuttable[chosen] = False
         cuts += 1

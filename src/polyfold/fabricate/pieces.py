@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..deadline import Deadline
 from ..mesh.geometry import FLAT_EPS, merged_edges  # flat creases are not scored, as in the FOLD files
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
@@ -257,7 +258,7 @@ class _Glued:
 
 
 def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
-          rho: dict[tuple[int, int], float]) -> tuple[_Glued, list[Tab | None]]:
+          rho: dict[tuple[int, int], float], deadline: Deadline) -> tuple[_Glued, list[Tab | None]]:
     """Note slits (two sides of one piece that touch in the plane) and give each glued pair (label
     = its 1-based rank) its tab (`choose_tab`); every tab joins its piece's `Room`."""
     from shapely.geometry import Polygon
@@ -265,6 +266,7 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
     out = _Glued(len(drawn))
     chosen: list[Tab | None] = []
     for idx, (key, (o1, o2)) in enumerate(pairs):
+        deadline.check(f"placing the tabs of {len(pairs):,} glued edges")
         label = str(idx + 1)
         if o1.piece == o2.piece and np.allclose(o1.p0, o2.p1, atol=1e-6) and np.allclose(o1.p1, o2.p0, atol=1e-6):
             out.slits[o1.piece].append(np.array([o1.p0, o1.p1]))  # the two sides touch in the plane
@@ -290,7 +292,7 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
 
 
 def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
-            min_label_mm: float, runs: list[list[int]], all_or_none: bool = False
+            min_label_mm: float, runs: list[list[int]], deadline: Deadline, all_or_none: bool = False
             ) -> tuple[list[PieceLabels], LabelStats] | None:
     """Every piece's name, then one glue label per copy of every run of glued pairs (a run of
     one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
@@ -301,6 +303,7 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     for i, d in enumerate(drawn):
         placed[i].piece(d.faces_xy, piece_name(i))
     for run in runs:
+        deadline.check(f"placing the glue labels of {len(pairs):,} glued edges")
         for copy in _run_copies(run, pairs, chosen):
             labels = placed[copy[0][0].piece]
             before = labels.stats.unplaced
@@ -378,22 +381,28 @@ def glue_strip(label: str, length: float, rho: float, part: int, size: float) ->
 
 
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
-                       min_label_mm: float = MIN_LABEL_MM) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+                       min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never()
+                       ) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
     """Draw every piece in mm and pair up their cut edges (see the module docstring). Tabs:
     `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed.
-    Labels: `labels.PieceLabels`, cap height at least `min_label_mm`."""
+    Labels: `labels.PieceLabels`, cap height at least `min_label_mm`. OutOfTime past `deadline`
+    (checked between pieces, tabs and labels)."""
     import shapely
 
-    drawn = [_draw(inp, i, scale) for i, inp in enumerate(inputs)]
+    drawn = []
+    for i, inp in enumerate(inputs):
+        deadline.check(f"drawing {len(inputs):,} pieces")
+        drawn.append(_draw(inp, i, scale))
     pairs, open_edges = _pair_sides(drawn)
     rooms = [Room(shapely.polygons(d.faces_xy)) for d in drawn]
     rho, flat = seam_fold_angles(inputs)
     # a flat polygon whose faces close a cycle keeps one edge out of its tree: both sides lie on
     # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
-    g, chosen = _glue(pairs, drawn, rooms, tabs, rho)
+    g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline)
     bare = [room.copy() for room in rooms]
-    per_edge = _labels(pairs, drawn, rooms, chosen, min_label_mm, [[i] for i in range(len(pairs))], all_or_none=True)
+    per_edge = _labels(pairs, drawn, rooms, chosen, min_label_mm, [[i] for i in range(len(pairs))], deadline,
+                       all_or_none=True)
     if per_edge is not None:
         placed, label_stats = per_edge
     else:
@@ -403,7 +412,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         runs = _split_at(runs, {int(label) - 1 for label in g.untabbed})
         # the shortest runs first: they sit where the mesh is densest and have the fewest places
         runs.sort(key=lambda run: sum(pairs[i][1][0].length for i in run))
-        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs)
+        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs, deadline)
         for run in runs:
             for i in run:
                 g.glue[i] = replace(g.glue[i], printed=str(min(run) + 1))

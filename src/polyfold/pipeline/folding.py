@@ -66,8 +66,9 @@ class _Planner:
     """The fold stage's state: pieces still to plan (for the time shares), splits, results."""
 
     def __init__(self, opts: MakeOptions, deadline: Deadline, n_parts: int, pending: int,
-                 say: Callable[[str, str], None], thickness: float) -> None:
+                 say: Callable[[str, str], None], thickness: float, hard: Deadline) -> None:
         self.opts, self.deadline, self.n_parts, self.say = opts, deadline, n_parts, say
+        self.hard = hard  # past it no piece is planned: OutOfTime
         self.thickness = thickness  # model units
         self.pending = pending
         self.splits = 0
@@ -82,6 +83,7 @@ class _Planner:
         if pnet.mesh.n_faces == 1:
             info = PathInfo(path=True, linear=True, planner="trivial", note="single face")
         elif opts.fold:
+            self.hard.check(f"planning folding paths ({self.pending} pieces to go)")
             self.say("fold", f"part {pi + 1}/{self.n_parts}: planning a path for {pnet.mesh.n_faces} faces")
             tf = time.perf_counter()
             tree = FoldTree.from_pattern(pattern, opts.contact_tol).with_thickness(self.thickness)
@@ -169,12 +171,13 @@ def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, th
 
 
 def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None],
-                mm_per_unit: float) -> tuple[list[FoldedPiece], FoldReport]:
+                mm_per_unit: float, hard: Deadline = Deadline.never()) -> tuple[list[FoldedPiece], FoldReport]:
     """Every piece of every part's net, with its folding path (see the module docstring); the
-    paper's thickness (opts.thickness mm) is mm_per_unit-scaled to model units."""
+    paper's thickness (opts.thickness mm) is mm_per_unit-scaled to model units. `deadline`: the
+    searches' (each piece still gets half a second past it); past `hard` OutOfTime."""
     t0 = time.perf_counter()
     planner = _Planner(opts, deadline, len(parts), sum(p.net.n_pieces for p in parts), say,
-                       opts.thickness / mm_per_unit)
+                       opts.thickness / mm_per_unit, hard)
     for pi, part in enumerate(parts):
         for k in range(part.net.n_pieces):
             planner.plan(pi, part.faces, *piece_net(part.net, k), 0)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..deadline import Deadline
-from ..errors import PolyfoldError
+from ..errors import OutOfTime, PolyfoldError
 from ..fabricate.check import check_pages
 from ..fabricate.fit import model_scale, smallest_printed
 from ..fabricate.paper import GAP_MM
@@ -96,6 +96,24 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     return report
 
 
+# The time limit holds for the whole run. The searches (unfold, fold) end early enough to leave the
+# work after them its time: drawing every piece with its tabs and labels, packing, checking and
+# writing take about 2-7 ms a face (star-4split-96-loop2, 1,536 faces: 10 s a drawing; a
+# 20,480-face sphere: 99 s), so a mesh gets LAYOUT_S + LAYOUT_S_PER_FACE a face of it, at most
+# half the limit. The optional layout work (cuts for crowded labels, fewer pages) then stops
+# TAIL_S + TAIL_S_PER_FACE a face (at most a quarter of the limit) before the end, for folding,
+# packing, checking and writing; the drawing it cannot skip stops the run at the limit.
+LAYOUT_S, LAYOUT_S_PER_FACE = 2.0, 0.01
+TAIL_S, TAIL_S_PER_FACE = 2.0, 0.001
+
+
+def time_shares(n_faces: int, time_limit: float) -> tuple[float, float]:
+    """(seconds kept back from the searches for the layout and after, seconds kept back from the
+    optional layout work for folding, packing, checking and writing) for a mesh of `n_faces`."""
+    return (min(0.5 * time_limit, LAYOUT_S + LAYOUT_S_PER_FACE * n_faces),
+            min(0.25 * time_limit, TAIL_S + TAIL_S_PER_FACE * n_faces))
+
+
 MIN_DRAWN_MM = 1e-3  # a face narrower than this on paper (a micrometre) cannot be drawn, let alone cut
 
 
@@ -113,7 +131,7 @@ def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, 
         small_labels=st.small_labels, open_edges=st.open_edges, smallest_edge_mm=edge, smallest_face_mm=face,
         reduced_tabs=st.reduced_tabs, labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside,
         seam_runs=st.seam_runs, min_label_mm=opts.min_label_mm, splits_for_packing=split.cuts, splits_for_labels=split.label_cuts,
-        packing_ran_out=split.ran_out or sheets.packing.ran_out)
+        packing_ran_out=split.ran_out or sheets.packing.ran_out, labels_ran_out=split.labels_ran_out)
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),
@@ -126,11 +144,28 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     width, height = check_options(opts)
     inputs = (Path(source),) if isinstance(source, (str, os.PathLike)) else ()
     check_folder(out_dir, OUTPUTS, inputs)
-    deadline = Deadline.after(opts.time_limit)
+    hard = Deadline.after(opts.time_limit)  # the whole run's
     t0 = time.perf_counter()
     mesh, input_report, load_report, name = _load(source, name, say)
+    try:
+        return _make(mesh, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report, inputs)
+    except OutOfTime as exc:
+        raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
+                        f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh to a few "
+                        f"thousand faces first (e.g. Blender's Decimate modifier) or raise --time-limit",
+                        exc.doing) from None
+
+
+def _make(mesh: Mesh, name: str, out_dir: str | os.PathLike, opts: MakeOptions, page: tuple[float, float],
+          say: Progress, hard: Deadline, t0: float, input_report: InputReport, load_report: LoadReport,
+          inputs: tuple[Path, ...]) -> MakeResult:
+    """`make` after loading (page: width, height in mm): OutOfTime when `hard` passes in work that
+    cannot be skipped."""
+    width, height = page
+    layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
+    searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
-    parts, segment_report, unfold_report = make_parts(mesh, opts, deadline, say)
+    parts, segment_report, unfold_report = make_parts(mesh, opts, searches, say, hard=hard)
     try:
         scale = model_scale([mesh], opts.size)
     except PolyfoldError as exc:
@@ -143,12 +178,12 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     ts = time.perf_counter()
     say("layout", "fitting pieces to the page")
     box = pack_box(width, height, opts)
-    fitted, page_splits = fit_parts(parts, scale, opts, box, name)
-    split = split_for_pages(mesh, fitted, scale, opts, box, deadline, say)
+    fitted, page_splits = fit_parts(parts, scale, opts, box, name, hard)
+    split = split_for_pages(mesh, fitted, scale, opts, box, optional, say, hard=hard)
     fitted = split.parts
     fit_seconds = time.perf_counter() - ts
-    folded, fold_report = fold_pieces(fitted, opts, deadline, say, scale)
-    sheets = lay_out(mesh, folded, scale, opts, width, height, deadline, say, planned=split)
+    folded, fold_report = fold_pieces(fitted, opts, searches, say, scale, hard=hard)
+    sheets = lay_out(mesh, folded, scale, opts, width, height, hard, say, planned=split)
     checks = _check(sheets, opts, name, fold_report.verified, say)
     layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)
     te = time.perf_counter()

@@ -2,7 +2,8 @@
 
 `make_parts` is make's segment + unfold stage: with `--tau` / `--parts` the mesh is segmented
 first; with `--segment auto` every connected component stays whole when it has a single-piece net
-(found within its share of half the time limit) and is segmented otherwise. `unfold_components`
+(found within its share of half the time limit) and is segmented otherwise (past the searches'
+deadline: unfolded into pieces as it is). `unfold_components`
 is the `unfold` command's: every component unfolded in its share of the time left.
 """
 
@@ -62,9 +63,11 @@ class _Segmenter:
         return [faces[f] for f in seg.face_ids]
 
 
-def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline,
-               say: Callable[[str, str], None]) -> tuple[list[Part], SegmentReport, UnfoldReport]:
-    """The parts of the mesh with their nets (see the module docstring), and the stage reports."""
+def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None],
+               hard: Deadline = Deadline.never()) -> tuple[list[Part], SegmentReport, UnfoldReport]:
+    """The parts of the mesh with their nets (see the module docstring), and the stage reports.
+    `deadline`: the searches'; past `hard` OutOfTime (every part needs a net, however short its
+    search: past `deadline` each still gets MIN_UNFOLD_S)."""
     comp, components = component_faces(mesh)
     explicit = opts.tau is not None or opts.parts is not None
     mode = "tau" if opts.tau is not None else "parts" if opts.parts is not None else opts.segment
@@ -80,21 +83,31 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline,
         todo = list(components)
     out: list[Part] = []
     while todo:
+        hard.check(f"unfolding part {len(out) + 1} ({len(todo) + 1} to go)")
         faces = todo.pop(0)
         part_mesh = mesh.submesh(faces)
         left = max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
         say("unfold", f"part {len(out) + 1}: {len(faces)} faces")
         tu = time.perf_counter()
         try:
-            single = mode == "auto" and len(faces) > 1
+            # past the searches' deadline a part is unfolded into pieces at once: no time for a
+            # single net, nor for segmenting (one kernel run, 19 s on 22k faces, minutes on 89k)
+            single = mode == "auto" and len(faces) > 1 and not deadline.expired()
             net, st = unfold(part_mesh, seed=opts.seed, time_limit=left, max_pieces=1 if single else None)
         except NoNetFound:
             # auto: no single net for this component in time -> split it into nearly convex parts
             unfold_s += time.perf_counter() - tu
-            say("segment", f"no single net for a {len(faces)}-face component: segmenting it")
-            segmented.append(int(comp[faces[0]]))
-            subs = segmenter(faces, None, None)
+            if deadline.expired():
+                say("segment", f"no single net for a {len(faces)}-face component, and no time left to segment it: "
+                               "unfolding it into pieces")
+                subs = [faces]
+            else:
+                say("segment", f"no single net for a {len(faces)}-face component: segmenting it")
+                segmented.append(int(comp[faces[0]]))
+                subs = segmenter(faces, None, None)
             if len(subs) == 1:  # already nearly convex: accept several pieces instead
+                left = max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
+                hard.check(f"unfolding part {len(out) + 1} ({len(todo) + 1} to go)")
                 net, st = unfold(part_mesh, seed=opts.seed, time_limit=left)
             else:
                 todo = subs + todo

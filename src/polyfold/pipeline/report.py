@@ -116,6 +116,7 @@ class LayoutReport:
     splits_for_packing: int = 0  # creases cut so that the pieces fill fewer pages
     splits_for_labels: int = 0  # creases cut where labels found no readable place (before the page split)
     packing_ran_out: bool = False  # the packer's time budget stopped its search
+    labels_ran_out: bool = False  # the time limit stopped the cuts for labels with no readable place
 
 
 @dataclass(frozen=True)

@@ -54,14 +54,15 @@ def _packer_page(box: tuple[float, float, float, float]) -> tuple[tuple[float, f
 
 
 def fit_parts(parts: list[Part], scale: float, opts: MakeOptions, box: tuple[float, float, float, float],
-              name: str) -> tuple[list[Part], int]:
+              name: str, deadline: Deadline = Deadline.never()) -> tuple[list[Part], int]:
     """The parts with their nets split along creases until every piece (with room for its tabs)
     fits `box` (`pack_box`); the number of pieces that added (`split_to_fit`). PolyfoldError naming
-    the largest size that fits when a single face (or flat polygon) does not."""
+    the largest size that fits when a single face (or flat polygon) does not; OutOfTime past
+    `deadline`."""
     fitted, splits = [], 0
     for part in parts:
         try:
-            net, cuts = split_to_fit(part.net, scale, *_packer_page(box))
+            net, cuts = split_to_fit(part.net, scale, *_packer_page(box), deadline=deadline)
         except PieceTooLarge as exc:
             largest = math.floor(opts.size * exc.factor * 10) / 10
             raise PolyfoldError(f"{name}: at --size {opts.size:g} mm {exc.what} alone (with its tabs) does not "
@@ -124,6 +125,7 @@ class PageSplit:
     drawn: tuple[list[SheetPiece], list[GlueEdge], LayoutStats]  # build_sheet_pieces of `parts`' pieces
     inputs: list[PieceInput]  # what was drawn
     label_cuts: int = 0  # creases cut before that where labels found no readable place (in `parts`)
+    labels_ran_out: bool = False  # the time limit stopped those cuts with labels still crowded
 
     def same_pieces(self, folded: list[FoldedPiece]) -> bool:
         """Whether the folded pieces are the very pieces planned (folding split none)."""
@@ -171,17 +173,20 @@ LABEL_ROUNDS = 3  # rounds of cuts for labels with no readable place (each redra
 
 
 def _split_for_labels(mesh: Mesh, parts: list[Part], inputs: list[PieceInput], drawn, draw,
-                      say: Callable[[str, str], None]):
+                      say: Callable[[str, str], None], deadline: Deadline, draw_seconds: float):
     """The parts, their pieces and drawing with a crease cut in every piece some of whose labels
     found no readable place (`fabricate.split.plan_label_cuts`), redrawn, for up to LABEL_ROUNDS
-    rounds while that leaves fewer such labels; and the creases cut. The rounds are made whatever
-    the time limit says: they are bounded redraws, not a search, unfolding a dense mesh takes the
-    time limit to itself, and an unreadable label is worse than a late sheet."""
+    rounds while that leaves fewer such labels; the creases cut; and whether `deadline` stopped
+    the rounds (a round is started only with `draw_seconds`, one drawing's time, left: the
+    unfold searches of a dense mesh take their time first, so here is where a tight limit shows)."""
     cuts = 0
     for _ in range(LABEL_ROUNDS):
         crowded = drawn[2].crowded
         if not crowded:
             break
+        if deadline.left() < draw_seconds:
+            say("layout", f"no time left to cut pieces where {len(crowded)} label(s) found no room")
+            return parts, inputs, drawn, cuts, True
         plan = plan_label_cuts(drawn[0], [inp.net for inp in inputs], crowded)
         if not any(len(c) for c in plan):
             break
@@ -192,12 +197,12 @@ def _split_for_labels(mesh: Mesh, parts: list[Part], inputs: list[PieceInput], d
         if len(cut_drawn[2].crowded) >= len(crowded):
             break
         parts, inputs, drawn, cuts = cut_parts, cut_inputs, cut_drawn, cuts + n_cut
-    return parts, inputs, drawn, cuts
+    return parts, inputs, drawn, cuts, False
 
 
 def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptions,
                     box: tuple[float, float, float, float], deadline: Deadline,
-                    say: Callable[[str, str], None]) -> PageSplit:
+                    say: Callable[[str, str], None], hard: Deadline = Deadline.never()) -> PageSplit:
     """Cut creases where that puts the pieces on fewer pages (`fabricate.split`), before folding.
 
     The pieces are drawn (tabs and labels included) and packed as they are. Then, for each page
@@ -211,11 +216,13 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     fill at most COMPACT_FILL of the pages; when that is met, one page fewer again. `box`:
     `pack_box`. Time: `pack_budget` and one drawing's time (as long as the first drawing took),
     from after the first drawing (`lay_out` reuses it when folding splits nothing); a plan is only
-    started with that drawing's time left."""
+    started with that drawing's time left. `deadline` ends this optional work (the label rounds
+    too); a drawing stops the run at `hard` (OutOfTime)."""
     page, margin = _packer_page(box)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
-        pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm)
+        pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm,
+                                                 deadline=hard)
         return pieces, glue, stats
 
     def pack(pcs: list[SheetPiece], hint: list[int] | None, seconds: float) -> Packing:
@@ -226,7 +233,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     t0 = time.perf_counter()
     drawn = draw(inputs)  # lay_out's drawing when folding splits nothing: not this stage's cost
     draw_seconds = time.perf_counter() - t0
-    parts, inputs, drawn, label_cuts = _split_for_labels(mesh, parts, inputs, drawn, draw, say)
+    parts, inputs, drawn, label_cuts, labels_ran_out = _split_for_labels(mesh, parts, inputs, drawn, draw, say,
+                                                                         deadline, draw_seconds)
     pieces = drawn[0]
     packing = pack(pieces, None, pack_budget(deadline))
     # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
@@ -300,7 +308,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
         if i < len(inputs):  # glue strips come after the net pieces and have no faces
             rank[inputs[i].face_ids] = pos
     return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs,
-                     label_cuts)
+                     label_cuts, labels_ran_out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -340,7 +348,7 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     else:
         say("layout", f"tabs and labels for {len(folded)} pieces")
         pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
-                                                 min_label_mm=opts.min_label_mm)
+                                                 min_label_mm=opts.min_label_mm, deadline=deadline)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     page, margin = _packer_page(pack_box(width, height, opts))
     hint = None if planned is None else planned.hint(folded, len(pieces))

@@ -354,16 +354,56 @@ def tree_path(a, b, parent, depth, out, k):
 
 
 @njit(cache=True)
+def tree_path_ptr(parent, order, pairs, limit):
+    """The CSR ptr (P+1,) of `tree_paths` (ptr[-1]: the creases on all paths) without the paths;
+    once more than `limit` creases are counted, the ptr so far (its last entry over `limit`)."""
+    n = parent.shape[0]
+    depth = np.empty(n, dtype=np.int64)
+    tree_depths(parent, order, depth)
+    ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
+    for r in range(pairs.shape[0]):
+        a, b, k = pairs[r, 0], pairs[r, 1], 0
+        while a != b:
+            if depth[a] >= depth[b]:
+                a = parent[a]
+            else:
+                b = parent[b]
+            k += 1
+        ptr[r + 1] = ptr[r] + k
+        if ptr[r + 1] > limit:
+            return ptr[:r + 2]
+    return ptr
+
+
+@njit(cache=True)
+def size_cuts(parent, order, cuttable, block):
+    """(F,) bool: creases (named by their child face) that cut a forest into pieces of about
+    `block` faces: bottom up, the crease above a face whose uncut subtree has reached `block`
+    faces (when `cuttable` allows; a face has at most 3 children, so a piece stays under
+    about 3 `block` faces where creases may be cut). Parents must precede children in `order`."""
+    n = parent.shape[0]
+    size = np.ones(n, dtype=np.int64)
+    cut = np.zeros(n, dtype=np.bool_)
+    for idx in range(n - 1, -1, -1):
+        f = order[idx]
+        p = parent[f]
+        if p < 0:
+            continue
+        if size[f] >= block and cuttable[f]:
+            cut[f] = True
+        else:
+            size[p] += size[f]
+    return cut
+
+
+@njit(cache=True)
 def tree_paths(parent, order, pairs):
     """Tree paths between the faces of each pair, as CSR (ptr, members); a crease is named by its
     child face. Parents must precede children in `order`."""
     n = parent.shape[0]
     depth = np.empty(n, dtype=np.int64)
     tree_depths(parent, order, depth)
-    scratch = np.empty(n, dtype=np.int64)  # a path has fewer creases than the tree has faces
-    ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
-    for r in range(pairs.shape[0]):
-        ptr[r + 1] = ptr[r] + tree_path(pairs[r, 0], pairs[r, 1], parent, depth, scratch, 0)
+    ptr = tree_path_ptr(parent, order, pairs, np.iinfo(np.int64).max)
     members = np.empty(ptr[-1], dtype=np.int64)
     for r in range(pairs.shape[0]):
         tree_path(pairs[r, 0], pairs[r, 1], parent, depth, members, ptr[r])
@@ -434,3 +474,51 @@ def piece_labels(order, parent):
         else:
             piece[f] = piece[parent[f]]
     return piece
+
+
+@njit(cache=True)
+def dfs_intervals(parent):
+    """Euler-tour (tin, tout) (F,) per face of the forest `parent` (F,) (-1 at roots): roots in
+    face order, each face's children in face order; g is in the subtree of f iff
+    tin[f] <= tin[g] < tout[f]."""
+    n = parent.shape[0]
+    first = np.zeros(n + 1, dtype=np.int64)  # children of f: kids[first[f]:first[f + 1]], ascending
+    for f in range(n):
+        if parent[f] >= 0:
+            first[parent[f] + 1] += 1
+    for f in range(n):
+        first[f + 1] += first[f]
+    kids = np.empty(first[n], dtype=np.int64)
+    fill = first[:n].copy()
+    for f in range(n):
+        p = parent[f]
+        if p >= 0:
+            kids[fill[p]] = f
+            fill[p] += 1
+    tin = np.zeros(n, dtype=np.int64)
+    tout = np.zeros(n, dtype=np.int64)
+    stack = np.empty(n, dtype=np.int64)  # faces whose subtree is open; next child to visit in `nxt`
+    nxt = np.zeros(n, dtype=np.int64)
+    t = 0
+    for root in range(n):
+        if parent[root] >= 0:
+            continue
+        top = 0
+        stack[0] = root
+        tin[root] = t
+        t += 1
+        nxt[root] = first[root]
+        while top >= 0:
+            f = stack[top]
+            if nxt[f] < first[f + 1]:
+                g = kids[nxt[f]]
+                nxt[f] += 1
+                tin[g] = t
+                t += 1
+                nxt[g] = first[g]
+                top += 1
+                stack[top] = g
+            else:
+                tout[f] = t
+                top -= 1
+    return tin, tout

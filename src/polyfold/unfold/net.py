@@ -97,28 +97,8 @@ def piece_net(net: Net, piece: int) -> tuple[Net, np.ndarray]:
 
 def _dfs_intervals(parent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Euler-tour (tin, tout) per face of a forest: g is in the subtree of f iff
-    tin[f] <= tin[g] < tout[f]."""
-    n = len(parent)
-    children: list[list[int]] = [[] for _ in range(n)]
-    for f, p in enumerate(parent.tolist()):
-        if p >= 0:
-            children[p].append(f)
-    tin = np.zeros(n, dtype=np.int64)
-    tout = np.zeros(n, dtype=np.int64)
-    t = 0
-    for root in np.flatnonzero(parent < 0).tolist():
-        stack = [(root, 0)]
-        while stack:
-            f, i = stack.pop()
-            if i == 0:
-                tin[f] = t
-                t += 1
-            if i < len(children[f]):
-                stack.append((f, i + 1))
-                stack.append((children[f][i], 0))
-            else:
-                tout[f] = t
-    return tin, tout
+    tin[f] <= tin[g] < tout[f] (`kernels.dfs_intervals`)."""
+    return K.dfs_intervals(np.asarray(parent, dtype=np.int64))
 
 
 def subtree_areas(net: Net) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -128,10 +108,9 @@ def subtree_areas(net: Net) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     e1, e2 = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
     sub_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
     tin, tout = _dfs_intervals(net.parent)
-    for f in np.argsort(tin)[::-1]:  # children come after their parent in tin order
-        if net.parent[f] >= 0:
-            sub_area[net.parent[f]] += sub_area[f]
-    return sub_area, tin, tout
+    # a subtree is a contiguous run in tin order: its area is a difference of prefix sums
+    prefix = np.concatenate([[0.0], np.cumsum(sub_area[np.argsort(tin)])])
+    return prefix[tout] - prefix[tin], tin, tout
 
 
 def balanced_cut(net: Net, piece: int) -> int | None:

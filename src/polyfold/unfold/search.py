@@ -291,6 +291,10 @@ def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator,
     return best_w, best_fit, tries
 
 
+MAX_PATH_CREASES = 20_000_000  # creases on all tree paths `split_into_pieces` covers at once (160 MB)
+PATH_BLOCK_FACES = 4096  # the first block size it cuts a larger instance into (halved while still too large)
+
+
 def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.ndarray, pairs: np.ndarray,
                       exact_limit: int = 2000, exact_seconds: float = 5.0,
                       cuttable: np.ndarray | None = None) -> np.ndarray:
@@ -301,19 +305,36 @@ def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.nda
     candidate creases). cuttable (F,): faces whose crease to their parent may be cut (None: all);
     the others (merged creases of flat regions) are cut only on a path that has no other crease
     (two faces of one flat region that overlap: a self-overlapping or not quite flat region, where
-    an overlapping net would be worse). Returns a boolean mask (F,) of faces whose crease to their
-    parent is cut.
+    an overlapping net would be worse). An instance with more than MAX_PATH_CREASES creases on its
+    paths is first cut into blocks (`kernels.size_cuts`), so the cover is bounded in time and
+    memory at the price of a few more pieces. Returns a boolean mask (F,) of faces whose crease to
+    their parent is cut.
     """
     n = len(parent)
     cut = np.zeros(n, dtype=bool)
     if len(pairs) == 0:
         return cut
-    ptr, members = K.tree_paths(parent, order, np.ascontiguousarray(pairs, dtype=np.int64))
+    pairs = np.ascontiguousarray(pairs, dtype=np.int64)
+    # a net of tens of thousands of faces has long paths between many overlapping pairs (82k
+    # faces: ~1e9 creases on them, a minute and gigabytes): it is first cut into blocks of about
+    # `block` faces, and only the pairs inside one block are covered
+    block = PATH_BLOCK_FACES
+    while K.tree_path_ptr(parent, order, pairs, MAX_PATH_CREASES)[-1] > MAX_PATH_CREASES and block >= 16:
+        blocks = K.size_cuts(parent, order, np.ones(n, dtype=np.bool_) if cuttable is None else cuttable, block)
+        cut |= blocks
+        parent = parent.copy()
+        parent[blocks] = -1
+        piece = K.piece_labels(order, parent)
+        pairs = np.ascontiguousarray(pairs[piece[pairs[:, 0]] == piece[pairs[:, 1]]])
+        block //= 2
+    if len(pairs) == 0:
+        return cut
+    ptr, members = K.tree_paths(parent, order, pairs)
     if cuttable is not None:
         ptr, members = _cuttable_paths(ptr, members, cuttable)
     greedy = K.greedy_cover(ptr, members, n)
     chosen = np.flatnonzero(greedy)
-    candidates = np.unique(members)
+    candidates = np.flatnonzero(np.bincount(members, minlength=n))  # ascending, as np.unique (and faster)
     if len(chosen) > 1 and len(candidates) <= exact_limit:
         try:
             from scipy.optimize import Bounds, LinearConstraint, milp

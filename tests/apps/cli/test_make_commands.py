@@ -140,3 +140,29 @@ def test_small_edges_are_said(models_dir, tmp_path):
     assert "smallest printed edge" not in proc.stderr
     lay = json.loads((tmp_path / "b" / "report.json").read_text())["stages"]["layout"]
     assert 5.0 <= lay["smallest_edge_mm"] < 5.0 * (size + 1) / size
+
+
+def test_a_mesh_too_fine_for_the_time_limit_stops_at_it(tmp_path):
+    # a 5,120-face noisy sphere: its labels alone take longer than 3 s to place (issue 20: an 82k-face
+    # mesh ran 286 s through --time-limit 60); make stops at the limit with one line, exit 1, writes
+    # nothing. bench/bench_big.py measures the stop on 20k-100k faces.
+    import time
+
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=4)
+    rng = np.random.default_rng(0)
+    sphere.vertices *= 1.0 + 0.02 * rng.standard_normal((len(sphere.vertices), 1))
+    src, out = tmp_path / "fine.obj", tmp_path / "out"
+    sphere.export(src)
+    out.mkdir()
+    t0 = time.perf_counter()
+    proc = run_cli("make", src, "-o", out, "--time-limit", 3, "-q")
+    elapsed = time.perf_counter() - t0
+    assert proc.returncode == 1, proc.stderr
+    line = one_line(proc.stderr)
+    assert "fine.obj: stopped at --time-limit 3 s while" in line and "5,120 faces" in line and "simplify" in line
+    assert not any(out.iterdir())  # nothing written, no temp folder left
+    # the stop is a check between steps, not a kill: it comes at the limit, not minutes later (the
+    # margin is the interpreter's start and loading, and one step of work)
+    assert elapsed < 3 + 20

@@ -28,7 +28,7 @@ def make(
     margin: float = options.MARGIN,
     tabs: str = options.TABS,
     seed: int = typer.Option(1, "--seed", min=0, help="Random seed (same seed, same sheets)."),
-    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the searches (unfold, fold)."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the whole run: the searches (unfold, fold) share it with the layout; a mesh too fine to lay out in it stops with one line (exit 1)."),
     fold: bool = options.FOLD,
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
@@ -66,7 +66,8 @@ def make(
                 "consecutive edges have one label each, their ends ticked (see instructions.html)")
         if lay.small_labels:
             say(f"warning: {lay.small_labels} label(s) found no free place at {lay.min_label_mm:g} mm and are "
-                "printed over their face (try a larger --size or a smaller --min-label-mm)")
+                "printed over their face (try a larger --size or a smaller --min-label-mm"
+                f"{', or a longer --time-limit: it stopped the cuts that make room for them' if lay.labels_ran_out else ''})")
         if lay.smallest_edge_mm < BUILDABLE_EDGE_MM:
             say(f"warning: the smallest printed edge is {lay.smallest_edge_mm:.3g} mm, under {BUILDABLE_EDGE_MM:g} mm "
                 f"(hard to fold and glue): --size {size_for_edge(size, lay.smallest_edge_mm)} would make it "
@@ -94,7 +95,7 @@ def view(
     host: Optional[str] = typer.Option(None, "--host", help="Address to listen on. Default 127.0.0.1 (this machine only); other addresses (e.g. 0.0.0.0) only when given here."),
     output: Optional[Path] = typer.Option(None, "-o", "--output", help="With a mesh: keep the make output in this folder (default: a temporary folder, removed on exit)."),
     parts: Optional[int] = typer.Option(None, "--parts", min=1, help="With a mesh: segment into this many parts."),
-    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="With a mesh: seconds for make's searches."),
+    time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="With a mesh: seconds for make (see make --time-limit)."),
 ) -> None:
     """Show a make folder (or a mesh, made first) in the browser: parts, nets, folding animation, inflation."""
     import shutil
