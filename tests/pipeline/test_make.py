@@ -132,3 +132,25 @@ def test_unnamed_mesh_is_called_model(models_dir, tmp_path):
     result = make(mesh, tmp_path, MakeOptions(time_limit=20))
     assert result.report.input.file == "model"
     assert "model - sheet 1/" in (tmp_path / "sheet-01.svg").read_text()
+
+
+def test_a_fine_mesh_is_simplified_first_by_default(tmp_path):
+    # issue 21: --faces auto (the default) takes a 20,480-face sphere to faces about 12 mm across at
+    # --size (60 mm: ~180 faces), says so in the report, and makes clean sheets of that
+    import trimesh
+
+    from polyfold.pipeline.report import MakeReport
+
+    sphere = trimesh.creation.icosphere(subdivisions=5)
+    sphere.vertices *= 1.0 + 0.01 * np.random.default_rng(1).standard_normal((len(sphere.vertices), 1))
+    src = tmp_path / "fine.obj"
+    sphere.export(src)
+    out, report = run_make(tmp_path, src, size=60.0, fold=False)
+    simp = report["stages"]["simplify"]
+    assert simp["spec"] == "auto" and simp["faces_before"] == 20480 and 150 <= simp["faces_after"] <= 210
+    assert 0.0 < simp["hausdorff"] < 0.05 and simp["min_angle_deg"] > 0.0
+    assert report["input"]["faces"] == 20480 and report["checks"]["problems"] == []
+    assert sum(p["faces"] for p in report["pieces"]) == simp["faces_after"]
+    assert MakeReport.from_dict(report).stages.simplify.faces_after == simp["faces_after"]
+    for svg in sorted(out.glob("sheet-*.svg")):
+        assert check_sheet(read_sheet(svg), 10.0) == [], svg.name

@@ -1,6 +1,6 @@
 """The whole job: a mesh in, a folder of printable, assemblable sheets out.
 
-load -> inflate -> segment + unfold (`parts`) -> fit to pages (`sheets.fit_parts`, then
+load -> simplify (--faces) -> inflate -> segment + unfold (`parts`) -> fit to pages (`sheets.fit_parts`, then
 `sheets.split_for_pages`) -> fold
 (`folding`) -> tabs, labels, packing (`sheets.lay_out`) -> check (`fabricate.check`) -> export
 (`export`). In: a mesh (a file, or a `Mesh` in memory) and `MakeOptions`. Out: the files of
@@ -29,7 +29,7 @@ from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
-                     PieceReport, StageReports)
+                     PieceReport, SimplifyReport, StageReports)
 from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
 
 Progress = Callable[[str, str], None]  # (stage, message)
@@ -65,6 +65,22 @@ def _load(source: str | os.PathLike | Mesh | LoadedMesh, name: str | None,
     info = InputReport(file=name, faces=int(mesh.n_faces), vertices=int(mesh.n_vertices), components=n_components,
                        warnings=warnings)
     return mesh, info, LoadReport(seconds=time.perf_counter() - t0), name
+
+
+def _simplify(mesh: Mesh, name: str, opts: MakeOptions, say: Progress) -> tuple[Mesh, SimplifyReport | None]:
+    """The mesh reduced to the face count of --faces (`mesh.simplify`), and its report (None: left
+    as it is)."""
+    from ..mesh.repair import LoadedMesh
+    from ..mesh.simplify import face_target, simplify
+
+    target = face_target(opts.faces, mesh, opts.size)
+    if target is None:
+        return mesh, None
+    say("simplify", f"{mesh.n_faces:,} faces to about {target:,} (--faces {opts.faces})")
+    done = simplify(LoadedMesh(path=name, mesh=mesh, components=(mesh,), warnings=()), target)
+    return done.loaded.mesh, SimplifyReport(spec=opts.faces, faces_before=done.faces_before,
+                                            faces_after=done.faces_after, hausdorff=done.hausdorff,
+                                            min_angle_deg=done.min_angle_deg, seconds=done.seconds)
 
 
 def _inflate(mesh: Mesh, opts: MakeOptions, say: Progress) -> tuple[Mesh, InflateReport]:
@@ -151,8 +167,8 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
         return _make(mesh, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report, inputs)
     except OutOfTime as exc:
         raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
-                        f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh to a few "
-                        f"thousand faces first (e.g. Blender's Decimate modifier) or raise --time-limit",
+                        f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh first "
+                        f"(--faces auto, or --faces N for about N faces) or raise --time-limit",
                         exc.doing) from None
 
 
@@ -162,6 +178,7 @@ def _make(mesh: Mesh, name: str, out_dir: str | os.PathLike, opts: MakeOptions, 
     """`make` after loading (page: width, height in mm): OutOfTime when `hard` passes in work that
     cannot be skipped."""
     width, height = page
+    mesh, simplify_report = _simplify(mesh, name, opts, say)
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
     searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
@@ -192,7 +209,8 @@ def _make(mesh: Mesh, name: str, out_dir: str | os.PathLike, opts: MakeOptions, 
     def finish(rows: tuple[PieceReport, ...], outputs: list[str]) -> MakeReport:
         stages = StageReports(load=load_report, inflate=inflate_report, segment=segment_report, unfold=unfold_report,
                               fold=fold_report, layout=layout_report,
-                              export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages))
+                              export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages),
+                              simplify=simplify_report)
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0)
 

@@ -37,6 +37,7 @@ class MakeOptions:
     thickness: float = THICKNESS_MM  # of the paper (mm): faces closer than this collide (verify.paths)
     marks: bool = False  # print-and-cut registration marks (Silhouette "Type 1") on the printed pages
     min_label_mm: float = MIN_LABEL_MM  # least cap height of every label (mm)
+    faces: str = "auto"  # simplify first: a face count, auto (meshes over mesh.simplify.AUTO_ABOVE faces) or none
 
 
 def paper_size(spec: str) -> tuple[float, float]:
@@ -67,6 +68,9 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
         raise PolyfoldError(f"--min-label-mm must be between 0.5 and 10 mm, not {opts.min_label_mm}")
     if not (0 <= opts.thickness <= 5 and math.isfinite(opts.thickness)):
         raise PolyfoldError(f"--thickness must be between 0 and 5 mm, not {opts.thickness}")
+    from ..mesh.simplify import check_faces_spec
+
+    check_faces_spec(opts.faces)
     width, height = paper_size(opts.paper)
     if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
         raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")

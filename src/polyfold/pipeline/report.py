@@ -40,6 +40,19 @@ class LoadReport:
 
 
 @dataclass(frozen=True)
+class SimplifyReport:
+    """--faces: what the simplification did (`mesh.simplify.Simplified`); hausdorff is relative to
+    the input's bounding-box diagonal."""
+
+    spec: str
+    faces_before: int
+    faces_after: int
+    hausdorff: float
+    min_angle_deg: float
+    seconds: float
+
+
+@dataclass(frozen=True)
 class InflateReport:
     """mode "none": only mode and seconds are written."""
 
@@ -134,6 +147,7 @@ class StageReports:
     fold: FoldReport
     layout: LayoutReport
     export: ExportReport
+    simplify: SimplifyReport | None = None  # only when the mesh was simplified
 
 
 @dataclass(frozen=True)

@@ -79,6 +79,8 @@ def test_a_hostile_file_gets_one_line_and_exit_2(name: str, tmp_path: Path) -> N
     (("nosuchverb",), "No such command"),
     (("inflate", "{mesh}", "-o", "{tmp}/i.obj", "--stiffness-ratio", "1e308"), "stiffness_ratio must be at most"),
     (("inflate", "{mesh}", "-o", "{tmp}/i.obj", "--pressure", "inf"), "pressure"),
+    (("make", "{mesh}", "-o", "{tmp}/m", "--faces", "5"), "--faces 5: too few"),
+    (("segment", "{mesh}", "-o", "{tmp}/s", "--faces", "many"), "--faces 'many'"),
 ])
 def test_a_bad_option_gets_one_line_and_exit_2(args, words: str, models_dir: Path, tmp_path: Path) -> None:
     filled = [a.format(mesh=models_dir / "bunny-128.obj", tmp=tmp_path) for a in args]

@@ -157,7 +157,7 @@ def test_a_mesh_too_fine_for_the_time_limit_stops_at_it(tmp_path):
     sphere.export(src)
     out.mkdir()
     t0 = time.perf_counter()
-    proc = run_cli("make", src, "-o", out, "--time-limit", 3, "-q")
+    proc = run_cli("make", src, "-o", out, "--time-limit", 3, "--faces", "none", "-q")
     elapsed = time.perf_counter() - t0
     assert proc.returncode == 1, proc.stderr
     line = one_line(proc.stderr)

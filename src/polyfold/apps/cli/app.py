@@ -56,14 +56,24 @@ def guard(func):
     return wrapper
 
 
-def load(path: Path, quiet: bool = False):
-    """The mesh file, loaded and repaired; a warning line per repair unless quiet."""
+def load(path: Path, quiet: bool = False, faces: str = "none", size: float = 150.0):
+    """The mesh file, loaded and repaired; a warning line per repair unless quiet. `faces`: the
+    --faces of `mesh.simplify.face_target` (at `size` mm for auto), said on a line when it acts."""
     from ...formats.meshes import load_mesh
+    from ...mesh.simplify import face_target, simplify
 
     loaded = load_mesh(path)
     if not quiet:
         for w in loaded.warnings:
             say(f"warning: {path.name}: {w}")
+    target = face_target(faces, loaded.mesh, size)
+    if target is not None:
+        done = simplify(loaded, target)
+        if not quiet:
+            say(f"{path.name}: simplified {done.faces_before:,} faces to {done.faces_after:,} (--faces {faces}; "
+                f"surface moved up to {done.hausdorff:.2%} of the model's size, smallest face angle "
+                f"{done.min_angle_deg:.1f} deg); face numbers from here on are the simplified mesh's")
+        loaded = done.loaded
     return loaded
 
 

@@ -34,13 +34,14 @@ def make(
     contact_tol: float = options.CONTACT_TOL_OPTION,
     thickness: float = options.THICKNESS_MM_OPTION,
     min_label_mm: float = options.MIN_LABEL,
+    faces: str = options.FACES,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
-    """Mesh in, printable sheets out: inflate, segment, unfold, fold, lay out with tabs and labels, export."""
+    """Mesh in, printable sheets out: simplify, inflate, segment, unfold, fold, lay out with tabs and labels, export."""
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks, min_label_mm=min_label_mm, thickness=thickness)
+                                    marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -51,6 +52,11 @@ def make(
     if not quiet:
         for w in rep.input.warnings:
             say(f"warning: {mesh.name}: {w}")
+        simp = rep.stages.simplify
+        if simp is not None:
+            say(f"simplified {simp.faces_before:,} faces to {simp.faces_after:,} (--faces {simp.spec}"
+                f"{': faces about 12 mm across at --size' if simp.spec == 'auto' else ''}; surface moved up to "
+                f"{simp.hausdorff:.2%} of the model's size, smallest face angle {simp.min_angle_deg:.1f} deg)")
         for row in rep.pieces:
             if not row.path_verified and fold:
                 say(f"warning: piece {row.piece}: no verified folding path ({row.note})")

@@ -9,6 +9,7 @@ from typing import Optional
 
 import typer
 
+from . import options
 from .app import app, fail, guard, load, say
 
 
@@ -94,18 +95,21 @@ def segment(
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="With --parts: seconds for the search of tau (then the closest count found)."),
     png: bool = typer.Option(True, "--png/--no-png", help="Also draw segments.png."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or table, only errors."),
+    faces: str = options.FACES,
 ) -> None:
     """Split a mesh into few connected, nearly convex parts (concavity <= tau each), ready to unfold."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
     from ...deadline import Deadline
     from ...formats.segmentation import check_segmentation_folder, write_segmentation
+    from ...mesh.simplify import check_faces_spec
     from ...segment.segment import DEFAULT_TAU, segment as segment_mesh
 
     check_segmentation_folder(output, (mesh,))
+    check_faces_spec(faces)
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit)
-    loaded = load(mesh, quiet)
+    loaded = load(mesh, quiet, faces)
     seg = segment_mesh(loaded.mesh, tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=seed, deadline=deadline)
     seconds = time.perf_counter() - t0
     if parts is not None and seg.n_parts != parts and not quiet:

@@ -54,6 +54,7 @@ def unfold(
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="With --fold: collision-check step along path segments, degrees."),
     contact_tol: float = contact_tol_option(),
     thickness: float = options.THICKNESS_REL_OPTION,
+    faces: str = options.FACES,
 ) -> None:
     """Unfold a mesh into overlap-free nets: one piece per component when one is found in time."""
     if max_pieces not in ("auto", "1"):
@@ -62,12 +63,14 @@ def unfold(
     from ...errors import NoNetFound
     from ...formats.files import check_outputs
     from ...formats.fold import write_fold
+    from ...mesh.simplify import check_faces_spec
     from ...pipeline.nets import NetsOptions, unfold_nets
 
     check_outputs([output, svg, png], [mesh])
+    check_faces_spec(faces)
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit)
-    loaded = load(mesh, quiet)
+    loaded = load(mesh, quiet, faces, size)
     opts = NetsOptions(method=method.value, seed=seed, max_pieces=1 if max_pieces == "1" else None, fold=fold,
                        prefer_linear=prefer_linear, planner=planner.value, resolution_deg=resolution_deg,
                        contact_tol=contact_tol, thickness=thickness)

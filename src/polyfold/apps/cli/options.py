@@ -45,6 +45,8 @@ THICKNESS_MM_OPTION = typer.Option(_D.thickness, "--thickness", min=0.0, max=5.0
                                    help="Paper thickness, mm: faces closer than this with overlapping projections collide (every path is re-checked at it).")
 THICKNESS_REL_OPTION = typer.Option(THICKNESS_REL, "--thickness", min=0.0, max=0.1,
                                     help="Material thickness as a fraction of the model size (bounding-box diagonal): faces closer than this with overlapping projections collide.")
+FACES = typer.Option(_D.faces, "--faces",
+                     help="Simplify the mesh first to about N faces (quadric edge collapse); auto: meshes over 3,000 faces to faces about 12 mm across at --size (segment: 150 mm); none: never.")
 MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
                          help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
@@ -52,7 +54,8 @@ MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
 def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str, tau: Optional[float],
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
                  time_limit: float, fold: bool, contact_tol: float, marks: bool,
-                 min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness) -> MakeOptions:
+                 min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness,
+                 faces: str = _D.faces) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -60,7 +63,8 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
         fail(f"--tabs must be 'auto' or 'none', not {tabs!r}", 2)
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
-                       contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness)
+                       contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness,
+                       faces=faces)
 
 
 @contextlib.contextmanager
