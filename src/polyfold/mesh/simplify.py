@@ -8,7 +8,7 @@ faces: fast-simplification and pyfqmr (the same algorithm) take 0.06-0.09 s and 
 meshes (within 1-2 % of the bounding box, closed and manifold); pymeshlab's
 quadric collapse with its quality threshold makes rounder triangles (smallest angle 9-19 degrees
 against 1-9) at the same distance, but takes 1.1 s, installs 280 MB and is GPL-3 (polyfold is
-MIT). The result goes through the loader's own `repair` (welding, orientation, components), so
+MIT). Its aggressiveness is chosen per mesh for the fewest slivers (AGGRESSIVENESS). The result goes through the loader's own `repair` (welding, orientation, components), so
 a simplified mesh is checked exactly like a file. The report says the smallest angle, since the
 collapse may leave slivers (bench/bench_big.py measures them).
 """
@@ -29,6 +29,11 @@ from .repair import LoadedMesh, RawMesh, repair
 AUTO_ABOVE = 3000  # --faces auto simplifies meshes with more faces than this
 AUTO_EDGE_MM = 12.0  # --faces auto: the printed edge of an equilateral face of the mean area
 MIN_FACES = 20  # fewer than this is no model of anything (and a tetrahedron needs 4)
+# fast-simplification's aggressiveness (its default 7): each is tried and the result with the fewest
+# faces under SLIVER_DEG kept; lower values leave rounder triangles but may stop short of the count
+# (an 89k-face bunny to 762 faces: 5, 13 and 13 slivers at 5, 6, 7; 2,000 faces: 10, 21, 69)
+AGGRESSIVENESS = (5, 6, 7)
+SLIVER_DEG = 5.0
 HAUSDORFF_SAMPLES = 20_000  # surface samples each way (and all vertices) for the distance estimate
 HAUSDORFF_NEAREST = 8  # triangles (nearest by centroid) a sample's distance is measured to
 
@@ -151,9 +156,18 @@ def simplify(loaded: LoadedMesh, faces: int) -> Simplified:
     if before <= faces:
         return Simplified(loaded, before, before, 0.0, float(min_angles_deg(mesh.vertices, mesh.faces).min()),
                           time.perf_counter() - t0)
-    points, tris = fast_simplification.simplify(mesh.vertices.astype(np.float64), mesh.faces.astype(np.int32),
-                                                target_count=int(faces))
-    tris = np.asarray(tris, dtype=np.int64)
+    best = None
+    for agg in AGGRESSIVENESS:  # the one with the fewest slivers (then the roundest) that meets the count
+        points, tris = fast_simplification.simplify(mesh.vertices.astype(np.float64), mesh.faces.astype(np.int32),
+                                                    target_count=int(faces), agg=agg)
+        tris = np.asarray(tris, dtype=np.int64)
+        if len(tris) > 1.05 * faces and agg != AGGRESSIVENESS[-1]:
+            continue
+        angles = min_angles_deg(np.asarray(points, dtype=np.float64), tris)
+        key = (len(tris) > 1.05 * faces, int((angles < SLIVER_DEG).sum()), -float(angles.min(initial=180.0)))
+        if best is None or key < best[0]:
+            best = (key, points, tris)
+    _, points, tris = best
     raw = RawMesh(vertices=np.asarray(points, dtype=np.float64), tris=tris, source=np.arange(len(tris)),
                   n_triangulated=0)
     out = repair(raw, loaded.path)
