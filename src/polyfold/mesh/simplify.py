@@ -126,7 +126,7 @@ def face_target(spec: str, mesh: Mesh, size_mm: float) -> int | None:
         n = auto_face_count(mesh, size_mm)
         return n if n < mesh.n_faces else None
     n = check_faces_spec(spec)
-    return n if n is not None and n < mesh.n_faces else None
+    return n if n < mesh.n_faces else None
 
 
 def check_faces_spec(spec: str) -> int | None:
@@ -143,6 +143,13 @@ def check_faces_spec(spec: str) -> int | None:
     return n
 
 
+def summary(spec: str, faces_before: int, faces_after: int, hausdorff_rel: float, min_angle_deg: float) -> str:
+    """The line that tells a user what --faces did."""
+    why = f": faces about {AUTO_EDGE_MM:g} mm across at the printed size" if spec.strip().lower() == "auto" else ""
+    return (f"simplified {faces_before:,} faces to {faces_after:,} (--faces {spec}{why}; surface moved up to "
+            f"{hausdorff_rel:.2%} of the model's size, smallest face angle {min_angle_deg:.1f} deg)")
+
+
 def simplify(loaded: LoadedMesh, faces: int) -> Simplified:
     """The mesh reduced to about `faces` faces (quadric edge collapse, module docstring), repaired
     like a file. A mesh with no more faces than that comes back as it is. PolyfoldError when
@@ -156,18 +163,14 @@ def simplify(loaded: LoadedMesh, faces: int) -> Simplified:
     if before <= faces:
         return Simplified(loaded, before, before, 0.0, float(min_angles_deg(mesh.vertices, mesh.faces).min()),
                           time.perf_counter() - t0)
-    best = None
-    for agg in AGGRESSIVENESS:  # the one with the fewest slivers (then the roundest) that meets the count
-        points, tris = fast_simplification.simplify(mesh.vertices.astype(np.float64), mesh.faces.astype(np.int32),
-                                                    target_count=int(faces), agg=agg)
-        tris = np.asarray(tris, dtype=np.int64)
-        if len(tris) > 1.05 * faces and agg != AGGRESSIVENESS[-1]:
-            continue
-        angles = min_angles_deg(np.asarray(points, dtype=np.float64), tris)
-        key = (len(tris) > 1.05 * faces, int((angles < SLIVER_DEG).sum()), -float(angles.min(initial=180.0)))
-        if best is None or key < best[0]:
-            best = (key, points, tris)
-    _, points, tris = best
+    def quality(result) -> tuple:  # meets the count, then fewest slivers, then roundest
+        points, tris = result
+        angles = min_angles_deg(points, tris)
+        return len(tris) > 1.05 * faces, int((angles < SLIVER_DEG).sum()), -float(angles.min(initial=180.0))
+
+    tries = [fast_simplification.simplify(mesh.vertices.astype(np.float64), mesh.faces.astype(np.int32),
+                                          target_count=int(faces), agg=agg) for agg in AGGRESSIVENESS]
+    points, tris = min(((np.asarray(p, dtype=np.float64), np.asarray(t, dtype=np.int64)) for p, t in tries), key=quality)
     raw = RawMesh(vertices=np.asarray(points, dtype=np.float64), tris=tris, source=np.arange(len(tris)),
                   n_triangulated=0)
     out = repair(raw, loaded.path)

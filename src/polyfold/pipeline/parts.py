@@ -82,11 +82,16 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
     else:
         todo = list(components)
     out: list[Part] = []
-    while todo:
+    def share() -> float:
+        """Seconds for the part just taken off `todo`: its share of what is left (past `hard`:
+        OutOfTime, as every part needs a net)."""
         hard.check(f"unfolding part {len(out) + 1} ({len(todo) + 1} to go)")
+        return max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
+
+    while todo:
         faces = todo.pop(0)
         part_mesh = mesh.submesh(faces)
-        left = max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
+        left = share()
         say("unfold", f"part {len(out) + 1}: {len(faces)} faces")
         tu = time.perf_counter()
         try:
@@ -106,9 +111,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
                 segmented.append(int(comp[faces[0]]))
                 subs = segmenter(faces, None, None)
             if len(subs) == 1:  # already nearly convex: accept several pieces instead
-                left = max(MIN_UNFOLD_S, min(budget, deadline.left()) / max(1, len(todo) + 1))
-                hard.check(f"unfolding part {len(out) + 1} ({len(todo) + 1} to go)")
-                net, st = unfold(part_mesh, seed=opts.seed, time_limit=left)
+                net, st = unfold(part_mesh, seed=opts.seed, time_limit=share())
             else:
                 todo = subs + todo
                 continue

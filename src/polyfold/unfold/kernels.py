@@ -357,19 +357,18 @@ def tree_path(a, b, parent, depth, out, k):
 def tree_path_ptr(parent, order, pairs, limit):
     """The CSR ptr (P+1,) of `tree_paths` (ptr[-1]: the creases on all paths) without the paths;
     once more than `limit` creases are counted, the ptr so far (its last entry over `limit`)."""
-    n = parent.shape[0]
-    depth = np.empty(n, dtype=np.int64)
+    depth = np.empty(parent.shape[0], dtype=np.int64)
     tree_depths(parent, order, depth)
+    return _path_ptr(parent, depth, pairs, limit)
+
+
+@njit(cache=True)
+def _path_ptr(parent, depth, pairs, limit):
+    """`tree_path_ptr` with the faces' depths given."""
+    scratch = np.empty(parent.shape[0], dtype=np.int64)  # a path has fewer creases than the tree has faces
     ptr = np.zeros(pairs.shape[0] + 1, dtype=np.int64)
     for r in range(pairs.shape[0]):
-        a, b, k = pairs[r, 0], pairs[r, 1], 0
-        while a != b:
-            if depth[a] >= depth[b]:
-                a = parent[a]
-            else:
-                b = parent[b]
-            k += 1
-        ptr[r + 1] = ptr[r] + k
+        ptr[r + 1] = ptr[r] + tree_path(pairs[r, 0], pairs[r, 1], parent, depth, scratch, 0)
         if ptr[r + 1] > limit:
             return ptr[:r + 2]
     return ptr
@@ -403,7 +402,7 @@ def tree_paths(parent, order, pairs):
     n = parent.shape[0]
     depth = np.empty(n, dtype=np.int64)
     tree_depths(parent, order, depth)
-    ptr = tree_path_ptr(parent, order, pairs, np.iinfo(np.int64).max)
+    ptr = _path_ptr(parent, depth, pairs, np.iinfo(np.int64).max)
     members = np.empty(ptr[-1], dtype=np.int64)
     for r in range(pairs.shape[0]):
         tree_path(pairs[r, 0], pairs[r, 1], parent, depth, members, ptr[r])

@@ -60,7 +60,7 @@ def load(path: Path, quiet: bool = False, faces: str = "none", size: float = 150
     """The mesh file, loaded and repaired; a warning line per repair unless quiet. `faces`: the
     --faces of `mesh.simplify.face_target` (at `size` mm for auto), said on a line when it acts."""
     from ...formats.meshes import load_mesh
-    from ...mesh.simplify import face_target, simplify
+    from ...mesh.simplify import face_target, simplify, summary
 
     loaded = load_mesh(path)
     if not quiet:
@@ -70,9 +70,8 @@ def load(path: Path, quiet: bool = False, faces: str = "none", size: float = 150
     if target is not None:
         done = simplify(loaded, target)
         if not quiet:
-            say(f"{path.name}: simplified {done.faces_before:,} faces to {done.faces_after:,} (--faces {faces}; "
-                f"surface moved up to {done.hausdorff:.2%} of the model's size, smallest face angle "
-                f"{done.min_angle_deg:.1f} deg); face numbers from here on are the simplified mesh's")
+            say(f"{path.name}: {summary(faces, done.faces_before, done.faces_after, done.hausdorff, done.min_angle_deg)}; "
+                "face numbers from here on are the simplified mesh's")
         loaded = done.loaded
     return loaded
 

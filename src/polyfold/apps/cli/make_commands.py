@@ -54,9 +54,9 @@ def make(
             say(f"warning: {mesh.name}: {w}")
         simp = rep.stages.simplify
         if simp is not None:
-            say(f"simplified {simp.faces_before:,} faces to {simp.faces_after:,} (--faces {simp.spec}"
-                f"{': faces about 12 mm across at --size' if simp.spec == 'auto' else ''}; surface moved up to "
-                f"{simp.hausdorff:.2%} of the model's size, smallest face angle {simp.min_angle_deg:.1f} deg)")
+            from ...mesh.simplify import summary
+
+            say(summary(simp.spec, simp.faces_before, simp.faces_after, simp.hausdorff, simp.min_angle_deg))
         for row in rep.pieces:
             if not row.path_verified and fold:
                 say(f"warning: piece {row.piece}: no verified folding path ({row.note})")
