@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -119,6 +120,43 @@ def footer(text: str, x0: float, x1: float, top: float) -> tuple[TextItem, Scale
 
 # eq=False: numpy fields make a generated __eq__/__hash__ meaningless (ambiguous truth values).
 @dataclass(frozen=True, eq=False)
+class PageImage:
+    """A picture printed on a page (a piece's texture, `fabricate.paint`): `pixels` (h, w, 3)
+    uint8, row 0 at the top, covering [x, x + width] x [y, y + height] page mm, shown only inside
+    `clip` (closed rings in page mm, even-odd: the piece's faces, not its tabs)."""
+
+    x: float
+    y: float
+    width: float
+    height: float
+    pixels: np.ndarray
+    clip: tuple[np.ndarray, ...]
+
+    def __post_init__(self) -> None:
+        if not all(math.isfinite(v) for v in (self.x, self.y, self.width, self.height)) or min(self.width, self.height) <= 0:
+            raise ValueError(f"page image: position must be finite and size > 0, got {self.width} x {self.height}")
+        px = np.asarray(self.pixels)
+        if px.ndim != 3 or px.shape[2] != 3 or px.dtype != np.uint8 or 0 in px.shape:
+            raise ValueError(f"page image: pixels must be (h, w, 3) uint8, got {px.shape} {px.dtype}")
+        object.__setattr__(self, "clip", tuple(_finite(r, "image.clip", (-1, 2)) for r in self.clip))
+
+    @cached_property
+    def jpeg(self) -> bytes:
+        """The pixels as a JPEG file (quality JPEG_QUALITY): what the PDF and the SVG embed."""
+        import io
+
+        from PIL import Image
+
+        buf = io.BytesIO()
+        Image.fromarray(self.pixels).save(buf, format="JPEG", quality=JPEG_QUALITY, optimize=True)
+        return buf.getvalue()
+
+
+JPEG_QUALITY = 90  # a printed texture: no visible artefacts, about a tenth of the raw pixels
+
+
+# eq=False: numpy fields make a generated __eq__/__hash__ meaningless (ambiguous truth values).
+@dataclass(frozen=True, eq=False)
 class Page:
     """One sheet, `width` x `height` mm, origin top-left, y down.
 
@@ -146,6 +184,8 @@ class Page:
     scale_bar: ScaleBar | None = None
     marks: RegistrationMarks | None = None
     leaders: np.ndarray = ()  # type: ignore[assignment]  # (n, 2, 2) thin printed lines to off-face labels
+    face_colors: tuple[np.ndarray, ...] = ()  # optional (n, 3) uint8 fill of each face of faces[i] (the model's colours)
+    images: tuple[PageImage, ...] = ()  # pictures printed over the face fills (the model's texture)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.width) and math.isfinite(self.height) and self.width > 0 and self.height > 0):
@@ -171,6 +211,14 @@ class Page:
         if len(tm) != len(self.tab_folds):
             raise ValueError(f"tab_mountain: expected {len(self.tab_folds)} flags, got {len(tm)}")
         object.__setattr__(self, "tab_mountain", tm)
+        if self.face_colors:
+            if len(self.face_colors) != len(faces):
+                raise ValueError(f"face_colors: expected {len(faces)} arrays (one per faces entry), got {len(self.face_colors)}")
+            fc = tuple(np.asarray(c, dtype=np.uint8).reshape(len(f), 3) for c, f in zip(self.face_colors, faces))
+            object.__setattr__(self, "face_colors", fc)
+        object.__setattr__(self, "images", tuple(self.images))
+        if not all(isinstance(im, PageImage) for im in self.images):
+            raise ValueError("images must be PageImages")
         if self.scale_bar is not None and not isinstance(self.scale_bar, ScaleBar):
             raise ValueError(f"scale_bar must be a ScaleBar, got {type(self.scale_bar).__name__}")
         if self.marks is not None and not isinstance(self.marks, RegistrationMarks):

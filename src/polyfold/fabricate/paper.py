@@ -31,3 +31,10 @@ def size_for_edge(size_mm: float, smallest_edge_mm: float, edge_mm: float = BUIL
     """The --size (mm, rounded up to a whole mm) at which the smallest printed edge, now
     smallest_edge_mm at size_mm, becomes edge_mm (the scale is proportional to the size)."""
     return math.ceil(size_mm * edge_mm / smallest_edge_mm)
+
+
+# The model's look on the sheets (`fabricate.paint`): --color texture (the file's texture and
+# colours), flat (one mean colour per face) or none (plain); textures rastered at --dpi.
+COLOR_MODES = ("texture", "flat", "none")
+DPI = 300.0
+DPI_RANGE = (30.0, 1200.0)

@@ -7,50 +7,53 @@ triangulation), so a user can find the culprit in their file.
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
 
 from ..errors import PolyfoldError
+from ..mesh.appearance import Appearance
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh, RawMesh, check_input, mesh_error, repair
 from .files import atomic_write
+from .materials import Looks, obj_appearance, trimesh_appearance
 
 
 MAX_INDEX = 2**40  # a vertex index beyond this is a broken file, not a mesh (numpy's int64 holds it)
 
 
-def _triangulate(polygons: list[list[int]], vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """Triangulate polygons; returns (tris, source polygon per tri, number of polygons > 3). A
-    convex polygon is fanned from its first corner; a concave one (seen in the plane of its
-    Newell normal) is cut into triangles inside it (`_concave`), never into triangles that fold
-    back over each other as a fan would."""
-    tris: list[tuple[int, int, int]] = []
+def _triangulate(polygons: list[list[int]], vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Triangulate polygons; returns (tris, source polygon per tri, the polygon corner (0..k-1) of
+    every triangle corner, number of polygons > 3). A convex polygon is fanned from its first
+    corner; a concave one (seen in the plane of its Newell normal) is cut into triangles inside it
+    (`_concave`), never into triangles that fold back over each other as a fan would."""
+    corners: list[tuple[int, int, int]] = []
     source: list[int] = []
     n_big = 0
     for i, p in enumerate(polygons):
         if len(p) < 3:
             # Keep it as a face with a repeated index so it is dropped (and counted) as degenerate.
-            p = p + [p[-1]] * (3 - len(p))
+            polygons[i] = p = p + [p[-1]] * (3 - len(p))
         elif len(p) > 3:
             n_big += 1
             inside = _concave(p, vertices)
             if inside is not None:
-                tris += inside
+                corners += inside
                 source += [i] * len(inside)
                 continue
         for j in range(1, len(p) - 1):
-            tris.append((p[0], p[j], p[j + 1]))
+            corners.append((0, j, j + 1))
             source.append(i)
-    return (
-        np.array(tris, dtype=np.int64).reshape(-1, 3),
-        np.array(source, dtype=np.int64),
-        n_big,
-    )
+    corner = np.array(corners, dtype=np.int64).reshape(-1, 3)
+    src = np.array(source, dtype=np.int64)
+    tris = np.array([[polygons[s][k] for k in c] for s, c in zip(source, corners)], dtype=np.int64).reshape(-1, 3)
+    return tris, src, corner, n_big
 
 
 def _concave(poly: list[int], vertices: np.ndarray) -> list[tuple[int, int, int]] | None:
-    """The triangles of a concave, simple polygon (vertex ids in poly), inside it and turning as it
+    """The triangles (as corner positions in poly) of a concave, simple polygon (vertex ids in
+    poly), inside it and turning as it
     does: shapely's constrained Delaunay triangulation in the polygon's plane. None when the
     polygon is convex, degenerate or not simple (then it is fanned), or an index is out of range
     (reported later with its face)."""
@@ -89,7 +92,7 @@ def _concave(poly: list[int], vertices: np.ndarray) -> list[tuple[int, int, int]
         a, b, c = (xy[k] for k in ids)
         if (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0:
             ids[1], ids[2] = ids[2], ids[1]  # turn as the polygon turns
-        out.append(tuple(poly[k] for k in ids))
+        out.append(tuple(ids))
     return out
 
 
@@ -114,11 +117,18 @@ def _logical_lines(text: str):
             yield start, tokens
 
 
-def _parse_obj(text: str, name: str) -> RawMesh:
+def _parse_obj(text: str, name: str, path: str = "") -> RawMesh:
     verts: list[list[float]] = []
     vlines: list[int] = []
+    colors: list[list[float] | None] = []  # "v x y z r g b" (MeshLab, scanners): 0..1
+    uvs: list[list[float]] = []
     polys: list[list[int]] = []
+    poly_vt: list[list[int]] = []
+    poly_mtl: list[str | None] = []
     flines: list[int] = []
+    mtllibs: list[str] = []
+    material: str | None = None
+    looks = Looks()
     for lineno, tokens in _logical_lines(text):
         tag = tokens[0]
         if tag == "v":
@@ -129,35 +139,84 @@ def _parse_obj(text: str, name: str) -> RawMesh:
             except ValueError:
                 raise mesh_error(name, f"line {lineno}: vertex {len(verts)} has a coordinate that is not a number") from None
             vlines.append(lineno)
+            rgb = None
+            if len(tokens) >= 7:
+                try:
+                    rgb = [float(t) for t in tokens[4:7]]
+                except ValueError:
+                    looks.warn(f"{name}: line {lineno}: a vertex colour that is not 3 numbers: ignored")
+            colors.append(rgb)
+        elif tag == "vt":
+            try:
+                uvs.append([float(t) for t in tokens[1:3]] + [0.0] * (3 - len(tokens)))
+            except ValueError:
+                looks.warn(f"{name}: line {lineno}: texture coordinate {len(uvs)} is not a number")
+                uvs.append([math.nan, math.nan])
         elif tag in ("f", "fo"):
             face = len(polys)
             if len(tokens) < 2:
                 raise mesh_error(name, f"line {lineno}: face {face} has no vertices")
-            idx = []
+            idx, vts = [], []
             for tok in tokens[1:]:
+                refs = tok.split("/")
                 try:
-                    k = int(tok.split("/", 1)[0])
+                    k = int(refs[0])
                 except ValueError:
                     raise mesh_error(name, f"line {lineno}: face {face} has a bad vertex reference {tok!r}") from None
                 if k == 0:
                     raise mesh_error(name, f"line {lineno}: face {face} uses vertex index 0 (OBJ indices start at 1)")
                 if abs(k) > MAX_INDEX:
-                    raise mesh_error(name, f"line {lineno}: face {face} uses vertex index {tok.split('/', 1)[0]}, "
+                    raise mesh_error(name, f"line {lineno}: face {face} uses vertex index {refs[0]}, "
                                            f"far beyond the file's vertices")
                 # Negative indices count back from the last vertex defined so far.
                 j = k - 1 if k > 0 else len(verts) + k
                 if j < 0:
                     raise mesh_error(name, f"line {lineno}: face {face} uses relative index {k} before that many vertices exist")
                 idx.append(j)
+                vts.append(_vt_index(refs, len(uvs)))
             polys.append(idx)
+            poly_vt.append(vts)
+            poly_mtl.append(material)
             flines.append(lineno)
-        # Other tags (vt, vn, g, o, s, usemtl, mtllib, l, p, ...) carry nothing a net needs.
+        elif tag == "mtllib" and len(tokens) > 1:
+            whole = " ".join(tokens[1:])  # one name with spaces, or several names
+            here = os.path.dirname(path)
+            mtllibs += [whole] if os.path.exists(os.path.join(here, whole)) or len(tokens) == 2 else tokens[1:]
+        elif tag == "usemtl":
+            material = " ".join(tokens[1:]) or None
+        # Other tags (vn, g, o, s, l, p, ...) carry nothing a net needs.
     vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
-    tris, source, n_big = _triangulate(polys, vertices)
-    return RawMesh(vertices, tris, source, n_big, flines, vlines)
+    tris, source, corner, n_big = _triangulate(polys, vertices)
+    appearance = None
+    if path and (mtllibs or any(c is not None for c in colors)):
+        vt = np.array([[poly_vt[s][k] for k in c] for s, c in zip(source.tolist(), corner.tolist())],
+                      dtype=np.int64).reshape(-1, 3)
+        vc = None
+        if any(c is not None for c in colors):
+            vc = np.array([c if c is not None else [1.0, 1.0, 1.0] for c in colors], dtype=np.float64)
+            if np.nanmax(vc) > 1.0:  # some writers use 0..255
+                vc = vc / 255.0
+        safe = np.where((tris >= 0) & (tris < len(vertices)), tris, 0)
+        appearance = obj_appearance(len(tris), safe, vt, [poly_mtl[s] for s in source.tolist()],
+                                    np.array(uvs, dtype=np.float64).reshape(-1, 2), vc, mtllibs, path, looks)
+    return RawMesh(vertices, tris, source, n_big, flines, vlines, appearance=appearance,
+                   warnings=tuple(looks.warnings))
 
 
-def _parse_off(text: str, name: str) -> RawMesh:
+def _vt_index(refs: list[str], n_uvs: int) -> int:
+    """The 0-based texture coordinate of a face corner `v/vt/vn` split at "/" (-1: none or bad;
+    negative OBJ indices count back from the last vt so far)."""
+    if len(refs) < 2 or not refs[1]:
+        return -1
+    try:
+        k = int(refs[1])
+    except ValueError:
+        return -1
+    j = k - 1 if k > 0 else n_uvs + k
+    return j if 0 <= j < MAX_INDEX else -1
+
+
+def _parse_off(text: str, name: str, path: str = "") -> RawMesh:
     rows = list(_logical_lines(text))
     if not rows:
         raise mesh_error(name, "no faces (empty file)")
@@ -203,7 +262,7 @@ def _parse_off(text: str, name: str) -> RawMesh:
         polys.append(idx)
         flines.append(lineno)
     vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
-    tris, source, n_big = _triangulate(polys, vertices)
+    tris, source, _, n_big = _triangulate(polys, vertices)
     return RawMesh(vertices, tris, source, n_big, flines, vlines)
 
 
@@ -254,7 +313,10 @@ def _load_trimesh(path: str, name: str, data: bytes) -> RawMesh:
     if not hasattr(tm, "faces") or tm.faces is None or len(tm.faces) == 0:
         raise mesh_error(name, f"no faces could be read (not a valid {ext[1:].upper()} file?)")
     faces = np.asarray(tm.faces, dtype=np.int64).reshape(-1, 3)
-    return RawMesh(np.asarray(tm.vertices, dtype=np.float64).reshape(-1, 3), faces, np.arange(len(faces)), 0)
+    looks = Looks()
+    appearance = trimesh_appearance(tm, len(faces), name, looks)
+    return RawMesh(np.asarray(tm.vertices, dtype=np.float64).reshape(-1, 3), faces, np.arange(len(faces)), 0,
+                   appearance=appearance, warnings=tuple(looks.warnings))
 
 
 def _read(path: str, name: str) -> RawMesh:
@@ -275,7 +337,7 @@ def _read(path: str, name: str) -> RawMesh:
         line = data.count(b"\n", 0, nul) + 1
         raise mesh_error(name, f"line {line}: a NUL byte (binary data in a text {ext[1:].upper()} file?)")
     # Comments may hold any encoding; the data we need is ASCII.
-    return parse(data.decode("utf-8", errors="replace"), name)
+    return parse(data.decode("utf-8", errors="replace"), name, path)
 
 
 # The readers by file suffix: a text parser of ours, or None for trimesh's loader.
@@ -326,6 +388,25 @@ def mesh_bytes(suffix: str, vertices: np.ndarray, faces: np.ndarray, *, face_col
         raise PolyfoldError(f"cannot write {suffix or 'a file without suffix'!r} meshes: use one of {', '.join(WRITERS)}")
     return writer(np.asarray(vertices, dtype=np.float64), np.asarray(faces), face_colors,
                   [header] if isinstance(header, str) else list(header))
+
+
+def look_glb(vertices: np.ndarray, faces: np.ndarray, look: Appearance) -> bytes:
+    """A GLB of a triangle mesh in its look: every face with corners of its own (UV seams), the
+    texture with its UVs when the look has one texture, else the colours per corner (several
+    textures: each face's mean colour)."""
+    import trimesh
+    from PIL import Image
+
+    corners = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3)
+    tris = np.arange(len(corners)).reshape(-1, 3)
+    if len(look.images) == 1 and look.textured.all():
+        visual = trimesh.visual.TextureVisuals(uv=look.uv.reshape(-1, 2),
+                                               image=Image.fromarray(look.images[0]))
+    else:
+        rgb = look.colors if not look.textured.any() else np.repeat(look.mean_colors[:, None, :], 3, axis=1)
+        rgba = np.concatenate([rgb.reshape(-1, 3), np.full((len(corners), 1), 255, np.uint8)], axis=1)
+        visual = trimesh.visual.ColorVisuals(vertex_colors=rgba)
+    return trimesh.Trimesh(corners, tris, visual=visual, process=False).export(file_type="glb")
 
 
 def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, *,

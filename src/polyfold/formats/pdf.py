@@ -12,7 +12,8 @@ import numpy as np
 
 from ..fabricate.page import Page, TextItem
 from .files import atomic_write
-from .sheet_style import LEADER_MM, MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
+from .sheet_style import (HALO_MM, HALO_RGB, HALO_TEXT, LEADER_MM, MM_TO_PT, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB,
+                          TEXT_RGB, coloured, crease_layers, text_baseline)
 
 
 def _pt(page: Page, pts: np.ndarray) -> np.ndarray:
@@ -41,15 +42,64 @@ def _pdf_polygon(c, pts_pt: np.ndarray, stroke: int, fill: int) -> None:
     c.drawPath(p, stroke=stroke, fill=fill)
 
 
-def _pdf_text(c, page: Page, t: TextItem) -> None:
-    """One centred text item (fill colour already set)."""
+def _pdf_text(c, page: Page, t: TextItem, halo: bool = False) -> None:
+    """One centred text item (fill colour already set); with `halo` a white outline under it."""
     bx, by = text_baseline(t)
     c.saveState()
     c.translate(bx * MM_TO_PT, (page.height - by) * MM_TO_PT)
     c.rotate(t.angle)  # PDF rotation is CCW with y up: the same visual sense as ours
     c.setFont("Helvetica", t.size * MM_TO_PT)
+    if halo:  # (in its own graphics state: the stroke-only render mode must not outlive it)
+        c.saveState()
+        outline = c.beginText()
+        outline.setTextRenderMode(1)  # stroke the glyphs only
+        outline.setFont("Helvetica", t.size * MM_TO_PT)
+        outline.setTextOrigin(-c.stringWidth(t.text, "Helvetica", t.size * MM_TO_PT) / 2, 0)
+        c.setStrokeColorRGB(*(v / 255 for v in HALO_RGB))
+        c.setLineWidth(HALO_TEXT * t.size * MM_TO_PT)
+        c.setLineJoin(1)
+        c.setDash([], 0)
+        outline.textOut(t.text)
+        c.drawText(outline)
+        c.restoreState()
     c.drawCentredString(0, 0, t.text)
     c.restoreState()
+
+
+def _pdf_pictures(c, page: Page) -> None:
+    """The model's texture: each piece's picture (embedded as its JPEG), clipped to its faces."""
+    from reportlab.lib.utils import ImageReader
+
+    for im in page.images:
+        c.saveState()
+        p = c.beginPath()
+        for ring in im.clip:
+            pts = _pt(page, ring)
+            p.moveTo(*pts[0])
+            for x, y in pts[1:]:
+                p.lineTo(x, y)
+            p.close()
+        c.clipPath(p, stroke=0, fill=0, fillMode=1)  # even-odd: holes stay out
+        c.drawImage(ImageReader(_io.BytesIO(im.jpeg)), im.x * MM_TO_PT, (page.height - im.y - im.height) * MM_TO_PT,
+                    im.width * MM_TO_PT, im.height * MM_TO_PT)
+        c.restoreState()
+
+
+def _pdf_halos(c, page: Page) -> None:
+    """A white stroke under every line of a coloured page."""
+    c.setStrokeColorRGB(*(v / 255 for v in HALO_RGB))
+    c.setLineWidth((STROKE_MM + HALO_MM) * MM_TO_PT)
+    c.setDash([], 0)
+    c.setLineCap(1)
+    c.setLineJoin(1)
+    for _style, _cls, segs in crease_layers(page):
+        for (x0, y0), (x1, y1) in _pt(page, segs):
+            c.line(x0, y0, x1, y1)
+    for poly in page.cut:
+        _pdf_polygon(c, _pt(page, poly), stroke=1, fill=0)
+    for (x0, y0), (x1, y1) in _pt(page, page.slits):
+        c.line(x0, y0, x1, y1)
+    c.setLineCap(0)
 
 
 def _draw_furniture(c, page: Page) -> None:
@@ -88,9 +138,15 @@ def _draw_pdf_page(c, page: Page) -> None:
     for t in page.tabs:
         _pdf_polygon(c, _pt(page, t), stroke=0, fill=1)
     c.setFillColorRGB(*(v / 255 for v in PREVIEW_RGB))
-    for tris in page.faces:
-        for tri in _pt(page, tris):
+    for i, tris in enumerate(page.faces):
+        for j, tri in enumerate(_pt(page, tris)):
+            if page.face_colors:  # the model's colour of every face
+                c.setFillColorRGB(*(int(v) / 255 for v in page.face_colors[i][j]))
             _pdf_polygon(c, tri, stroke=0, fill=1)
+    _pdf_pictures(c, page)
+    halo = coloured(page)
+    if halo:
+        _pdf_halos(c, page)
 
     for style, _cls, segs in crease_layers(page):
         if not len(segs):
@@ -108,7 +164,7 @@ def _draw_pdf_page(c, page: Page) -> None:
 
     c.setFillColorRGB(*(v / 255 for v in TEXT_RGB))
     for t in page.texts:
-        _pdf_text(c, page, t)
+        _pdf_text(c, page, t, halo)
     if len(page.leaders):
         c.setStrokeColorRGB(*(v / 255 for v in TEXT_RGB))
         c.setLineWidth(LEADER_MM * MM_TO_PT)

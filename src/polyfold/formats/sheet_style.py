@@ -50,6 +50,19 @@ TAB_RGB = (236, 236, 236)  # glue tabs, lighter than the faces
 TEXT_RGB = (0, 0, 0)
 
 
+# On a page printed in the model's colours, lines and labels get a white halo so they stay
+# readable on dark textures: lines a HALO_MM wider white stroke under them, labels a white outline
+# HALO_TEXT em wide (half of it outside the glyphs).
+HALO_RGB = (255, 255, 255)
+HALO_MM = 0.35
+HALO_TEXT = 0.18
+
+
+def coloured(page: Page) -> bool:
+    """Whether the page prints the model's colours (then lines and labels get halos)."""
+    return bool(page.images or page.face_colors)
+
+
 def text_baseline(t: TextItem) -> tuple[float, float]:
     """Page point (mm, y down) where the centred baseline of `t` starts: half a cap height
     'below' the centre in the text's own frame, so the glyphs end up centred on (x, y)."""

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..fabricate.page import Page, TextItem
 from .files import atomic_write
-from .sheet_style import LEADER_MM, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB, crease_layers, text_baseline
+from .sheet_style import (HALO_MM, HALO_RGB, HALO_TEXT, LEADER_MM, PREVIEW_RGB, STROKE_MM, STYLES, TAB_RGB, TEXT_RGB,
+                          coloured, crease_layers, text_baseline)
 
 
 SVG_NS = "http://www.w3.org/2000/svg"
@@ -58,7 +59,7 @@ def _polyline_d(points: np.ndarray, closed: bool) -> str:
     return d + " Z" if closed else d
 
 
-def _text(parent: ET.Element, t: TextItem) -> None:
+def _text(parent: ET.Element, t: TextItem) -> ET.Element:
     """One centred text element (font attributes come from the parent layer)."""
     bx, by = text_baseline(t)
     el = ET.SubElement(parent, "text", {"class": t.kind, "x": _num(bx), "y": _num(by), "font-size": _num(t.size)})
@@ -66,6 +67,7 @@ def _text(parent: ET.Element, t: TextItem) -> None:
         # SVG rotate() is clockwise on screen (y down); our angles are counter-clockwise.
         el.set("transform", f"rotate({_num(-t.angle)} {_num(bx)} {_num(by)})")
     el.text = t.text
+    return el
 
 
 def _svg_root(page: Page) -> ET.Element:
@@ -79,6 +81,37 @@ def _svg_root(page: Page) -> ET.Element:
         "height": f"{_num(page.height)}mm",
         "viewBox": f"0 0 {_num(page.width)} {_num(page.height)}",
     })
+
+
+def _halo_layer(root: ET.Element, page: Page) -> None:
+    """A white stroke under every line of the page (print file of a coloured page only)."""
+    g = _layer(root, "halo", **{"class": "no-cut", "fill": "none", "stroke": _hex(HALO_RGB),
+                                "stroke-width": _num(STROKE_MM + HALO_MM), "stroke-linejoin": "round",
+                                "stroke-linecap": "round", "stroke-opacity": "0.85"})
+    ET.SubElement(g, "desc").text = "white halo under the lines on a coloured page: print only, do not cut"
+    d = [_polyline_d(seg, closed=False) for _, _, segs in crease_layers(page) for seg in segs]
+    d += [_polyline_d(poly, closed=True) for poly in page.cut] + [_polyline_d(seg, closed=False) for seg in page.slits]
+    if d:
+        ET.SubElement(g, "path", {"d": " ".join(d)})
+
+
+def _picture_layer(root: ET.Element, page: Page) -> None:
+    """The model's texture: one embedded JPEG per piece, clipped to the piece's faces."""
+    import base64
+
+    root.set("xmlns:xlink", "http://www.w3.org/1999/xlink")
+    defs = ET.SubElement(root, "defs")
+    g = _layer(root, "texture", **{"class": "no-cut"})
+    ET.SubElement(g, "desc").text = "the model's texture on the pieces: print only, do not cut"
+    for i, im in enumerate(page.images):
+        clip = ET.SubElement(defs, "clipPath", {"id": f"clip-{i}", "clipPathUnits": "userSpaceOnUse"})
+        ET.SubElement(clip, "path", {"clip-rule": "evenodd",
+                                     "d": " ".join(_polyline_d(r, closed=True) for r in im.clip)})
+        ET.SubElement(g, "image", {"id": f"picture-{i}", "x": _num(im.x), "y": _num(im.y), "width": _num(im.width),
+                                   "height": _num(im.height), "preserveAspectRatio": "none",
+                                   "clip-path": f"url(#clip-{i})",
+                                   # xlink:href (SVG 1.1): what cutting software's importers read
+                                   "xlink:href": "data:image/jpeg;base64," + base64.b64encode(im.jpeg).decode("ascii")})
 
 
 def _line_layers(root: ET.Element, page: Page, dashed: bool) -> None:
@@ -117,6 +150,11 @@ def svg_page_string(page: Page) -> str:
         g = _layer(root, "preview", **{"class": "no-cut", "fill": _hex(PREVIEW_RGB), "stroke": "none"})
         ET.SubElement(g, "desc").text = "preview fill: print only, do not cut"
         for i, tris in enumerate(page.faces):
+            if page.face_colors:  # the model's colour of every face
+                for j, (tri, rgb) in enumerate(zip(tris, page.face_colors[i])):
+                    ET.SubElement(g, "path", {"id": f"preview-{i}-{j}", "fill": _hex(tuple(int(v) for v in rgb)),
+                                              "d": _polyline_d(tri, closed=True)})
+                continue
             d = " ".join(_polyline_d(tri, closed=True) for tri in tris)
             if d:
                 ET.SubElement(g, "path", {"id": f"preview-{i}", "d": d})
@@ -124,11 +162,20 @@ def svg_page_string(page: Page) -> str:
             ET.SubElement(g, "path", {"id": f"tab-{i}", "class": "tab", "fill": _hex(TAB_RGB),
                                       "d": _polyline_d(t, closed=True)})
 
+    if page.images:
+        _picture_layer(root, page)
+    halo = coloured(page)
+    if halo:
+        _halo_layer(root, page)
+
     text_font = {"font-family": "Helvetica, Arial, sans-serif", "text-anchor": "middle"}
     g = _layer(root, "labels", **{"class": "no-cut", "fill": _hex(TEXT_RGB), "stroke": "none", **text_font})
     ET.SubElement(g, "desc").text = "labels: print or draw only, do not cut"
     for t in page.texts:
-        _text(g, t)
+        el = _text(g, t)
+        if halo:  # a white outline under the glyphs (paint-order: stroke first)
+            el.attrib.update({"stroke": _hex(HALO_RGB), "stroke-width": _num(HALO_TEXT * t.size),
+                              "stroke-linejoin": "round", "paint-order": "stroke"})
     for seg in page.leaders:  # thin lines from an edge to its label beside the piece
         ET.SubElement(g, "path", {"class": "leader", "fill": "none", "stroke": _hex(TEXT_RGB),
                                   "stroke-width": _num(LEADER_MM), "d": _polyline_d(seg, closed=False)})

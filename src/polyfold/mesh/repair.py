@@ -20,6 +20,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from ..errors import MeshError
+from .appearance import Appearance
 from .geometry import concavity, face_areas
 from .mesh import boundary_loops, edge_topology, face_components, Mesh, Topology
 
@@ -52,6 +53,7 @@ class LoadedMesh:
     manifold: bool = True
     oriented: bool = True
     n_input_faces: int = -1  # faces in the file (before triangulation and repairs); -1 if unknown
+    appearance: Appearance | None = None  # the look of each face of `mesh` (None: the file has none)
 
 
 @dataclass
@@ -62,6 +64,8 @@ class RawMesh:
     n_triangulated: int  # file faces with more than 3 corners
     face_lines: list[int] | None = None  # line number of each file face (text formats only)
     vertex_lines: list[int] | None = None  # line number of each vertex (text formats only)
+    appearance: Appearance | None = None  # the look of each triangle of `tris` (None: the file has none)
+    warnings: tuple[str, ...] = ()  # what the reader could not use (a missing texture, ...): said, not fatal
 
 
 def mesh_error(name: str, message: str) -> MeshError:
@@ -286,9 +290,11 @@ class _Work:
     source: np.ndarray
     notes: dict[str, str] = field(default_factory=dict)  # kind of repair -> its warning line
     degenerate: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # dropped faces
+    tri: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # the parsed triangle of each face
 
     def keep(self, mask: np.ndarray) -> None:
         self.faces, self.corners, self.source = self.faces[mask], self.corners[mask], self.source[mask]
+        self.tri = self.tri[mask]
 
 
 def _drop_degenerate(w: _Work) -> None:
@@ -516,7 +522,8 @@ def repair(parsed: RawMesh, path: str) -> LoadedMesh:
     cannot be used."""
     name = os.path.basename(path)
     check_input(parsed, name)
-    w = _Work(name, parsed.vertices, parsed.tris, parsed.tris.copy(), parsed.source)
+    w = _Work(name, parsed.vertices, parsed.tris, parsed.tris.copy(), parsed.source,
+              tri=np.arange(len(parsed.tris), dtype=np.int64))
     if parsed.n_triangulated:
         w.notes["triangulated"] = f"triangulated {_plural(parsed.n_triangulated, 'polygon')} with more than 3 corners"
 
@@ -542,11 +549,20 @@ def repair(parsed: RawMesh, path: str) -> LoadedMesh:
         path=path,
         mesh=mesh,
         components=components,
-        warnings=tuple(w.notes[k] for k in _NOTE_ORDER if k in w.notes),
+        warnings=tuple(parsed.warnings) + tuple(w.notes[k] for k in _NOTE_ORDER if k in w.notes),
         manifold=n_split == 0,
         oriented=n_flipped == 0,
         n_input_faces=int(parsed.source.max()) + 1 if len(parsed.source) else 0,
+        appearance=None if parsed.appearance is None else _carry_appearance(parsed, w),
     )
+
+
+def _carry_appearance(parsed: RawMesh, w: _Work) -> Appearance:
+    """The parsed triangles' look on the repaired faces: face f is parsed triangle w.tri[f], its
+    corner k the parsed corner with the same input vertex (flips reversed the corners)."""
+    raw = parsed.tris[w.tri]  # (F, 3) input vertex ids in parsed corner order
+    corners = np.argmax(raw[:, None, :] == w.corners[:, :, None], axis=2)  # (F, 3): parsed corner of each
+    return parsed.appearance.take(w.tri, corners)
 
 
 def describe(loaded: LoadedMesh) -> dict:

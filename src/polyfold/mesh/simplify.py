@@ -9,7 +9,8 @@ meshes (within 1-2 % of the bounding box, closed and manifold); pymeshlab's
 quadric collapse with its quality threshold makes rounder triangles (smallest angle 9-19 degrees
 against 1-9) at the same distance, but takes 1.1 s, installs 280 MB and is GPL-3 (polyfold is
 MIT). Its aggressiveness is chosen per mesh for the fewest slivers (AGGRESSIVENESS). The result goes through the loader's own `repair` (welding, orientation, components), so
-a simplified mesh is checked exactly like a file. The report says the smallest angle, since the
+a simplified mesh is checked exactly like a file; its look (texture, colours) is baked onto the
+new faces (`bake`). The report says the smallest angle, since the
 collapse may leave slivers (bench/bench_big.py measures them).
 """
 
@@ -17,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -174,6 +175,10 @@ def simplify(loaded: LoadedMesh, faces: int) -> Simplified:
     raw = RawMesh(vertices=np.asarray(points, dtype=np.float64), tris=tris, source=np.arange(len(tris)),
                   n_triangulated=0)
     out = repair(raw, loaded.path)
+    if loaded.appearance is not None:  # the new faces get the old look (a baked texture, or colours)
+        from .bake import bake
+
+        out = replace(out, appearance=bake(mesh, loaded.appearance, out.mesh))
     diag = float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
     dist = hausdorff(mesh, out.mesh) / diag if diag > 0 else 0.0
     return Simplified(out, before, int(out.mesh.n_faces), dist,

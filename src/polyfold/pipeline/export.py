@@ -2,7 +2,8 @@
 in at the end (report.json last, so it marks a finished run).
 
 The folder: sheets.pdf (all pages), sheet-NN.svg (print), cut-NN.svg (cutting machines: cut and
-score lines only) and sheet-NN.dxf per page, part-K.obj per part, piece-X.fold per piece (net,
+score lines only) and sheet-NN.dxf per page, part-K.obj per part, model.glb (the model as made in
+the look the sheets print; only for a model with a texture or colours), piece-X.fold per piece (net,
 folding path, source faces; in mm where it is printed, with its page and sheet transform:
 `formats.fold.piece_fold`), assembly.json, instructions.html and report.json. Every printed page
 has a scale bar in its footer; with --marks, registration marks. Files an earlier run wrote that
@@ -12,20 +13,22 @@ touched, and the input mesh is never replaced (`formats.files.StagedFolder`).
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from ..fabricate.pack import Placement
+from ..fabricate.paint import page_looks
 from ..fabricate.page import Page, footer, page_of, registration_marks
 from ..formats.dxf import dxf_document
 from ..formats.files import StagedFolder
 from ..formats.fold import dumps, piece_fold
-from ..formats.meshes import obj_text
+from ..formats.meshes import look_glb, obj_text
 from ..formats.pdf import pdf_bytes
 from ..formats.svg import cut_svg_string, svg_page_string
+from ..mesh.appearance import Appearance, flat_look
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
 from ..unfold.pattern import CreasePattern
@@ -37,23 +40,43 @@ from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, 
 from .sheets import Sheets, pack_box
 
 # every name make may write into its folder (`files.check_folder` before the run)
-OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "piece-*.fold", "assembly.json",
-           "instructions.html", "report.json")
+OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "model.glb", "piece-*.fold",
+           "assembly.json", "instructions.html", "report.json")
 
 
-def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions) -> list[Page]:
-    """One `Page` per sheet: its pieces, the footer line and scale bar in the footer strip (below
-    the packed area, beside the marks' corner with --marks), the registration marks with --marks."""
+@dataclass(frozen=True)
+class PrintedLook:
+    """What the sheets print of the model's look: faces from a texture, faces in colour (a fill or
+    a picture), pieces printed as a picture."""
+
+    faces_textured: int = 0
+    faces_coloured: int = 0
+    pictures: int = 0
+
+
+def sheet_pages(sheets: Sheets, name: str, opts: MakeOptions,
+                look: Appearance | None = None) -> tuple[list[Page], PrintedLook]:
+    """One `Page` per sheet: its pieces in the model's look (`fabricate.paint`, --color, --dpi),
+    the footer line and scale bar in the footer strip (below the packed area, beside the marks'
+    corner with --marks), the registration marks with --marks; and what they print of the look."""
     n_pages = sheets.packing.n_pages
     on_page = sheets.page_of_piece()
     x0, _, x1, strip_top = pack_box(sheets.width, sheets.height, opts)
     marks = registration_marks(sheets.width, sheets.height) if opts.marks else None
     pages = []
+    printed = PrintedLook()
     for k in range(n_pages):
-        page = page_of([p for i, p in enumerate(sheets.pieces) if on_page[i] == k], sheets.width, sheets.height)
+        pieces = [p for i, p in enumerate(sheets.pieces) if on_page[i] == k]
+        page = page_of(pieces, sheets.width, sheets.height)
+        fills, images = page_looks(pieces, look, opts.color, opts.dpi)
+        if fills:
+            fids = np.concatenate([np.asarray(p.face_ids, dtype=np.int64) for p in pieces])
+            printed = PrintedLook(printed.faces_textured + (int(look.textured[fids].sum()) if images else 0),
+                                  printed.faces_coloured + len(fids), printed.pictures + len(images))
         text, bar = footer(f"{name} - sheet {k + 1}/{n_pages} - {opts.size:g} mm - polyfold", x0, x1, strip_top)
-        pages.append(replace(page, texts=(*page.texts, text), scale_bar=bar, marks=marks))
-    return pages
+        pages.append(replace(page, texts=(*page.texts, text), scale_bar=bar, marks=marks, face_colors=fills,
+                             images=images))
+    return pages, printed
 
 
 def pattern_to_page(pattern: CreasePattern, net: Net, scale: float, placement: Placement) -> np.ndarray:
@@ -94,14 +117,16 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
 
 def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],
                       folded: list[FoldedPiece], sheets: Sheets,
-                      finish: Callable[[tuple[PieceReport, ...], list[str]], MakeReport],
-                      inputs: tuple[Path, ...] = ()) -> tuple[tuple[str, ...], MakeReport]:
+                      finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int], MakeReport],
+                      inputs: tuple[Path, ...] = (), look: Appearance | None = None) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
-    written, and the report. finish(piece rows, outputs so far) gives the report, written last.
-    inputs: the files make read (never replaced)."""
-    pages = sheet_pages(sheets, model, opts)
+    written, and the report. finish(piece rows, outputs so far, what the sheets print of the
+    model's `look`, sheets.pdf's size in bytes) gives the report, written last. inputs: the files
+    make read (never replaced)."""
+    pages, printed = sheet_pages(sheets, model, opts, look)
     with StagedFolder(out_dir, "make", inputs=inputs) as stage:
-        stage.write("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))
+        pdf = pdf_bytes(pages, title=f"{model}: polyfold sheets")
+        stage.write("sheets.pdf", pdf)
         svgs = []
         for k, page in enumerate(pages):
             svgs.append(f"sheet-{k + 1:02d}.svg")
@@ -111,6 +136,9 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         for k, part in enumerate(parts):
             sub = mesh.submesh(part.faces)
             stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
+        if look is not None and opts.color != "none":  # the model as made, in the look printed (the viewer shows it)
+            shown = look if opts.color == "texture" else flat_look(look)
+            stage.write("model.glb", look_glb(mesh.vertices, mesh.faces, shown))
         rows = piece_reports(folded, sheets)
         for fp, piece, row, placement in zip(folded, sheets.pieces, rows, sheets.packing.placements):
             stage.write(row.fold_file, dumps(piece_fold(
@@ -123,6 +151,6 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         stage.write("instructions.html", instructions_html(
             model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),
             sheets.packing.n_pages, opts, svgs))
-        report = finish(rows, list(stage.names))
+        report = finish(rows, list(stage.names), printed, len(pdf))
         stage.write("report.json", report.to_json())
         return stage.commit(), report

@@ -22,13 +22,14 @@ from ..fabricate.check import check_pages
 from ..fabricate.fit import model_scale, smallest_printed
 from ..fabricate.paper import GAP_MM
 from ..formats.files import check_folder
+from ..mesh.appearance import Appearance
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
-from .export import OUTPUTS, write_make_folder
+from .export import OUTPUTS, PrintedLook, write_make_folder
 from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
-from .report import (ChecksReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
+from .report import (ChecksReport, ColorReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
                      PieceReport, SimplifyReport, StageReports)
 from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
 
@@ -47,9 +48,11 @@ def _progress_noop(stage: str, message: str) -> None:
 
 
 def _load(source: str | os.PathLike | Mesh | LoadedMesh, name: str | None,
-          say: Progress) -> tuple[Mesh, InputReport, LoadReport, str]:
-    """The mesh to make, its report and its name (the file name; a Mesh in memory: `name`)."""
+          say: Progress) -> tuple[Mesh, Appearance | None, InputReport, LoadReport, str]:
+    """The mesh to make, its look (None: the file has none), its report and its name (the file
+    name; a Mesh in memory: `name`)."""
     t0 = time.perf_counter()
+    look = None
     if isinstance(source, Mesh):
         name = name or "model"
         mesh, n_components, warnings = source, len(component_faces(source)[1]), ()
@@ -62,25 +65,28 @@ def _load(source: str | os.PathLike | Mesh | LoadedMesh, name: str | None,
             source = load_mesh(source)
         name = name or Path(source.path).name
         mesh, n_components, warnings = source.mesh, len(source.components), tuple(source.warnings)
+        look = source.appearance
     info = InputReport(file=name, faces=int(mesh.n_faces), vertices=int(mesh.n_vertices), components=n_components,
                        warnings=warnings)
-    return mesh, info, LoadReport(seconds=time.perf_counter() - t0), name
+    return mesh, look, info, LoadReport(seconds=time.perf_counter() - t0), name
 
 
-def _simplify(mesh: Mesh, name: str, opts: MakeOptions, say: Progress) -> tuple[Mesh, SimplifyReport | None]:
-    """The mesh reduced to the face count of --faces (`mesh.simplify`), and its report (None: left
-    as it is)."""
+def _simplify(mesh: Mesh, look: Appearance | None, name: str, opts: MakeOptions,
+              say: Progress) -> tuple[Mesh, Appearance | None, SimplifyReport | None]:
+    """The mesh reduced to the face count of --faces (`mesh.simplify`) with its look carried over,
+    and its report (None: left as it is)."""
     from ..mesh.repair import LoadedMesh
     from ..mesh.simplify import face_target, simplify
 
     target = face_target(opts.faces, mesh, opts.size)
     if target is None:
-        return mesh, None
+        return mesh, look, None
     say("simplify", f"{mesh.n_faces:,} faces to about {target:,} (--faces {opts.faces})")
-    done = simplify(LoadedMesh(path=name, mesh=mesh, components=(mesh,), warnings=()), target)
-    return done.loaded.mesh, SimplifyReport(spec=opts.faces, faces_before=done.faces_before,
-                                            faces_after=done.faces_after, hausdorff=done.hausdorff,
-                                            min_angle_deg=done.min_angle_deg, seconds=done.seconds)
+    keep = look if opts.color != "none" else None  # (no texture to bake when none is printed)
+    done = simplify(LoadedMesh(path=name, mesh=mesh, components=(mesh,), warnings=(), appearance=keep), target)
+    return done.loaded.mesh, done.loaded.appearance, SimplifyReport(
+        spec=opts.faces, faces_before=done.faces_before, faces_after=done.faces_after, hausdorff=done.hausdorff,
+        min_angle_deg=done.min_angle_deg, seconds=done.seconds)
 
 
 def _inflate(mesh: Mesh, opts: MakeOptions, say: Progress) -> tuple[Mesh, InflateReport]:
@@ -130,6 +136,16 @@ def time_shares(n_faces: int, time_limit: float) -> tuple[float, float]:
             min(0.25 * time_limit, TAIL_S + TAIL_S_PER_FACE * n_faces))
 
 
+def _color_report(look: Appearance | None, opts: MakeOptions, printed: PrintedLook) -> ColorReport:
+    """report.json's account of the model's look on the sheets."""
+    shown = "none" if look is None or opts.color == "none" else opts.color
+    if shown == "texture" and not look.textured.any():
+        shown = "flat" if not look.shaded.any() else "texture"  # (vertex colours are printed as pictures)
+    return ColorReport(source="none" if look is None else look.kind, mode=opts.color, printed=shown,
+                       faces_textured=printed.faces_textured, faces_coloured=printed.faces_coloured,
+                       pictures=printed.pictures, dpi=opts.dpi)
+
+
 MIN_DRAWN_MM = 1e-3  # a face narrower than this on paper (a micrometre) cannot be drawn, let alone cut
 
 
@@ -162,9 +178,10 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     check_folder(out_dir, OUTPUTS, inputs)
     hard = Deadline.after(opts.time_limit)  # the whole run's
     t0 = time.perf_counter()
-    mesh, input_report, load_report, name = _load(source, name, say)
+    mesh, look, input_report, load_report, name = _load(source, name, say)
     try:
-        return _make(mesh, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report, inputs)
+        return _make(mesh, look, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report,
+                     inputs)
     except OutOfTime as exc:
         raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
                         f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh first "
@@ -172,13 +189,13 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
                         exc.doing) from None
 
 
-def _make(mesh: Mesh, name: str, out_dir: str | os.PathLike, opts: MakeOptions, page: tuple[float, float],
-          say: Progress, hard: Deadline, t0: float, input_report: InputReport, load_report: LoadReport,
-          inputs: tuple[Path, ...]) -> MakeResult:
+def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.PathLike, opts: MakeOptions,
+          page: tuple[float, float], say: Progress, hard: Deadline, t0: float, input_report: InputReport,
+          load_report: LoadReport, inputs: tuple[Path, ...]) -> MakeResult:
     """`make` after loading (page: width, height in mm): OutOfTime when `hard` passes in work that
     cannot be skipped."""
     width, height = page
-    mesh, simplify_report = _simplify(mesh, name, opts, say)
+    mesh, look, simplify_report = _simplify(mesh, look, name, opts, say)
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
     searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
@@ -206,13 +223,17 @@ def _make(mesh: Mesh, name: str, out_dir: str | os.PathLike, opts: MakeOptions, 
     te = time.perf_counter()
     say("export", "writing sheets and files")
 
-    def finish(rows: tuple[PieceReport, ...], outputs: list[str]) -> MakeReport:
+    def finish(rows: tuple[PieceReport, ...], outputs: list[str], printed: PrintedLook, pdf_size: int) -> MakeReport:
         stages = StageReports(load=load_report, inflate=inflate_report, segment=segment_report, unfold=unfold_report,
                               fold=fold_report, layout=layout_report,
-                              export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages),
-                              simplify=simplify_report)
+                              export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages,
+                                                  pdf_bytes=pdf_size),
+                              simplify=simplify_report, color=_color_report(look, opts, printed))
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0)
 
-    files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs)
+    if look is not None and opts.color != "none":
+        say("export", f"printing the model's {'texture' if look.textured.any() and opts.color == 'texture' else 'colours'}")
+    files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs,
+                                      look=look)
     return MakeResult(out_dir=Path(out_dir), files=files, report=report)

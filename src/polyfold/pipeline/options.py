@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..collide.tolerance import CONTACT_TOL, THICKNESS_MM
 from ..errors import PolyfoldError
-from ..fabricate.paper import FOOTER_MM, MARK_CLEAR_MM, MIN_LABEL_MM
+from ..fabricate.paper import COLOR_MODES, DPI, DPI_RANGE, FOOTER_MM, MARK_CLEAR_MM, MIN_LABEL_MM
 
 PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
 INFLATE_MODES = ("none", "constrained", "uniform")
@@ -38,6 +38,8 @@ class MakeOptions:
     marks: bool = False  # print-and-cut registration marks (Silhouette "Type 1") on the printed pages
     min_label_mm: float = MIN_LABEL_MM  # least cap height of every label (mm)
     faces: str = "auto"  # simplify first: a face count, auto (meshes over mesh.simplify.AUTO_ABOVE faces) or none
+    color: str = "texture"  # the model's look on the sheets: texture (as the file has it), flat or none
+    dpi: float = DPI  # raster resolution of printed textures
 
 
 def paper_size(spec: str) -> tuple[float, float]:
@@ -71,6 +73,10 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
     from ..mesh.simplify import check_faces_spec
 
     check_faces_spec(opts.faces)
+    if opts.color not in COLOR_MODES:
+        raise PolyfoldError(f"--color must be one of {', '.join(COLOR_MODES)}, not {opts.color!r}")
+    if not (DPI_RANGE[0] <= opts.dpi <= DPI_RANGE[1]):
+        raise PolyfoldError(f"--dpi must be between {DPI_RANGE[0]:g} and {DPI_RANGE[1]:g}, not {opts.dpi:g}")
     width, height = paper_size(opts.paper)
     if not (0 <= opts.margin and 2 * opts.margin + FOOTER_MM < min(width, height)):
         raise PolyfoldError(f"--margin {opts.margin} mm leaves no room on a {width:g} x {height:g} mm page")

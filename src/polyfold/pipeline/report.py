@@ -136,6 +136,23 @@ class LayoutReport:
 class ExportReport:
     seconds: float
     pages: int
+    pdf_bytes: int = 0  # the size of sheets.pdf
+
+
+@dataclass(frozen=True)
+class ColorReport:
+    """--color: what the sheets print of the model's look. source: what the file had (texture,
+    vertex, face colours, or none); mode: the --color asked for; printed: texture, flat or none
+    (what was printed); faces_textured / faces_coloured: faces printed from a texture / in
+    colours; pictures: pieces printed as a picture at `dpi`."""
+
+    source: str
+    mode: str
+    printed: str
+    faces_textured: int
+    faces_coloured: int
+    pictures: int
+    dpi: float
 
 
 @dataclass(frozen=True)
@@ -148,6 +165,7 @@ class StageReports:
     layout: LayoutReport
     export: ExportReport
     simplify: SimplifyReport | None = None  # only when the mesh was simplified
+    color: ColorReport | None = None  # the model's look on the sheets
 
 
 @dataclass(frozen=True)

@@ -35,13 +35,16 @@ def make(
     thickness: float = options.THICKNESS_MM_OPTION,
     min_label_mm: float = options.MIN_LABEL,
     faces: str = options.FACES,
+    color: str = options.COLOR,
+    dpi: float = options.DPI,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
     """Mesh in, printable sheets out: simplify, inflate, segment, unfold, fold, lay out with tabs and labels, export."""
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces)
+                                    marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces,
+                                    color=color, dpi=dpi)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -85,8 +88,14 @@ def make(
                 "crowded spot")
         if lay.splits_for_packing:
             say(f"split {lay.splits_for_packing} more crease(s) so the pieces fill fewer pages")
+        look = rep.stages.color
+        printed = ""
+        if look is not None and look.printed != "none":
+            printed = (f", printed in its {'texture' if look.printed == 'texture' else 'colours'} "
+                       f"({look.dpi:g} dpi, sheets.pdf {rep.stages.export.pdf_bytes / 1e6:.1f} MB)"
+                       if look.printed == "texture" else ", printed in flat colours")
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
-             f"page(s) ({lay.utilisation:.0%} of their printable area), {lay.glue_edges} glue edges, "
+             f"page(s) ({lay.utilisation:.0%} of their printable area){printed}, {lay.glue_edges} glue edges, "
              f"smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
              f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified "
              f"(independent check, {opts.thickness:g} mm paper), "

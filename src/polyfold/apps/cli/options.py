@@ -47,6 +47,10 @@ THICKNESS_REL_OPTION = typer.Option(THICKNESS_REL, "--thickness", min=0.0, max=0
                                     help="Material thickness as a fraction of the model size (bounding-box diagonal): faces closer than this with overlapping projections collide.")
 FACES = typer.Option(_D.faces, "--faces",
                      help="Simplify the mesh first to about N faces (quadric edge collapse); auto: meshes over 3,000 faces to faces about 12 mm across at --size (segment: 150 mm); none: never.")
+COLOR = typer.Option(_D.color, "--color",
+                     help="The model's look on the sheets: texture (the file's texture or colours, if it has any), "
+                          "flat (one mean colour per face) or none (plain).")
+DPI = typer.Option(_D.dpi, "--dpi", min=30.0, max=1200.0, help="Resolution of printed textures (dots per inch).")
 MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
                          help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
@@ -55,7 +59,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
                  time_limit: float, fold: bool, contact_tol: float, marks: bool,
                  min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness,
-                 faces: str = _D.faces) -> MakeOptions:
+                 faces: str = _D.faces, color: str = _D.color, dpi: float = _D.dpi) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -64,7 +68,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
                        contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness,
-                       faces=faces)
+                       faces=faces, color=color, dpi=dpi)
 
 
 @contextlib.contextmanager
