@@ -2,8 +2,9 @@
 input, bad input), the gate in front of viser (apps/view_guard.py, issue 20: Host, Origin and
 token checked on every request and websocket handshake; a foreign page in the browser gets
 nothing and writes nothing) and the page itself in a real headless browser (Debian's Chromium driven by
-Playwright; never a downloaded browser). (The folder loader and the folding poses it shows:
-pipeline/test_folder.py.)
+Playwright; never a downloaded browser), and the model's look (model.glb, issue 21: read with the
+folder, matched to the parts, drawn on the folded model). (The folder loader and the folding
+poses it shows: pipeline/test_folder.py.)
 
 Set POLYFOLD_VIEWER_SCREENSHOT=path to also save a screenshot of the page (docs/viewer.png)."""
 
@@ -259,6 +260,227 @@ def test_viewer_in_browser(make_dir: Path) -> None:
                 assert viewer.folder.path == (make_dir / "again").resolve()
                 assert viewer.folder.options.parts == 3 and len(viewer.folder.parts) >= 2
                 page.wait_for_timeout(500)
+            finally:
+                browser.close()
+    finally:
+        viewer.stop()
+    assert not problems, "\n".join(problems)
+
+
+# ----------------------------------------------------------------------------------------------
+# The model's look (model.glb, issue 21): read with the folder, shown on the folded model
+
+
+def _ball_uv(xyz: np.ndarray) -> np.ndarray:
+    """The test texture's UVs: a function of the position (the left ball in [0, 0.5]^2, the right
+    one partly beyond 1: the texture repeats there)."""
+    return (np.asarray(xyz)[..., :2] + 1.0) / 4.0
+
+
+@pytest.fixture(scope="module")
+def look_dirs(tmp_path_factory) -> dict[str, Path]:
+    """Make folders of two textured balls (two parts, verified paths): printed in the texture
+    ('texture'), in flat colours ('flat': model.glb has colours per corner) and without a look
+    ('none': no model.glb)."""
+    import trimesh
+    from PIL import Image
+
+    from polyfold.pipeline.make import make
+    from polyfold.pipeline.options import MakeOptions
+
+    root = tmp_path_factory.mktemp("look")
+    a, b = trimesh.creation.icosphere(subdivisions=1), trimesh.creation.icosphere(subdivisions=0)
+    verts = np.concatenate([a.vertices, b.vertices + [3.0, 0.0, 0.0]])
+    faces = np.concatenate([a.faces, b.faces + len(a.vertices)])
+    uv = _ball_uv(verts)
+    i, j = np.mgrid[:32, :32]
+    image = np.stack([i * 8, j * 8, ((i // 4 + j // 4) % 2) * 255], axis=2).astype(np.uint8)
+    Image.fromarray(image).save(root / "balls.png")
+    (root / "balls.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd balls.png\n")
+    lines = ["mtllib balls.mtl", *(f"v {x!r} {y!r} {z!r}" for x, y, z in verts.tolist()),
+             *(f"vt {u!r} {v!r}" for u, v in uv.tolist()), "usemtl skin",
+             *(f"f {p + 1}/{p + 1} {q + 1}/{q + 1} {r + 1}/{r + 1}" for p, q, r in faces.tolist())]
+    (root / "balls.obj").write_text("\n".join(lines) + "\n")
+    out = {}
+    for color in ("texture", "flat", "none"):
+        out[color] = root / color
+        make(root / "balls.obj", out[color], MakeOptions(size=60, color=color, time_limit=30))
+    return out
+
+
+def _glb_attributes(glb: bytes) -> tuple[dict[str, np.ndarray], np.ndarray | None]:
+    """The first primitive of a GLB (as viser gets it): its attributes by name, and its base
+    colour texture as pixels (None without one)."""
+    import struct
+
+    from PIL import Image
+
+    n_json = struct.unpack_from("<I", glb, 12)[0]
+    doc = json.loads(glb[20:20 + n_json])
+    binary = glb[20 + n_json + 8:]
+    kinds = {5126: np.float32, 5121: np.uint8, 5125: np.uint32, 5123: np.uint16}
+    widths = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+
+    def data(view: int, offset: int = 0) -> bytes:
+        v = doc["bufferViews"][view]
+        return binary[v.get("byteOffset", 0) + offset:v.get("byteOffset", 0) + v["byteLength"]]
+
+    def accessor(k: int) -> np.ndarray:
+        acc = doc["accessors"][k]
+        return np.frombuffer(data(acc["bufferView"], acc.get("byteOffset", 0)), dtype=kinds[acc["componentType"]],
+                             count=acc["count"] * widths[acc["type"]]).reshape(acc["count"], -1)
+
+    prim = doc["meshes"][0]["primitives"][0]
+    attrs = {name: accessor(k) for name, k in prim["attributes"].items()}
+    attrs["indices"] = accessor(prim["indices"]).reshape(-1, 3)
+    pbr = doc["materials"][prim["material"]].get("pbrMetallicRoughness", {})
+    if "baseColorTexture" not in pbr:
+        return attrs, None
+    source = doc["textures"][pbr["baseColorTexture"]["index"]]["source"]
+    picture = Image.open(io.BytesIO(data(doc["images"][source]["bufferView"])))
+    return attrs, np.asarray(picture.convert("RGB"))
+
+
+def _sample(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """The texel under each UV (v up, repeating), nearest."""
+    h, w = image.shape[:2]
+    x = np.floor(uv[:, 0] * w).astype(int) % w
+    y = np.floor((1.0 - uv[:, 1]) * h).astype(int) % h
+    return image[y, x]
+
+
+def test_a_folder_with_a_look_loads_it(look_dirs: dict[str, Path]) -> None:
+    """model.glb is read and matched to the parts: every face of the model once, each corner with
+    the UVs of its position (the texture as the OBJ had it) or the colour of its face."""
+    from PIL import Image
+
+    from polyfold.pipeline.folder import load_folder
+
+    folder = load_folder(look_dirs["texture"])
+    look = folder.look
+    assert look is not None and look.textured and look.colors is None and len(folder.parts) == 2
+    np.testing.assert_array_equal(look.image, np.asarray(Image.open(look_dirs["texture"].parent / "balls.png")))
+    rows = np.concatenate(look.part_corners)
+    assert sorted(rows.reshape(-1).tolist()) == list(range(len(look.corners)))  # each model corner once
+    for k, part in enumerate(folder.parts):
+        corners = part.vertices[part.faces]
+        np.testing.assert_allclose(look.corners[look.part_corners[k]], corners, rtol=0, atol=1e-6)
+        np.testing.assert_allclose(look.part_uv(k), _ball_uv(corners), rtol=0, atol=1e-6)
+
+    flat = load_folder(look_dirs["flat"]).look
+    assert flat is not None and not flat.textured and flat.uv is None
+    for k in range(2):
+        rgba = flat.part_colors(k)
+        assert (rgba == rgba[:, :1]).all() and (rgba[..., 3] == 255).all()  # one colour a face, opaque
+        assert len(np.unique(rgba[:, 0], axis=0)) > 3
+
+    assert not (look_dirs["none"] / "model.glb").exists() and load_folder(look_dirs["none"]).look is None
+
+
+def test_a_broken_look_is_one_line(look_dirs: dict[str, Path], tmp_path: Path) -> None:
+    import shutil
+
+    import trimesh
+
+    from polyfold.pipeline.folder import load_folder
+
+    copy = tmp_path / "copy"
+    shutil.copytree(look_dirs["flat"], copy)
+    (copy / "model.glb").write_bytes(b"glTF not really")
+    with pytest.raises(PolyfoldError, match=r"model\.glb: not a readable model look") as err:
+        load_folder(copy)
+    assert "\n" not in str(err.value)
+    box = trimesh.creation.box()
+    box.visual.vertex_colors = [200, 30, 30, 255]
+    (copy / "model.glb").write_bytes(box.export(file_type="glb"))  # a look, but of another model
+    with pytest.raises(PolyfoldError, match=r"model\.glb: not the model of the parts"):
+        load_folder(copy)
+    (copy / "model.glb").unlink()
+    assert load_folder(copy).look is None  # old folders (no model.glb) load as before
+
+
+def test_the_viewer_shows_the_texture(look_dirs: dict[str, Path]) -> None:
+    """Folded, every part is drawn in the model's texture (a GLB per part: its corners, their UVs,
+    the texture) instead of its pieces; while folding, and with the box unticked, the pieces in
+    the part colours are."""
+    viewer = serve(look_dirs["texture"], port=0)
+    try:
+        look = viewer.folder.look
+        assert len(viewer.look_nodes) == len(viewer.folder.parts) == 2 and not viewer.look_checkbox.disabled
+        for k, node in enumerate(viewer.look_nodes):
+            attrs, image = _glb_attributes(node.glb_data)
+            part = viewer.folder.parts[k]
+            corners = attrs["POSITION"][attrs["indices"]]
+            np.testing.assert_allclose(corners, viewer._to_view(part.vertices[part.faces]), rtol=0, atol=1e-6)
+            uv = attrs["TEXCOORD_0"][attrs["indices"]].astype(np.float64)
+            uv[..., 1] = 1.0 - uv[..., 1]  # glTF's v runs down
+            # a part whose UVs stay in [0, 1] gets only the piece of the texture it uses
+            inside = 0 <= look.part_uv(k).min() and look.part_uv(k).max() <= 1
+            assert image.shape[0] < look.image.shape[0] if inside else image.shape == look.image.shape
+            # the texel at every face's middle is the model's there
+            texels = _sample(look.image, look.part_uv(k).mean(axis=1))
+            np.testing.assert_array_equal(_sample(image, uv.mean(axis=1)), texels)
+            assert texels.std() > 10  # a texture, not one colour
+
+        def shown() -> tuple[list[bool], list[bool]]:
+            return [n.visible for n in viewer.look_nodes], [h.visible for _, h in viewer._fold_nodes]
+
+        assert shown() == ([True, True], [False, False])  # folded: the look
+        viewer.set_fold(0.5)
+        assert shown() == ([False, False], [True, True])  # folding: the pieces move in part colours
+        viewer.set_fold(1.0)
+        viewer.set_part(1)
+        assert shown() == ([False, True], [False] * len(viewer._fold_nodes))  # part 0 ghosted, part 1 in its look
+        assert viewer._part_nodes[0].visible and viewer._part_nodes[0].color == (190, 190, 190)
+        viewer.look_checkbox.value = False
+        assert shown() == ([False, False], [True])
+    finally:
+        viewer.stop()
+
+
+def test_the_viewer_shows_colours_and_works_without_a_look(look_dirs: dict[str, Path]) -> None:
+    viewer = serve(look_dirs["flat"], port=0)
+    try:
+        look = viewer.folder.look
+        for k, node in enumerate(viewer.look_nodes):
+            attrs, image = _glb_attributes(node.glb_data)
+            assert image is None
+            np.testing.assert_array_equal(attrs["COLOR_0"][attrs["indices"]], look.part_colors(k))
+        assert all(n.visible for n in viewer.look_nodes)
+    finally:
+        viewer.stop()
+    viewer = serve(look_dirs["none"], port=0)
+    try:
+        assert viewer.folder.look is None and viewer.look_nodes == [] and viewer.look_checkbox.disabled
+        assert all(h.visible for _, h in viewer._fold_nodes)  # the pieces in the part colours, as before
+    finally:
+        viewer.stop()
+
+
+@needs_chromium
+def test_the_texture_in_the_browser(look_dirs: dict[str, Path]) -> None:
+    """The page draws the parts' GLBs (no console errors) and the "Model's colours" box swaps them
+    for the part colours."""
+    from playwright.sync_api import sync_playwright
+
+    viewer = serve(look_dirs["texture"], port=0)
+    problems: list[str] = []
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+            try:
+                page = browser.new_page(viewport={"width": 1024, "height": 640})
+                page.on("console", lambda m: problems.append(f"console: {m.text}") if m.type == "error" else None)
+                page.on("pageerror", lambda e: problems.append(f"pageerror: {e}"))
+                page.goto(viewer.url)
+                page.wait_for_selector("canvas", timeout=30000)
+                canvas = page.locator("canvas").first
+                textured = _stable_shot(canvas)
+                page.get_by_text("Model's colours").click()
+                _until(lambda: viewer.look_checkbox.value is False, 10, "the box to be unticked")
+                plain = _stable_shot(canvas)
+                changed = (np.abs(textured - plain).max(axis=2) > 30).mean()
+                assert changed > 0.002, f"only {changed:.2%} of the canvas changed with the model's colours"
             finally:
                 browser.close()
     finally:

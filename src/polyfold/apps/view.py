@@ -1,11 +1,13 @@
 """The browser viewer behind `polyfold view` (issue 7), built on viser.
 
-In: an output folder of `polyfold make` (assembly.json, report.json, part-K.obj, piece-X.fold).
+In: an output folder of `polyfold make` (assembly.json, report.json, part-K.obj, piece-X.fold, and
+model.glb for a model with a texture or colours).
 Out: a local web page (viser serves its bundled client; nothing else is served, nothing is
 fetched) showing the model with its parts in colour, the flat nets of the chosen part, its
-folding animation along the verified path of every piece, an inflation panel (mode, pressure,
-stiffness ratio, steps; hyperbolic vertices in red, their count as "HV: N") and buttons that run
-`make` / export the inflated mesh into the folder.
+folding animation along the verified path of every piece (folded, the model is shown in the
+texture or colours of model.glb instead, issue 21: the "Model's colours" box), an inflation
+panel (mode, pressure, stiffness ratio, steps; hyperbolic vertices in red, their count as
+"HV: N") and buttons that run `make` / export the inflated mesh into the folder.
 
 Only its own page gets in: every request and websocket handshake must come with the right Host,
 Origin and session token (the printed URL's `?token=`, then a SameSite cookie), else 403 before
@@ -134,6 +136,20 @@ def _wait_until(done: Callable[[], bool], timeout: float) -> bool:
     return done()
 
 
+def _crop_texture(image: np.ndarray, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The part of a texture (H, W, C) that UVs (N, 2) use (v up; a pixel of margin), with the
+    UVs moved onto it, so that every part does not carry the whole picture to the browser. UVs
+    outside [0, 1] (a repeating texture) keep the whole picture."""
+    if not len(uv) or uv.min() < 0.0 or uv.max() > 1.0:
+        return image, uv
+    h, w = image.shape[:2]
+    px, py = uv[:, 0] * w, (1.0 - uv[:, 1]) * h  # pixel coordinates, rows from the top
+    x0, x1 = max(int(np.floor(px.min())) - 1, 0), min(int(np.ceil(px.max())) + 1, w)
+    y0, y1 = max(int(np.floor(py.min())) - 1, 0), min(int(np.ceil(py.max())) + 1, h)
+    moved = np.stack([(px - x0) / (x1 - x0), 1.0 - (py - y0) / (y1 - y0)], axis=1)
+    return image[y0:y1, x0:x1], moved
+
+
 class Viewer:
     """A running viewer: the viser server, its scene and GUI. Create with `serve`."""
 
@@ -157,6 +173,8 @@ class Viewer:
         self._part_nodes: list = []
         self._net_nodes: list = []
         self._fold_nodes: list = []  # (piece, mesh handle)
+        self.look_nodes: list = []  # per part, its faces in the model's look (GLB handles; none without one)
+        self._animated: set[int] = set()  # the parts whose pieces fold
         self._make_running = False
 
         self._set_view_frame(source)
@@ -209,6 +227,9 @@ class Viewer:
                                                   hint="The part whose pieces fold; the others are ghosted.")
             self.fold_slider = gui.add_slider("Fold", 0.0, 1.0, 0.01, 1.0, hint="0 = flat net, 1 = folded onto the model.")
             self.play_button = gui.add_button("Play", hint="Play the folding path from flat to folded.")
+            self.look_checkbox = gui.add_checkbox(
+                "Model's colours", True, hint="Folded, show the model in its texture / colours (model.glb) "
+                "instead of the part colours.")
             self.fold_info = gui.add_markdown("")
         with gui.add_folder("Inflation"):
             self.mode_dropdown = gui.add_dropdown("Mode", ["constrained", "uniform"], initial_value="constrained")
@@ -241,6 +262,7 @@ class Viewer:
         self.part_dropdown.on_update(lambda _: self._show_part())
         self.fold_slider.on_update(lambda _: self._pose())
         self.play_button.on_click(lambda _: self.toggle_play())
+        self.look_checkbox.on_update(lambda _: self._show_look())
         for h in (self.mode_dropdown, self.pressure_slider, self.stiffness_slider, self.steps_slider):
             h.on_update(lambda _: self._inflater.request())
         self.show_inflated.on_update(lambda _: self._show_inflated_visibility())
@@ -274,12 +296,41 @@ class Viewer:
                 self._part_nodes.append(self.server.scene.add_mesh_simple(
                     f"/model/part-{k}", self._to_view(part.vertices), part.faces.astype(np.uint32),
                     color=self._colors[k], flat_shading=True, side="double"))
+            for h in self.look_nodes:
+                h.remove()
+            self.look_nodes = []
+            if folder.look is not None:
+                for k in range(len(folder.parts)):
+                    self.look_nodes.append(self.server.scene.add_mesh_trimesh(
+                        f"/look/part-{k}", self.part_look_mesh(k), visible=False))
+            self.look_checkbox.disabled = folder.look is None
             options = [ALL_PARTS] + [self._part_label(k) for k in range(len(folder.parts))]
             self.part_dropdown.options = options
             verified = sum(p.verified for p in folder.pieces)
             self._title.content = (f"**{folder.model}**: {len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
                                    f"{verified}/{len(folder.pieces)} folding paths verified")
             self._show_part()
+
+    def part_look_mesh(self, k: int):
+        """Part k in the model's look (folder.look), in the view frame: a trimesh, every face with
+        corners of its own, with the texture and its UVs, or the colours per corner; a matte,
+        double-sided material (as paper)."""
+        import trimesh
+        from PIL import Image
+
+        part, look = self.folder.parts[k], self.folder.look
+        corners = self._to_view(part.vertices[part.faces].reshape(-1, 3))
+        tris = np.arange(len(corners)).reshape(-1, 3)
+        if look.textured:
+            image, uv = _crop_texture(look.image, look.part_uv(k).reshape(-1, 2))
+            material = trimesh.visual.material.PBRMaterial(
+                baseColorTexture=Image.fromarray(image), metallicFactor=0.0, roughnessFactor=1.0, doubleSided=True)
+            visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+        else:  # vertex colours (COLOR_0) under a white material: glTF's default one is metallic
+            material = trimesh.visual.material.PBRMaterial(metallicFactor=0.0, roughnessFactor=1.0, doubleSided=True)
+            visual = trimesh.visual.TextureVisuals(material=material)
+            visual.vertex_attributes["color"] = look.part_colors(k).reshape(-1, 4)
+        return trimesh.Trimesh(corners, tris, visual=visual, process=False)
 
     def _part_label(self, k: int) -> str:
         names = [p.name for p in self.folder.pieces if p.part == k]
@@ -300,6 +351,7 @@ class Viewer:
             self._net_nodes, self._fold_nodes = [], []
             chosen = self._chosen_part()
             parts = range(len(self.folder.parts)) if chosen is None else [chosen]
+            self._animated = set(parts)
             pieces = [p for p in self.folder.pieces if p.part in parts]
             for k, node in enumerate(self._part_nodes):
                 animated = k in parts
@@ -365,6 +417,21 @@ class Viewer:
             t = float(self.fold_slider.value)
             for piece, h in self._fold_nodes:
                 h.vertices = self._to_view(piece.pose(t).reshape(-1, 3))
+            self._show_look()
+
+    def _show_look(self) -> None:
+        """Folded (the slider at 1, or no piece of the part has a path to move along), an animated
+        part is shown in the model's look instead of its pieces in the part colour, when the
+        folder has a look and the "Model's colours" box is ticked."""
+        with self._lock:
+            on = bool(self.look_checkbox.value) and bool(self.look_nodes)
+            folded = float(self.fold_slider.value) >= 1.0
+            for k, node in enumerate(self.look_nodes):
+                mine = [(p, h) for p, h in self._fold_nodes if p.part == k]
+                shown = on and k in self._animated and (folded or not any(p.verified for p, _ in mine))
+                node.visible = shown
+                for _, h in mine:
+                    h.visible = not shown
 
     # ---- controls
 

@@ -29,6 +29,7 @@ from .paper import DPI
 from .pieces import SheetPiece
 
 BLEED_PX = 1.5
+MAX_PICTURE_PX = 60e6  # a larger picture (a page-sized piece at over 900 dpi) is rastered coarser: 180 MB is enough
 
 
 @njit(cache=True)
@@ -88,10 +89,11 @@ def _paint(out, level, tri, uv, colors, image, textured, bleed):
 
 
 def piece_image(piece: SheetPiece, look: Appearance, dpi: float = DPI) -> PageImage:
-    """The piece's faces as a picture at `dpi` (see the module docstring): its bounding box grown by
-    a pixel, clipped to its faces."""
+    """The piece's faces as a picture at `dpi` (see the module docstring; at most MAX_PICTURE_PX
+    pixels): its bounding box grown by a pixel, clipped to its faces."""
     xy = np.asarray(piece.faces_xy, dtype=np.float64)
-    per_mm = dpi / 25.4
+    extent = np.ptp(xy.reshape(-1, 2), axis=0)
+    per_mm = min(dpi / 25.4, math.sqrt(MAX_PICTURE_PX / max(float(extent[0] * extent[1]), 1e-9)))
     lo = xy.reshape(-1, 2).min(axis=0) - 1.0 / per_mm
     hi = xy.reshape(-1, 2).max(axis=0) + 1.0 / per_mm
     w, h = (int(math.ceil(v)) for v in (hi - lo) * per_mm)

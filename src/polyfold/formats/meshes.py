@@ -399,14 +399,19 @@ def look_glb(vertices: np.ndarray, faces: np.ndarray, look: Appearance) -> bytes
 
     corners = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)].reshape(-1, 3)
     tris = np.arange(len(corners)).reshape(-1, 3)
+    # paper: matte, not metal, seen from both sides; the texture as it is (factor white), where
+    # trimesh's default material would show it at 40 %
+    paper = dict(baseColorFactor=[255, 255, 255, 255], metallicFactor=0.0, roughnessFactor=1.0, doubleSided=True)
     if len(look.images) == 1 and look.textured.all():
-        visual = trimesh.visual.TextureVisuals(uv=look.uv.reshape(-1, 2),
-                                               image=Image.fromarray(look.images[0]))
+        material = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.fromarray(look.images[0]), **paper)
+        visual = trimesh.visual.TextureVisuals(uv=look.uv.reshape(-1, 2), material=material)
+        mesh = trimesh.Trimesh(corners, tris, visual=visual, process=False)
     else:
         rgb = look.colors if not look.textured.any() else np.repeat(look.mean_colors[:, None, :], 3, axis=1)
         rgba = np.concatenate([rgb.reshape(-1, 3), np.full((len(corners), 1), 255, np.uint8)], axis=1)
-        visual = trimesh.visual.ColorVisuals(vertex_colors=rgba)
-    return trimesh.Trimesh(corners, tris, visual=visual, process=False).export(file_type="glb")
+        mesh = trimesh.Trimesh(corners, tris, vertex_colors=rgba, process=False)
+    # (colours go without a material: trimesh, reading a GLB back, drops COLOR_0 beside one)
+    return mesh.export(file_type="glb")
 
 
 def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, *,

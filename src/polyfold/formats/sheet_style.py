@@ -54,7 +54,7 @@ TEXT_RGB = (0, 0, 0)
 # readable on dark textures: lines a HALO_MM wider white stroke under them, labels a white outline
 # HALO_TEXT em wide (half of it outside the glyphs).
 HALO_RGB = (255, 255, 255)
-HALO_MM = 0.35
+HALO_MM = 0.2
 HALO_TEXT = 0.18
 
 

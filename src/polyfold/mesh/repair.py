@@ -549,12 +549,19 @@ def repair(parsed: RawMesh, path: str) -> LoadedMesh:
         path=path,
         mesh=mesh,
         components=components,
-        warnings=tuple(parsed.warnings) + tuple(w.notes[k] for k in _NOTE_ORDER if k in w.notes),
+        warnings=tuple(parsed.warnings) + tuple(w.notes[k] for k in _NOTE_ORDER if k in w.notes
+                                                and not (k == "welded" and _seams(parsed))),
         manifold=n_split == 0,
         oriented=n_flipped == 0,
         n_input_faces=int(parsed.source.max()) + 1 if len(parsed.source) else 0,
         appearance=None if parsed.appearance is None else _carry_appearance(parsed, w),
     )
+
+
+def _seams(parsed: RawMesh) -> bool:
+    """Whether the file is textured: its vertices are split along UV seams, and welding them is
+    what every textured file needs, not worth a warning."""
+    return parsed.appearance is not None and bool(parsed.appearance.textured.any())
 
 
 def _carry_appearance(parsed: RawMesh, w: _Work) -> Appearance:
@@ -597,5 +604,16 @@ def describe(loaded: LoadedMesh) -> dict:
         "hyperbolic_vertices": int(n_hyperbolic),
         "concavity": float(concavity(mesh)),
         "bbox_diagonal": float(mesh.bbox_diagonal),
+        "look": _look_summary(loaded.appearance),
         "warnings": list(loaded.warnings),
     }
+
+
+def _look_summary(look: Appearance | None) -> str:
+    """What `make` can print of the file's look, in a few words."""
+    if look is None:
+        return "none"
+    if look.textured.any():
+        sizes = ", ".join(f"{im.shape[1]}x{im.shape[0]}" for im in look.images)
+        return f"texture ({sizes} px) on {int(look.textured.sum()):,} faces"
+    return "colours per vertex" if look.kind == "vertex" else "colours per face"

@@ -1,17 +1,18 @@
 """A `polyfold make` output folder, read back: `load_folder` -> `MakeFolder`.
 
-In: the folder (assembly.json, report.json, part-K.obj, piece-X.fold). Out: the parts as meshes,
-the whole model (the parts welded back together), and every piece ready to be posed along its
-folding path (`ViewPiece.pose`: face corners in the model frame at a fraction t of the path). The
-viewer draws it; tests and scripts use it without a browser. `make_folder` runs make, then reads
-the result.
+In: the folder (assembly.json, report.json, part-K.obj, piece-X.fold, and model.glb when the
+model has a texture or colours). Out: the parts as meshes, the whole model (the parts welded back
+together), the model's look matched to the parts' faces (`ModelLook`), and every piece ready to
+be posed along its folding path (`ViewPiece.pose`: face corners in the model frame at a fraction
+t of the path). The viewer draws it; tests and scripts use it without a browser. `make_folder`
+runs make, then reads the result.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
@@ -77,10 +78,40 @@ class ViewPiece:
 
 
 @dataclass(frozen=True, eq=False)
+class ModelLook:
+    """model.glb of a make folder: the model as made, in the look its sheets print.
+
+    corners (C, 3): the model's face corners as stored (float32; every face its own 3 corners, so
+    C = 3 x faces); either a texture, uv (C, 2) with image (H, W, 3 or 4) uint8, or colors (C, 4)
+    uint8 RGBA per corner; part_corners: per part, (F_k, 3) the row of `corners` of each corner of
+    the part's faces (in the part's face and corner order; `load_folder` matches them by position).
+    """
+
+    corners: np.ndarray
+    uv: np.ndarray | None
+    image: np.ndarray | None
+    colors: np.ndarray | None
+    part_corners: tuple[np.ndarray, ...] = ()
+
+    @property
+    def textured(self) -> bool:
+        return self.image is not None
+
+    def part_uv(self, k: int) -> np.ndarray | None:
+        """UVs (F_k, 3, 2) of part k's face corners; None without a texture."""
+        return None if self.uv is None else self.uv[self.part_corners[k]]
+
+    def part_colors(self, k: int) -> np.ndarray | None:
+        """RGBA (F_k, 3, 4) uint8 of part k's face corners; None for a texture."""
+        return None if self.colors is None else self.colors[self.part_corners[k]]
+
+
+@dataclass(frozen=True, eq=False)
 class MakeFolder:
     """A `polyfold make` output folder: parts (in part order), pieces (in assembly order), the
-    whole model (the parts welded back together), the model's file name and the make options of
-    report.json (None when there is no readable report)."""
+    whole model (the parts welded back together), the model's file name, the make options of
+    report.json (None when there is no readable report) and the model's look of model.glb (None
+    when the folder has none: a model without texture or colours, or made with --color none)."""
 
     path: Path
     model: str
@@ -88,6 +119,7 @@ class MakeFolder:
     pieces: tuple[ViewPiece, ...]
     whole: Mesh
     options: MakeOptions | None
+    look: ModelLook | None = None
 
 
 def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
@@ -200,6 +232,85 @@ def _read_options(root: Path) -> MakeOptions | None:
         return None
 
 
+def read_look(path: str | Path) -> ModelLook:
+    """The look of a model.glb (see `ModelLook`; part_corners left empty): one mesh with a base
+    colour texture and UVs, or with vertex (or face) colours. PolyfoldError (one line, naming the
+    file) when it cannot be read or has neither."""
+    import trimesh
+
+    path = Path(path)
+    try:
+        mesh = trimesh.load(str(path), file_type="glb", force="mesh", process=False)
+        corners = np.asarray(mesh.vertices, dtype=np.float32)[np.asarray(mesh.faces, dtype=np.int64)].reshape(-1, 3)
+        visual = mesh.visual
+        uv = image = colors = None
+        if getattr(visual, "kind", None) == "texture":
+            material = visual.material
+            picture = getattr(material, "baseColorTexture", None)
+            if picture is None:
+                picture = getattr(material, "image", None)
+            if picture is None or visual.uv is None:
+                raise ValueError("a texture visual without image or UVs")
+            image = np.asarray(picture.convert("RGBA" if "A" in picture.mode else "RGB"), dtype=np.uint8)
+            uv = np.asarray(visual.uv, dtype=np.float64)[mesh.faces].reshape(-1, 2)
+        elif getattr(visual, "kind", None) == "vertex":
+            colors = np.asarray(visual.vertex_colors, dtype=np.uint8)[mesh.faces].reshape(-1, 4)
+        elif getattr(visual, "kind", None) == "face":
+            colors = np.repeat(np.asarray(visual.face_colors, dtype=np.uint8), 3, axis=0)
+        else:
+            raise ValueError("neither a texture nor colours")
+    except Exception as exc:  # trimesh raises many kinds on a broken file
+        raise PolyfoldError(f"{path}: not a readable model look ({type(exc).__name__}: {_first_line(exc)})") from None
+    if not len(corners) or not np.isfinite(corners).all() or (uv is not None and not np.isfinite(uv).all()):
+        raise PolyfoldError(f"{path}: not a readable model look (no faces, or a non-finite coordinate)")
+    return ModelLook(corners=corners, uv=uv, image=image, colors=colors)
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else "no message"
+
+
+def match_corners(corners: np.ndarray, mine: np.ndarray) -> np.ndarray | None:
+    """For every face corner of `mine` (F, 3, 3), the row of `corners` (C, 3; 3 corners a face,
+    face after face) at its position, in the face at its place: (F, 3). Faces are matched by their
+    centroids (the nearest few, KD-tree), corners within a face by position; positions agree up
+    to float32 rounding (model.glb stores float32). None when some face has no counterpart."""
+    from scipy.spatial import cKDTree
+
+    model = np.asarray(corners, dtype=np.float64).reshape(-1, 3, 3)
+    mine = np.asarray(mine, dtype=np.float64).reshape(-1, 3, 3)
+    if not len(mine):
+        return np.zeros((0, 3), dtype=np.int64)
+    tol = 1e-6 * max(float(np.abs(model).max()), float(np.abs(mine).max()), 1e-30)
+    k = min(3, len(model))  # a few nearest centroids: distinct faces may share one
+    _, near = cKDTree(model.mean(axis=1)).query(mine.mean(axis=1), k=k)
+    near = np.asarray(near).reshape(len(mine), k)
+    # (F, k candidates, 3 mine, 3 theirs): how far each of my corners is from each of theirs
+    gap = np.abs(mine[:, None, :, None, :] - model[near][:, :, None, :, :]).max(axis=4)
+    which = gap.argmin(axis=3)
+    fits = (np.take_along_axis(gap, which[..., None], axis=3)[..., 0] <= tol).all(axis=2)
+    fits &= (np.sort(which, axis=2) == np.arange(3)).all(axis=2)  # each of theirs used once
+    if not fits.any(axis=1).all():
+        return None
+    pick = fits.argmax(axis=1)
+    face, which = near[np.arange(len(mine)), pick], which[np.arange(len(mine)), pick]
+    return 3 * face[:, None] + which
+
+
+def _read_look(root: Path, parts: list[Mesh]) -> ModelLook | None:
+    """model.glb matched to the parts' faces; None when the folder has no model.glb."""
+    path = root / "model.glb"
+    if not path.is_file():
+        return None
+    look = read_look(path)
+    rows = match_corners(look.corners, np.concatenate([p.vertices[p.faces] for p in parts]))
+    if rows is None:
+        raise PolyfoldError(f"{path}: not the model of the parts (a face of a part-K.obj is not in it)")
+    ends = np.cumsum([p.n_faces for p in parts])[:-1]
+    return replace(look, part_corners=tuple(np.split(rows, ends)))
+
+
 def load_folder(path: str | Path) -> MakeFolder:
     """Read a `polyfold make` output folder. Raises PolyfoldError (one line) when it is not one."""
     root = Path(path)
@@ -225,7 +336,7 @@ def load_folder(path: str | Path) -> MakeFolder:
         except (ValueError, TypeError, KeyError, IndexError) as exc:  # malformed values in the JSON
             raise PolyfoldError(f"{row.fold}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
     return MakeFolder(path=root, model=assembly.model or root.name, parts=tuple(parts), pieces=tuple(pieces),
-                      whole=weld_parts(parts), options=_read_options(root))
+                      whole=weld_parts(parts), options=_read_options(root), look=_read_look(root, parts))
 
 
 def make_folder(source: str | Path | Mesh | LoadedMesh, out_dir: str | Path, opts: MakeOptions | None = None,
