@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from .appearance import Appearance
+from .closest import closest_points
 from .geometry import face_areas
 from .mesh import Mesh
 
@@ -28,71 +29,6 @@ MAX_ATLAS_TEXELS = 4096 * 4096  # the baked texture's area at most (the old dens
 MIN_FACE_TEXELS = 12  # the longest side of a new face in the atlas at least (texels)
 PAD = 2  # texels around every face in the atlas (bleed for bilinear samples at its edges)
 BACKFACE_PENALTY = 1e3  # x the model size: a closest point on a face turned away loses to any other
-
-
-@njit(cache=True)
-def _closest_on_triangle(px, py, pz, t):
-    """Barycentric coordinates (u, v, w) of the point of triangle t (3, 3) closest to p (Ericson,
-    Real-Time Collision Detection 5.1.5); scalars only (this runs for every texel)."""
-    ax, ay, az = t[0, 0], t[0, 1], t[0, 2]
-    abx, aby, abz = t[1, 0] - ax, t[1, 1] - ay, t[1, 2] - az
-    acx, acy, acz = t[2, 0] - ax, t[2, 1] - ay, t[2, 2] - az
-    apx, apy, apz = px - ax, py - ay, pz - az
-    d1 = abx * apx + aby * apy + abz * apz
-    d2 = acx * apx + acy * apy + acz * apz
-    if d1 <= 0.0 and d2 <= 0.0:
-        return 1.0, 0.0, 0.0
-    bpx, bpy, bpz = px - t[1, 0], py - t[1, 1], pz - t[1, 2]
-    d3 = abx * bpx + aby * bpy + abz * bpz
-    d4 = acx * bpx + acy * bpy + acz * bpz
-    if d3 >= 0.0 and d4 <= d3:
-        return 0.0, 1.0, 0.0
-    vc = d1 * d4 - d3 * d2
-    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        v = d1 / (d1 - d3)
-        return 1.0 - v, v, 0.0
-    cpx, cpy, cpz = px - t[2, 0], py - t[2, 1], pz - t[2, 2]
-    d5 = abx * cpx + aby * cpy + abz * cpz
-    d6 = acx * cpx + acy * cpy + acz * cpz
-    if d6 >= 0.0 and d5 <= d6:
-        return 0.0, 0.0, 1.0
-    vb = d5 * d2 - d1 * d6
-    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        w = d2 / (d2 - d6)
-        return 1.0 - w, 0.0, w
-    va = d3 * d6 - d5 * d4
-    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-        return 0.0, 1.0 - w, w
-    den = va + vb + vc
-    if den == 0.0:
-        return 1.0, 0.0, 0.0
-    v, w = vb / den, vc / den
-    return 1.0 - v - w, v, w
-
-
-@njit(cache=True)
-def closest_points(points, normals, candidates, tri, tri_normals, penalty, face, bary):
-    """For every point (N, 3) the old face (of `candidates` (N, k) into tri (M, 3, 3)) holding its
-    closest point and that point's barycentric coordinates, into face (N,) and bary (N, 3).
-    Candidates whose normal (tri_normals) points against the point's `normals` (N, 3) get
-    `penalty` added to their distance."""
-    for i in range(points.shape[0]):
-        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
-        best = np.inf
-        for j in range(candidates.shape[1]):
-            f = candidates[i, j]
-            u, v, w = _closest_on_triangle(px, py, pz, tri[f])
-            dx = u * tri[f, 0, 0] + v * tri[f, 1, 0] + w * tri[f, 2, 0] - px
-            dy = u * tri[f, 0, 1] + v * tri[f, 1, 1] + w * tri[f, 2, 1] - py
-            dz = u * tri[f, 0, 2] + v * tri[f, 1, 2] + w * tri[f, 2, 2] - pz
-            d = math.sqrt(dx * dx + dy * dy + dz * dz)
-            if tri_normals[f, 0] * normals[i, 0] + tri_normals[f, 1] * normals[i, 1] + tri_normals[f, 2] * normals[i, 2] < 0.0:
-                d += penalty
-            if d < best:
-                best = d
-                face[i] = f
-                bary[i, 0], bary[i, 1], bary[i, 2] = u, v, w
 
 
 @njit(cache=True)
