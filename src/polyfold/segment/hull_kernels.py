@@ -15,6 +15,7 @@ from numba import njit
 
 NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex
 HULL_FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
+MAX_HULL_EPS = 1e-6  # relative: the largest tolerance `convex_hull` retries an inconsistent hull at
 DENSE_EDGES = 1024  # convex_hull counts facets per directed edge in an n x n table up to this many points
 
 
@@ -43,7 +44,35 @@ def copy_row(dst, i, src, j):
 
 
 @njit(cache=True)
+def _compact(F, E, alive, nf):
+    """Move the live facets among the first nf to the front, in order: their number."""
+    m = 0
+    for f in range(nf):
+        if alive[f]:
+            F[m, 0], F[m, 1], F[m, 2] = F[f, 0], F[f, 1], F[f, 2]
+            E[m, 0], E[m, 1], E[m, 2], E[m, 3] = E[f, 0], E[f, 1], E[f, 2], E[f, 3]
+            alive[m] = True
+            m += 1
+    return m
+
+
+@njit(cache=True)
 def convex_hull(p, rel_eps):
+    """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)); see
+    `_hull_at`. A hull that does not close up as a convex polytope (2 V - 4 facets), which nearly
+    coplanar points can make at rel_eps (the flat sides of a subdivided mesh: 24 vertices and 129
+    facets where qhull has 16 and 28), is made again with a tolerance 100 times larger, up to
+    MAX_HULL_EPS."""
+    v, e = _hull_at(p, rel_eps)
+    r = rel_eps
+    while e.shape[0] > 0 and e.shape[0] != 2 * v.shape[0] - 4 and r < MAX_HULL_EPS:
+        r *= 100.0
+        v, e = _hull_at(p, r)
+    return v, e
+
+
+@njit(cache=True)
+def _hull_at(p, rel_eps):
     """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)).
 
     Facet planes are unit outward normals with offsets, n.x + d <= 0 inside (qhull's convention).
@@ -116,7 +145,7 @@ def convex_hull(p, rel_eps):
         nf += 1
     vis = np.zeros(cap, dtype=np.bool_)
     vl = np.empty(cap, dtype=np.int64)
-    hor = np.empty((cap, 2), dtype=np.int64)
+    hor = np.empty((3 * cap, 2), dtype=np.int64)  # every edge of every visible facet at most
     n_live, nf_kept = nf, nf
     dense = n <= DENSE_EDGES
     on = np.zeros(n * n if dense else 1, dtype=np.int32)  # live facets having directed edge a->b (a * n + b)
@@ -169,6 +198,10 @@ def convex_hull(p, rel_eps):
                     e = F[vl[q], k] * n + F[vl[q], (k + 1) % 3]
                     seen[e] -= 1
                     on[e] -= 1
+        if nf + nh > cap:  # nearly coplanar points can make the visible region odd: room first
+            nf = _compact(F, E, alive, nf)
+            if nf + nh > cap:
+                return empty_v, empty_e
         for h in range(nh):
             a, b = hor[h, 0], hor[h, 1]
             F[nf, 0], F[nf, 1], F[nf, 2] = a, b, i
@@ -188,14 +221,7 @@ def convex_hull(p, rel_eps):
         if nf_kept > 2 * n + 64:
             nf_kept = n_live
         if nf > 2 * n_live:
-            m = 0
-            for f in range(nf):
-                if alive[f]:
-                    F[m, 0], F[m, 1], F[m, 2] = F[f, 0], F[f, 1], F[f, 2]
-                    E[m, 0], E[m, 1], E[m, 2], E[m, 3] = E[f, 0], E[f, 1], E[f, 2], E[f, 3]
-                    alive[m] = True
-                    m += 1
-            nf = m
+            nf = _compact(F, E, alive, nf)
     used = np.zeros(n, dtype=np.bool_)
     m = 0
     for f in range(nf):
