@@ -101,25 +101,30 @@ def surface_distances(points: np.ndarray, vertices: np.ndarray, faces: np.ndarra
     """(N,) the exact distance from every point (N, 3) to the surface (vertices, faces): first
     the `nearest` triangles by centroid (scipy's KD-tree); a point for which a farther triangle
     could still be closer (its centroid within that distance plus the largest bounding radius)
-    is then checked against every triangle, pruned by bounding spheres."""
+    is measured again against 8 times as many, and one still unsure against every triangle,
+    pruned by bounding spheres."""
     from scipy.spatial import cKDTree
 
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
     tri = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64)[np.asarray(faces)])
     centre = tri.mean(axis=1)
     radius = np.linalg.norm(tri - centre[:, None], axis=2).max(axis=1)
-    k = min(nearest, len(tri))
-    reach, near = cKDTree(centre).query(points, k=k, workers=-1)
-    near = np.ascontiguousarray(near.reshape(len(points), k), dtype=np.int64)
-    face = np.zeros(len(points), dtype=np.int64)
-    bary = np.zeros((len(points), 3))
-    normals = np.zeros((len(points), 3))
-    closest_points(points, normals, near, tri, np.zeros((len(tri), 3)), 0.0, face, bary)
-    q = np.einsum("nk,nkc->nc", bary, tri[face])
-    best = np.linalg.norm(q - points, axis=1)
-    unsure = np.flatnonzero(reach.reshape(len(points), k)[:, -1] - radius.max() < best)
-    if len(unsure) and k < len(tri):
-        sub = best[unsure].copy()
-        _distances_pruned(points[unsure], tri, centre, radius, sub)
-        best[unsure] = sub
+    tree = cKDTree(centre)
+    best = np.full(len(points), np.inf)
+    todo = np.arange(len(points))
+    for k in (min(nearest, len(tri)), min(8 * nearest, len(tri))):  # then more of the nearest, for the few unsure
+        reach, near = tree.query(points[todo], k=k, workers=-1)
+        near = np.ascontiguousarray(near.reshape(len(todo), k), dtype=np.int64)
+        face = np.zeros(len(todo), dtype=np.int64)
+        bary = np.zeros((len(todo), 3))
+        closest_points(points[todo], np.zeros((len(todo), 3)), near, tri, np.zeros((len(tri), 3)), 0.0, face, bary)
+        best[todo] = np.linalg.norm(np.einsum("nk,nkc->nc", bary, tri[face]) - points[todo], axis=1)
+        if k == len(tri):
+            return best
+        todo = todo[reach.reshape(len(todo), k)[:, -1] - radius.max() < best[todo]]
+        if not len(todo):
+            return best
+    sub = best[todo].copy()
+    _distances_pruned(points[todo], tri, centre, radius, sub)
+    best[todo] = sub
     return best
