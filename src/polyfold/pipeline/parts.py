@@ -3,7 +3,8 @@
 `make_parts` is make's segment + unfold stage: with `--tau` / `--parts` the mesh is segmented
 first; with `--segment auto` every connected component stays whole when it has a single-piece net
 (found within its share of half the time limit) and is segmented otherwise (past the searches'
-deadline: unfolded into pieces as it is). `unfold_components`
+deadline, or when segmenting it would not fit in their time left (SEGMENT_S_PER_FACE): unfolded
+into pieces as it is). `unfold_components`
 is the `unfold` command's: every component unfolded in its share of the time left.
 """
 
@@ -27,6 +28,10 @@ from .report import NetReport, SegmentReport, UnfoldReport
 
 MIN_UNFOLD_S = 0.5  # the least time a part's search gets, however little is left
 TAB_ROOM_S = 5.0  # the most time a part's net spends opening notches for tabs (`open_notches`)
+# segmenting is one kernel run the time limit cannot stop, of about this much a face and more on
+# big meshes (22k faces: 19 s; a 93,696-face subdivided Spot: minutes): a component is only
+# segmented when that fits in the searches' time left, else unfolded into pieces as it is
+SEGMENT_S_PER_FACE = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,7 +107,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
         except NoNetFound:
             # auto: no single net for this component in time -> split it into nearly convex parts
             unfold_s += time.perf_counter() - tu
-            if deadline.expired():
+            if deadline.expired() or len(faces) * SEGMENT_S_PER_FACE > deadline.left():
                 say("segment", f"no single net for a {len(faces)}-face component, and no time left to segment it: "
                                "unfolding it into pieces")
                 subs = [faces]
