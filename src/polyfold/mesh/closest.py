@@ -30,7 +30,7 @@ def _closest_on_triangle(px, py, pz, t):
         return 0.0, 1.0, 0.0
     vc = d1 * d4 - d3 * d2
     if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        v = d1 / (d1 - d3)
+        v = d1 / (d1 - d3) if d1 != d3 else 0.0  # (equal only on a degenerate triangle)
         return 1.0 - v, v, 0.0
     cpx, cpy, cpz = px - t[2, 0], py - t[2, 1], pz - t[2, 2]
     d5 = abx * cpx + aby * cpy + abz * cpz
@@ -39,11 +39,11 @@ def _closest_on_triangle(px, py, pz, t):
         return 0.0, 0.0, 1.0
     vb = d5 * d2 - d1 * d6
     if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        w = d2 / (d2 - d6)
+        w = d2 / (d2 - d6) if d2 != d6 else 0.0
         return 1.0 - w, 0.0, w
     va = d3 * d6 - d5 * d4
     if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6)) if (d4 - d3) + (d5 - d6) > 0.0 else 0.0
         return 0.0, 1.0 - w, w
     den = va + vb + vc
     if den == 0.0:
