@@ -26,7 +26,6 @@ class Material:
 
     kd: tuple[float, float, float] = (1.0, 1.0, 1.0)
     image: np.ndarray | None = None
-    image_name: str = ""
 
 
 @dataclass
@@ -124,7 +123,7 @@ def read_mtl(path: str, looks: Looks, images: dict[str, np.ndarray | None]) -> d
             full = os.path.join(os.path.dirname(path), file.replace("\\", os.sep))
             if full not in images:
                 images[full] = read_image(full, looks, "texture")
-            cur.image, cur.image_name = images[full], file
+            cur.image = images[full]
     return materials
 
 

@@ -57,7 +57,7 @@ class Appearance:
         """(F,) bool: faces printed from a texture."""
         return self.face_image >= 0
 
-    @property
+    @cached_property
     def shaded(self) -> np.ndarray:
         """(F,) bool: faces whose colour varies across them (a texture, or corners that differ):
         printed as a picture rather than one fill colour."""

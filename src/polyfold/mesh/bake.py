@@ -32,10 +32,13 @@ BACKFACE_PENALTY = 1e3  # x the model size: a closest point on a face turned awa
 
 
 @njit(cache=True)
-def atlas_texels(tri, owner, bary, pad):
-    """Which face's triangle (tri (n, 3, 2), atlas pixel coordinates) covers each texel centre,
-    into owner (H, W) (-1: none) and bary (H, W, 3) its barycentric coordinates; texels up to
-    `pad` px outside a triangle (in its cell) take the nearest point of it."""
+def cover_triangles(tri, owner, bary, pad):
+    """Which triangle (tri (n, 3, 2), pixel coordinates, x right, y down) covers each pixel centre
+    of an image, into owner (H, W) (-1: none; pass it filled with -1) and bary (H, W, 3) the
+    barycentric coordinates there. A pixel up to `pad` px outside every triangle that covers it
+    takes the nearest point of the first triangle that reaches it (the bleed that keeps bilinear
+    samples and clipped edges free of background); a covering triangle always wins over a bleed.
+    The one rasteriser of the baked atlas (`bake`) and of the printed pictures (`fabricate.paint`)."""
     H, W = owner.shape
     for t in range(tri.shape[0]):
         ax, ay = tri[t, 0, 0], tri[t, 0, 1]
@@ -144,7 +147,7 @@ def bake(old: Mesh, look: Appearance, new: Mesh) -> Appearance:
     W = int(math.ceil(float(px[..., 0].max()))) + 2 * PAD
     owner = np.full((H, W), -1, dtype=np.int64)
     bary = np.zeros((H, W, 3))
-    atlas_texels(np.ascontiguousarray(px), owner, bary, float(PAD))
+    cover_triangles(np.ascontiguousarray(px), owner, bary, float(PAD))
     atlas = np.full((H, W, 3), 255, dtype=np.uint8)
     ys, xs = np.nonzero(owner >= 0)
     f = owner[ys, xs]
