@@ -216,6 +216,23 @@ def test_viewer_in_browser(make_dir: Path) -> None:
                 changed = (np.abs(flat - folded).max(axis=2) > 30).mean()
                 assert changed > 0.005, f"only {changed:.2%} of the canvas changed between flat and folded"
 
+                # the build steps: step 1 shows one piece, the last the whole model; back to folding at 0
+                steps = _slider(page, "Step")
+                steps.press("Home")
+                steps.press("ArrowRight")
+                _until(lambda: viewer.step_slider.value == 1, 10, "the step slider at 1")
+                page.get_by_text(re.compile(r"Step 1/\d+")).wait_for(timeout=10000)
+                first = _stable_shot(canvas)
+                steps.press("End")
+                _until(lambda: viewer.step_slider.value == len(viewer.folder.steps), 10, "the last step")
+                last = _stable_shot(canvas)
+                assert sum(h.visible for h in viewer._build_nodes) == len(viewer.folder.pieces)
+                changed = (np.abs(first - last).max(axis=2) > 30).mean()
+                assert changed > 0.005, f"only {changed:.2%} of the canvas changed between the first and last step"
+                steps.press("Home")
+                _until(lambda: viewer.step_slider.value == 0, 10, "the step slider at 0")
+                _until(lambda: not any(h.visible for h in viewer._build_nodes), 10, "the folding view back")
+
                 # play, then pause half way: the slider moves on its own and stops where paused
                 page.get_by_role("button", name="Play").click()
                 _until(lambda: 0.0 < viewer.fold_slider.value < 0.9, 10, "the animation to start")

@@ -54,7 +54,8 @@ def test_parts_are_glued_across(models_dir, tmp_path):
     assert between and all(len(set(g["pieces"])) == 2 for g in between)
     assert report["checks"]["paths_verified"] == len(report["pieces"])
     html = (out / "instructions.html").read_text()
-    assert "Joining the parts" in html and html.count("<h2>Part ") == 7
+    seams = html[html.index("id='seams'"):]
+    assert "Joining the parts" in seams and seams.count("<h3>Part ") == 7
 
 
 def test_unsegmented_bunny_is_one_piece_on_large_paper(models_dir, tmp_path):

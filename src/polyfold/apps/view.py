@@ -173,6 +173,7 @@ class Viewer:
         self._part_nodes: list = []
         self._net_nodes: list = []
         self._fold_nodes: list = []  # (piece, mesh handle)
+        self._build_nodes: list = []  # per piece, folded in place, for the build steps
         self.look_nodes: list = []  # per part, its faces in the model's look (GLB handles; none without one)
         self._animated: set[int] = set()  # the parts whose pieces fold
         self._make_running = False
@@ -231,6 +232,11 @@ class Viewer:
                 "Model's colours", True, hint="Folded, show the model in its texture / colours (model.glb) "
                 "instead of the part colours.")
             self.fold_info = gui.add_markdown("")
+        with gui.add_folder("Build steps"):
+            self.step_slider = gui.add_slider(
+                "Step", 0, 1, 1, 0, hint="The assembly guide's steps (guide.pdf): the model part-built, the new "
+                "piece in full colour. 0 = off.")
+            self.step_info = gui.add_markdown("")
         with gui.add_folder("Inflation"):
             self.mode_dropdown = gui.add_dropdown("Mode", ["constrained", "uniform"], initial_value="constrained")
             self.pressure_slider = gui.add_slider("Pressure", 0.1, 1.0, 0.05, 0.5)
@@ -259,8 +265,9 @@ class Viewer:
 
     def _connect(self) -> None:
         """The callbacks of the controls."""
-        self.part_dropdown.on_update(lambda _: self._show_part())
-        self.fold_slider.on_update(lambda _: self._pose())
+        self.part_dropdown.on_update(lambda _: self._leave_steps() or self._show_part())
+        self.fold_slider.on_update(lambda _: self._leave_steps() or self._pose())
+        self.step_slider.on_update(lambda _: self._show_step())
         self.play_button.on_click(lambda _: self.toggle_play())
         self.look_checkbox.on_update(lambda _: self._show_look())
         for h in (self.mode_dropdown, self.pressure_slider, self.stiffness_slider, self.steps_slider):
@@ -304,12 +311,36 @@ class Viewer:
                     self.look_nodes.append(self.server.scene.add_mesh_trimesh(
                         f"/look/part-{k}", self.part_look_mesh(k), visible=False))
             self.look_checkbox.disabled = folder.look is None
+            self._add_build_nodes()
             options = [ALL_PARTS] + [self._part_label(k) for k in range(len(folder.parts))]
             self.part_dropdown.options = options
             verified = sum(p.verified for p in folder.pieces)
             self._title.content = (f"**{folder.model}**: {len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
                                    f"{verified}/{len(folder.pieces)} folding paths verified")
             self._show_part()
+
+    def _add_build_nodes(self) -> None:
+        """Every piece folded in place (hidden until a build step is picked), in the guide's piece
+        colours; the step slider's range."""
+        from ..guide.pictures import piece_palette
+
+        for h in self._build_nodes:
+            h.remove()
+        pieces = self.folder.pieces
+        self._piece_colors = piece_palette(len(pieces))
+        self._build_nodes = []
+        for i, piece in enumerate(pieces):
+            corners = self._to_view(piece.pose(1.0).reshape(-1, 3))
+            self._build_nodes.append(self.server.scene.add_mesh_simple(
+                f"/build/piece-{i}", corners, np.arange(len(corners), dtype=np.uint32).reshape(-1, 3),
+                color=tuple(int(c) for c in self._piece_colors[i]), flat_shading=True, side="double",
+                visible=False))
+        n = len(self.folder.steps)
+        self.step_slider.value = 0
+        self.step_slider.max = max(1, n)
+        self.step_slider.disabled = n == 0
+        self.step_info.content = (f"{n} steps (as in guide.pdf)" if n else
+                                  "no build steps in this folder (made with --no-guide?)")
 
     def part_look_mesh(self, k: int):
         """Part k in the model's look (folder.look), in the view frame: a trimesh, every face with
@@ -433,7 +464,53 @@ class Viewer:
                 for _, h in mine:
                     h.visible = not shown
 
+    def _leave_steps(self) -> None:
+        """Back from a build step to the folding view (moving the fold slider or picking a part)."""
+        if int(self.step_slider.value) != 0:
+            self.step_slider.value = 0
+
+    def _show_step(self) -> None:
+        """The model after build step k of the slider (0: the folding view): the pieces placed so
+        far folded in place, the step's new piece (or, gluing on, the pieces it glues) in full
+        colour, the rest lighter; everything else hidden."""
+        from ..guide.pictures import lighter
+
+        with self._lock:
+            k = int(self.step_slider.value)
+            steps = self.folder.steps
+            if k <= 0 or not steps:
+                for h in self._build_nodes:
+                    h.visible = False
+                self._show_part()
+                return
+            k = min(k, len(steps))
+            step = steps[k - 1]
+            placed = set(self.folder.placed_after(k))
+            names = [p.name for p in self.folder.pieces]
+            if step.piece in names:
+                new = {names.index(step.piece)}
+            else:  # gluing on: the pieces of its seams (the last placed and those it glues to)
+                new = {names.index(n) for n in step.attach_to if n in names}
+                if step.kind == "glue" and self.folder.placed_after(k):
+                    new.add(self.folder.placed_after(k)[-1])
+            for node in (*self._part_nodes, *self.look_nodes, *self._net_nodes, *(h for _, h in self._fold_nodes)):
+                node.visible = False
+            for i, h in enumerate(self._build_nodes):
+                h.visible = i in placed
+                rgb = self._piece_colors[i] if i in new else lighter(self._piece_colors[i], 0.6)
+                h.color = tuple(int(c) for c in rgb)
+            what = {"piece": f"fold and attach piece **{step.piece}**", "glue": "glue on",
+                    "join": f"join part {step.part + 1} to the model"}.get(step.kind, step.kind)
+            sheets = f" (sheet {', '.join(map(str, step.sheets))})" if step.sheets else ""
+            self.step_info.content = (f"**Step {k}/{len(steps)}**: {what}{sheets}  \n"
+                                      f"glue: {', '.join(step.labels) or 'nothing'}"
+                                      + (f"  \nto: {', '.join(step.attach_to)}" if step.attach_to else ""))
+
     # ---- controls
+
+    def set_step(self, k: int) -> None:
+        """Show build step k (0: the folding view), as the step slider does."""
+        self.step_slider.value = int(min(max(0, k), max(1, len(self.folder.steps))))
 
     def set_part(self, part: int | None) -> None:
         """Pick a part (None: all parts), as the dropdown does."""

@@ -54,6 +54,19 @@ class FoldPath:
         return rho_to_fold_deg(self.frames).tolist()
 
 
+def path_at(frames: np.ndarray, t: float) -> np.ndarray:
+    """The configuration (E,) at fraction t of a path (K, E) (any angle unit): linear between
+    consecutive frames, every segment the same share of t (t clamped to 0..1)."""
+    frames = np.asarray(frames, dtype=np.float64)
+    t = min(1.0, max(0.0, float(t)))
+    if len(frames) == 1:
+        return frames[0].copy()
+    s = t * (len(frames) - 1)
+    i = min(int(math.floor(s)), len(frames) - 2)
+    u = s - i
+    return (1.0 - u) * frames[i] + u * frames[i + 1]
+
+
 @dataclass(frozen=True)
 class PlannerSettings:
     """What a planner may use besides the tree, the checker and the deadline: the seed of its own

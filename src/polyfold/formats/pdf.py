@@ -4,9 +4,10 @@ drawn like the print SVG (preview fills, creases, cut lines, labels, the scale b
 
 from __future__ import annotations
 
+import contextlib
 import io as _io
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -174,6 +175,21 @@ def _draw_pdf_page(c, page: Page) -> None:
     _draw_furniture(c, page)
 
 
+@contextlib.contextmanager
+def binary_streams() -> Iterator[None]:
+    """reportlab writes its streams without the ASCII85 filter while this is on (restored after):
+    that filter is pure Python here, a third of the time of a PDF full of pictures, and a quarter
+    bigger."""
+    from reportlab import rl_config
+
+    old = rl_config.useA85
+    rl_config.useA85 = 0
+    try:
+        yield
+    finally:
+        rl_config.useA85 = old
+
+
 def pdf_bytes(pages: Sequence[Page], title: str = "polyfold net") -> bytes:
     """The PDF document (bytes): one PDF page per Page, each exactly its own mm size."""
     from reportlab.pdfgen.canvas import Canvas  # lazy: reportlab is slow to import
@@ -185,11 +201,12 @@ def pdf_bytes(pages: Sequence[Page], title: str = "polyfold net") -> bytes:
     c = Canvas(buf, pagesize=(pages[0].width * MM_TO_PT, pages[0].height * MM_TO_PT), invariant=1)
     c.setTitle(title)
     c.setCreator("polyfold")
-    for page in pages:
-        c.setPageSize((page.width * MM_TO_PT, page.height * MM_TO_PT))
-        _draw_pdf_page(c, page)
-        c.showPage()
-    c.save()
+    with binary_streams():
+        for page in pages:
+            c.setPageSize((page.width * MM_TO_PT, page.height * MM_TO_PT))
+            _draw_pdf_page(c, page)
+            c.showPage()
+        c.save()
     return buf.getvalue()
 
 

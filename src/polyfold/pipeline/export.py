@@ -5,7 +5,9 @@ The folder: sheets.pdf (all pages), sheet-NN.svg (print), cut-NN.svg (cutting ma
 score lines only) and sheet-NN.dxf per page, part-K.obj per part, model.glb (the model as made in
 the look the sheets print; only for a model with a texture or colours), piece-X.fold per piece (net,
 folding path, source faces; in mm where it is printed, with its page and sheet transform:
-`formats.fold.piece_fold`), assembly.json, instructions.html and report.json. Every printed page
+`formats.fold.piece_fold`), assembly.json (with the build steps), instructions.html, guide.pdf
+(the assembly guide, `guide.guide`, as pages of the sheets' size; not with --no-guide) and
+report.json. Every printed page
 has a scale bar in its footer; with --marks, registration marks. Files an earlier run wrote that
 this run does not produce are removed (they would be mistaken for this run's); no other file is
 touched, and the input mesh is never replaced (`formats.files.StagedFolder`).
@@ -33,15 +35,16 @@ from ..mesh.mesh import Mesh
 from ..unfold.net import Net
 from ..unfold.pattern import CreasePattern
 from .folding import FoldedPiece
-from .instructions import instructions_html
+from .instructions import guide_intro, instructions_html
 from .options import MakeOptions
 from .parts import Part
-from .report import Assembly, AssemblyPart, AssemblyPiece, GlueRow, MakeReport, PieceReport
+from .report import (Assembly, AssemblyPart, AssemblyPiece, AssemblyStep, GlueRow, GuideReport, MakeReport,
+                     PieceReport)
 from .sheets import Sheets, pack_box
 
 # every name make may write into its folder (`files.check_folder` before the run)
 OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "model.glb", "piece-*.fold",
-           "assembly.json", "instructions.html", "report.json")
+           "assembly.json", "instructions.html", "guide.pdf", "report.json")
 
 
 @dataclass(frozen=True)
@@ -100,9 +103,13 @@ def piece_reports(folded: list[FoldedPiece], sheets: Sheets) -> tuple[PieceRepor
 
 
 def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
-             rows: tuple[PieceReport, ...]) -> Assembly:
-    """assembly.json: parts, pieces and glue pairs."""
+             rows: tuple[PieceReport, ...], guide=None) -> Assembly:
+    """assembly.json: parts, pieces, glue pairs and the guide's build steps."""
     pieces = sheets.pieces
+    steps = () if guide is None else tuple(
+        AssemblyStep(step=st.number, kind=st.kind, part=plan_step.part, piece=st.piece, labels=st.labels,
+                     attach_to=st.attach_to, sheets=st.sheets, strips=st.strips)
+        for st, plan_step in zip(guide.steps, guide.plan.steps))
     return Assembly(
         model=model, size_mm=opts.size, paper=opts.paper, pages=sheets.packing.n_pages,
         parts=tuple(AssemblyPart(part=k, faces=int(len(part.faces)), obj=f"part-{k}.obj",
@@ -112,18 +119,25 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
                            between_parts=pieces[g.pieces[0]].part != pieces[g.pieces[1]].part,
                            tab_on=pieces[g.tab_piece].name if g.tab_piece is not None else None,
                            mesh_vertices=tuple(int(v) for v in g.mesh_edge), printed_label=g.printed)
-                    for g in sheets.glue))
+                    for g in sheets.glue),
+        steps=steps)
 
 
 def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],
                       folded: list[FoldedPiece], sheets: Sheets,
-                      finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int], MakeReport],
+                      finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int, GuideReport | None],
+                                       MakeReport],
                       inputs: tuple[Path, ...] = (), look: Appearance | None = None) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
     written, and the report. finish(piece rows, outputs so far, what the sheets print of the
-    model's `look`, sheets.pdf's size in bytes) gives the report, written last. inputs: the files
-    make read (never replaced)."""
+    model's `look`, sheets.pdf's size in bytes, the guide's report or None) gives the report,
+    written last. inputs: the files make read (never replaced)."""
     pages, printed = sheet_pages(sheets, model, opts, look)
+    guide = None
+    if opts.guide:
+        from ..guide.guide import build_guide
+
+        guide = build_guide(mesh, sheets.pieces, sheets.glue, sheets.page_of_piece(), folded, sheets.scale)
     with StagedFolder(out_dir, "make", inputs=inputs) as stage:
         pdf = pdf_bytes(pages, title=f"{model}: polyfold sheets")
         stage.write("sheets.pdf", pdf)
@@ -147,10 +161,22 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                 contact_tol=opts.contact_tol, thickness=opts.thickness / sheets.scale, verified=fp.info.path,
                 mm_per_unit=sheets.scale, page=row.page,
                 to_page=pattern_to_page(fp.pattern, fp.net, sheets.scale, placement))))
-        stage.write("assembly.json", assembly(model, opts, parts, sheets, rows).to_json())
+        stage.write("assembly.json", assembly(model, opts, parts, sheets, rows, guide).to_json())
         stage.write("instructions.html", instructions_html(
             model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),
-            sheets.packing.n_pages, opts, svgs))
-        report = finish(rows, list(stage.names), printed, len(pdf))
+            sheets.packing.n_pages, opts, svgs, guide))
+        guide_report = None
+        if guide is not None:
+            from ..formats.guide_pdf import guide_pdf_bytes
+
+            intro = guide_intro(opts, sheets.packing.n_pages, len(parts), len(sheets.pieces),
+                                any(g.printed != g.label for g in sheets.glue))
+            guide_pdf, guide_pages = guide_pdf_bytes(guide, f"Building {model}", (sheets.width, sheets.height), intro)
+            stage.write("guide.pdf", guide_pdf)
+            pictures = len(guide.overview) + sum(map(len, guide.parts)) + sum(1 + len(s.folding) for s in guide.steps)
+            closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
+            guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=pictures,
+                                       pdf_pages=guide_pages, closing_seams=closing)
+        report = finish(rows, list(stage.names), printed, len(pdf), guide_report)
         stage.write("report.json", report.to_json())
         return stage.commit(), report

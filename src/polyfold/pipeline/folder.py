@@ -1,7 +1,7 @@
 """A `polyfold make` output folder, read back: `load_folder` -> `MakeFolder`.
 
-In: the folder (assembly.json, report.json, part-K.obj, piece-X.fold, and model.glb when the
-model has a texture or colours). Out: the parts as meshes, the whole model (the parts welded back
+In: the folder (assembly.json with its build steps, report.json, part-K.obj, piece-X.fold, and
+model.glb when the model has a texture or colours). Out: the parts as meshes, the whole model (the parts welded back
 together), the model's look matched to the parts' faces (`ModelLook`), and every piece ready to
 be posed along its folding path (`ViewPiece.pose`: face corners in the model frame at a fraction
 t of the path). The viewer draws it; tests and scripts use it without a browser. `make_folder`
@@ -19,6 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import PolyfoldError
+from ..fold.plan import path_at as path_degrees  # (FOLD degrees here; the name its callers know)
 from ..fold.tree import FoldTree, fold_positions
 from ..formats.fold import FoldNet, fold_net, read_fold
 from ..formats.meshes import read_mesh_as_is
@@ -26,7 +27,7 @@ from ..mesh.geometry import fold_deg_to_rho
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
 from .options import MakeOptions
-from .report import Assembly, MakeReport
+from .report import Assembly, AssemblyStep, MakeReport
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,19 +121,13 @@ class MakeFolder:
     whole: Mesh
     options: MakeOptions | None
     look: ModelLook | None = None
+    steps: tuple[AssemblyStep, ...] = ()  # the guide's build steps (none: made with --no-guide)
 
-
-def path_degrees(frames: np.ndarray, t: float) -> np.ndarray:
-    """FOLD angles (E,) in degrees at fraction t of a path (K, E): linear between consecutive
-    frames, every segment the same share of t."""
-    frames = np.asarray(frames, dtype=np.float64)
-    t = min(1.0, max(0.0, float(t)))
-    if len(frames) == 1:
-        return frames[0].copy()
-    s = t * (len(frames) - 1)
-    i = min(int(math.floor(s)), len(frames) - 2)
-    u = s - i
-    return (1.0 - u) * frames[i] + u * frames[i + 1]
+    def placed_after(self, step: int) -> list[int]:
+        """The pieces (indices into `pieces`) in the model after build step `step` (1-based), in
+        the order they came."""
+        index = {p.name: i for i, p in enumerate(self.pieces)}
+        return [index[s.piece] for s in self.steps[:step] if s.piece is not None and s.piece in index]
 
 
 def _kabsch(p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -336,7 +331,8 @@ def load_folder(path: str | Path) -> MakeFolder:
         except (ValueError, TypeError, KeyError, IndexError) as exc:  # malformed values in the JSON
             raise PolyfoldError(f"{row.fold}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
     return MakeFolder(path=root, model=assembly.model or root.name, parts=tuple(parts), pieces=tuple(pieces),
-                      whole=weld_parts(parts), options=_read_options(root), look=_read_look(root, parts))
+                      whole=weld_parts(parts), options=_read_options(root), look=_read_look(root, parts),
+                      steps=assembly.steps)
 
 
 def make_folder(source: str | Path | Mesh | LoadedMesh, out_dir: str | Path, opts: MakeOptions | None = None,

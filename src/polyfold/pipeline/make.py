@@ -29,8 +29,8 @@ from .export import OUTPUTS, PrintedLook, write_make_folder
 from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
-from .report import (ChecksReport, ColorReport, ExportReport, InflateReport, InputReport, LayoutReport, LoadReport, MakeReport,
-                     PieceReport, SimplifyReport, StageReports)
+from .report import (ChecksReport, ColorReport, ExportReport, GuideReport, InflateReport, InputReport, LayoutReport,
+                     LoadReport, MakeReport, PieceReport, SimplifyReport, StageReports)
 from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
 
 Progress = Callable[[str, str], None]  # (stage, message)
@@ -221,14 +221,15 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     checks = _check(sheets, opts, name, fold_report.verified, say)
     layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)
     te = time.perf_counter()
-    say("export", "writing sheets and files")
+    say("export", "writing sheets and files" + (" and the assembly guide" if opts.guide else ""))
 
-    def finish(rows: tuple[PieceReport, ...], outputs: list[str], printed: PrintedLook, pdf_size: int) -> MakeReport:
+    def finish(rows: tuple[PieceReport, ...], outputs: list[str], printed: PrintedLook, pdf_size: int,
+               guide: GuideReport | None) -> MakeReport:
         stages = StageReports(load=load_report, inflate=inflate_report, segment=segment_report, unfold=unfold_report,
                               fold=fold_report, layout=layout_report,
                               export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages,
                                                   pdf_bytes=pdf_size),
-                              simplify=simplify_report, color=_color_report(look, opts, printed))
+                              simplify=simplify_report, color=_color_report(look, opts, printed), guide=guide)
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0)
 

@@ -40,6 +40,7 @@ class MakeOptions:
     faces: str = "auto"  # simplify first: a face count, auto (meshes over mesh.simplify.AUTO_ABOVE faces) or none
     color: str = "texture"  # the model's look on the sheets: texture (as the file has it), flat or none
     dpi: float = DPI  # raster resolution of printed textures
+    guide: bool = True  # write the assembly guide (guide.pdf, the steps in instructions.html)
 
 
 def paper_size(spec: str) -> tuple[float, float]:

@@ -156,6 +156,19 @@ class ColorReport:
 
 
 @dataclass(frozen=True)
+class GuideReport:
+    """The assembly guide (guide.pdf and instructions.html): seconds to build it (plan and
+    pictures; writing is in export's), its steps, pictures, pages of guide.pdf, and the seams
+    glued once no finger fits inside (closed from outside)."""
+
+    seconds: float
+    steps: int
+    pictures: int
+    pdf_pages: int
+    closing_seams: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class StageReports:
     load: LoadReport
     inflate: InflateReport
@@ -166,6 +179,7 @@ class StageReports:
     export: ExportReport
     simplify: SimplifyReport | None = None  # only when the mesh was simplified
     color: ColorReport | None = None  # the model's look on the sheets
+    guide: GuideReport | None = None  # None with --no-guide
 
 
 @dataclass(frozen=True)
@@ -261,6 +275,23 @@ class GlueRow:
 
 
 @dataclass(frozen=True)
+class AssemblyStep:
+    """One build step of the guide: its number and kind (piece: fold and attach a new piece;
+    glue: more seams; join: a built part to the others), the part, the new piece (None for glue
+    and join steps), the glue labels in gluing order, the placed pieces they glue to, the sheets
+    used (1-based) and the glue strips."""
+
+    step: int
+    kind: str
+    part: int
+    piece: str | None
+    labels: tuple[str, ...]
+    attach_to: tuple[str, ...]
+    sheets: tuple[int, ...]
+    strips: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class Assembly:
     """assembly.json: what the pieces are, where they go, what glues to what."""
 
@@ -271,6 +302,7 @@ class Assembly:
     parts: tuple[AssemblyPart, ...]
     pieces: tuple[AssemblyPiece, ...]
     glue: tuple[GlueRow, ...]
+    steps: tuple[AssemblyStep, ...] = ()  # the guide's build order (none with --no-guide)
 
     def to_json(self) -> str:
         return json.dumps(_plain(self), indent=1) + "\n"

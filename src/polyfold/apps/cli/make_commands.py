@@ -37,6 +37,7 @@ def make(
     faces: str = options.FACES,
     color: str = options.COLOR,
     dpi: float = options.DPI,
+    guide: bool = options.GUIDE,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No warnings or progress, only errors."),
 ) -> None:
     """Mesh in, printable sheets out: simplify, inflate, segment, unfold, fold, lay out with tabs and labels, export."""
@@ -44,7 +45,7 @@ def make(
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
                                     marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces,
-                                    color=color, dpi=dpi)
+                                    color=color, dpi=dpi, guide=guide)
     from ...pipeline.make import make as run_make
 
     t0 = time.perf_counter()
@@ -94,6 +95,11 @@ def make(
             printed = (f", printed in its {'texture' if look.printed == 'texture' else 'colours'} "
                        f"({look.dpi:g} dpi, sheets.pdf {rep.stages.export.pdf_bytes / 1e6:.1f} MB)"
                        if look.printed == "texture" else ", printed in flat colours")
+        guide = rep.stages.guide
+        if guide is not None:
+            say(f"assembly guide: {guide.steps} steps in instructions.html and guide.pdf ({guide.pdf_pages} pages)"
+                + (f"; seam(s) {', '.join(guide.closing_seams)} close the model from outside" if guide.closing_seams
+                   else ""))
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
              f"page(s) ({lay.utilisation:.0%} of their printable area){printed}, {lay.glue_edges} glue edges, "
              f"smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "
@@ -190,6 +196,7 @@ def batch(
     marks: bool = options.MARKS,
     contact_tol: float = options.CONTACT_TOL_OPTION,
     thickness: float = options.THICKNESS_MM_OPTION,
+    guide: bool = options.GUIDE,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress and no table: only the summary line and errors."),
 ) -> None:
     """Make (or study) every mesh matching GLOB, each in its own process, locally or on Dask.
@@ -201,7 +208,7 @@ def batch(
     opts = options.make_options(fail, inflate=inflate_mode, segment=segment_mode, tau=tau, parts=parts,
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
-                                    marks=marks, thickness=thickness)
+                                    marks=marks, thickness=thickness, guide=guide)
     if study is not None and study not in ("cspace", "unfold"):
         fail(f"--study must be 'cspace' or 'unfold', not {study!r}", 2)
     from ..batch import run_batch

@@ -51,6 +51,8 @@ COLOR = typer.Option(_D.color, "--color",
                      help="The model's look on the sheets: texture (the file's texture or colours, if it has any), "
                           "flat (one mean colour per face) or none (plain).")
 DPI = typer.Option(_D.dpi, "--dpi", min=30.0, max=1200.0, help="Resolution of printed textures (dots per inch).")
+GUIDE = typer.Option(_D.guide, "--guide/--no-guide",
+                     help="Write the assembly guide: guide.pdf and the build steps in instructions.html.")
 MIN_LABEL = typer.Option(_D.min_label_mm, "--min-label-mm", min=0.5, max=10.0,
                          help="Least cap height of every label, mm; a label that does not fit its face goes on its tab or beside its edge.")
 
@@ -59,7 +61,8 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
                  parts: Optional[int], paper: str, size: float, margin: float, tabs: str, seed: int,
                  time_limit: float, fold: bool, contact_tol: float, marks: bool,
                  min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness,
-                 faces: str = _D.faces, color: str = _D.color, dpi: float = _D.dpi) -> MakeOptions:
+                 faces: str = _D.faces, color: str = _D.color, dpi: float = _D.dpi,
+                 guide: bool = _D.guide) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -68,7 +71,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
                        contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness,
-                       faces=faces, color=color, dpi=dpi)
+                       faces=faces, color=color, dpi=dpi, guide=guide)
 
 
 @contextlib.contextmanager

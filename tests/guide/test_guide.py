@@ -1,0 +1,198 @@
+"""The assembly guide (issue 22), read back from make folders as a person gets them: every piece
+and every glue label in exactly one step, each step gluing only to pieces already in the model,
+pictures that show something and change from step to step, guide.pdf with every step, and
+--no-guide. On bunny-128 (one part, 12 pieces), horse-302 (long pieces, glue strips), bunny-128
+in 3 parts (join steps) and a random convex hull (not a shared model)."""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from polyfold.mesh.mesh import Mesh
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions
+
+
+def _hull(n_points: int, seed: int) -> Mesh:
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n_points, 3)) * np.array([1.0, 0.7, 0.5])
+    hull = ConvexHull(pts)
+    faces = hull.simplices.copy()
+    # outward corner order
+    c = pts.mean(axis=0)
+    n = np.cross(pts[faces[:, 1]] - pts[faces[:, 0]], pts[faces[:, 2]] - pts[faces[:, 0]])
+    flip = np.einsum("ij,ij->i", n, pts[faces[:, 0]] - c) < 0
+    faces[flip] = faces[flip][:, ::-1]
+    used, inverse = np.unique(faces, return_inverse=True)
+    return Mesh(pts[used], inverse.reshape(-1, 3))
+
+
+CASES = {
+    "bunny": ("bunny-128.obj", MakeOptions(time_limit=60)),
+    "horse": ("horse-302.obj", MakeOptions(time_limit=60)),
+    "bunny-parts": ("bunny-128.obj", MakeOptions(parts=3, time_limit=60)),
+    "hull": (None, MakeOptions(time_limit=60, size=120)),
+}
+
+
+@pytest.fixture(scope="module")
+def folders(models_dir: Path, tmp_path_factory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("guide")
+    out = {}
+    for name, (model, opts) in CASES.items():
+        src = models_dir / model if model else _hull(90, 7)
+        make(src, root / name, opts, name=None if model else "hull-90")
+        out[name] = root / name
+    return out
+
+
+def _read(folder: Path) -> tuple[dict, dict]:
+    return (json.loads((folder / "assembly.json").read_text()), json.loads((folder / "report.json").read_text()))
+
+
+def _step_pictures(folder: Path) -> list[np.ndarray]:
+    """The picture of every build step in instructions.html (embedded PNGs, in step order)."""
+    html = (folder / "instructions.html").read_text()
+    out = []
+    for section in re.findall(r"<section class='step' id='step-\d+'>(.*?)</section>", html, re.S):
+        b64 = re.search(r"<figure class='pic'><img src='data:image/png;base64,([^']+)'", section).group(1)
+        out.append(np.asarray(Image.open(io.BytesIO(base64.b64decode(b64))).convert("RGB")))
+    return out
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_every_piece_and_label_in_exactly_one_step(folders: dict[str, Path], case: str) -> None:
+    asm, rep = _read(folders[case])
+    steps = asm["steps"]
+    assert steps and [s["step"] for s in steps] == list(range(1, len(steps) + 1))
+    labels = [label for s in steps for label in s["labels"]]
+    assert sorted(labels, key=int) == sorted((g["label"] for g in asm["glue"]), key=int)
+    assert len(labels) == len(set(labels))
+    new = [s["piece"] for s in steps if s["piece"] is not None]
+    assert sorted(new) == sorted(p["piece"] for p in asm["pieces"])  # every net piece brought in once
+    strips = [name for s in steps for name in s["strips"]]
+    tab_strips = sorted({g["tab_on"] for g in asm["glue"] if g["tab_on"] and g["tab_on"].startswith("S")})
+    assert sorted(strips) == tab_strips and len(strips) == len(set(strips))
+    assert rep["stages"]["guide"]["steps"] == len(steps)
+    if case == "horse":
+        assert strips, "horse-302 has glue strips: each must be used in a step"
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_each_step_glues_only_to_what_is_built(folders: dict[str, Path], case: str) -> None:
+    asm, _ = _read(folders[case])
+    glue = {g["label"]: g for g in asm["glue"]}
+    part_of = {p["piece"]: p["part"] for p in asm["pieces"]}
+    placed: list[str] = []
+    parts_built: list[int] = []
+    for s in asm["steps"]:
+        before = list(placed)
+        if s["piece"] is not None:
+            assert s["kind"] == "piece" and s["piece"] not in placed
+            placed.append(s["piece"])
+            assert s["sheets"][0] == next(p["page"] for p in asm["pieces"] if p["piece"] == s["piece"])
+        assert set(s["attach_to"]) <= set(before), f"step {s['step']} attaches to a piece not placed yet"
+        for label in s["labels"]:  # both sides of every seam glued are in the model
+            assert set(glue[label]["pieces"]) <= set(placed), f"step {s['step']} glues {label} to a missing piece"
+        if s["kind"] == "piece" and any(part_of[q] == part_of[s["piece"]] for q in before):
+            # a piece after the first of its part is glued to what is built, in its step or the
+            # "glue" steps that follow it
+            k = s["step"]
+            following = [t for t in asm["steps"][k - 1:] if t["step"] == k or t["kind"] == "glue"]
+            following = following[:next((i for i, t in enumerate(following[1:], 1) if t["kind"] != "glue"),
+                                        len(following))]
+            assert any(t["attach_to"] for t in following), f"piece {s['piece']} is glued to nothing built"
+        if s["kind"] == "join":
+            assert s["attach_to"] and all(part_of[q] != s["part"] for q in s["attach_to"])
+            parts_built.append(s["part"])
+        if s["piece"] is not None and part_of[s["piece"]] not in parts_built:
+            parts_built.append(part_of[s["piece"]])
+    if case == "bunny-parts":
+        assert any(s["kind"] == "join" for s in asm["steps"])
+
+
+@pytest.mark.parametrize("case", ["bunny", "horse", "bunny-parts"])
+def test_the_pictures_show_the_steps(folders: dict[str, Path], case: str) -> None:
+    asm, _ = _read(folders[case])
+    pics = _step_pictures(folders[case])
+    assert len(pics) == len(asm["steps"])
+    for k, img in enumerate(pics):
+        drawn = (img.astype(int).sum(axis=2) < 3 * 245).mean()
+        assert drawn > 0.05, f"step {k + 1}'s picture is nearly blank ({drawn:.1%} drawn)"
+        colourful = (img.max(axis=2).astype(int) - img.min(axis=2) > 60).mean()
+        assert colourful > 0.002, f"step {k + 1}'s picture has no piece in colour"  # (a one-face piece: ~1 %)
+    for k in range(1, len(pics)):
+        changed = (np.abs(pics[k].astype(int) - pics[k - 1]).max(axis=2) > 30).mean()
+        assert changed > 0.005, f"steps {k} and {k + 1} look the same ({changed:.2%} differs)"
+
+
+def test_the_overview_names_every_piece(folders: dict[str, Path]) -> None:
+    html = (folders["bunny"] / "instructions.html").read_text()
+    where = html[html.index("id='where'"):html.index("id='steps'")]
+    assert len(re.findall(r"data:image/png;base64", where)) == 6  # six sides
+    for side in ("front", "back", "left", "right", "top", "bottom"):
+        assert f"the model from the {side}" in where
+
+
+def test_parts_get_their_own_pictures(folders: dict[str, Path]) -> None:
+    html = (folders["bunny-parts"] / "instructions.html").read_text()
+    where = html[html.index("id='where'"):html.index("id='steps'")]
+    asm, _ = _read(folders["bunny-parts"])
+    assert len(re.findall(r"data:image/png;base64", where)) == 6 * (1 + len(asm["parts"]))
+
+
+@pytest.mark.parametrize("case", ["bunny", "horse"])
+def test_guide_pdf_has_every_step(folders: dict[str, Path], case: str) -> None:
+    from pypdf import PdfReader
+
+    _, rep = _read(folders[case])
+    reader = PdfReader(folders[case] / "guide.pdf")
+    assert len(reader.pages) == rep["stages"]["guide"]["pdf_pages"]
+    w, h = (float(x) for x in reader.pages[0].mediabox.upper_right)
+    assert abs(w - 595.3) < 1 and abs(h - 841.9) < 1  # A4, as --paper
+    text = "\n".join(p.extract_text() for p in reader.pages)
+    for k in range(1, rep["stages"]["guide"]["steps"] + 1):
+        assert f"Step {k}:" in text
+    assert "Where each piece goes" in text
+    images = sum(len(p.images) for p in reader.pages)
+    assert images == rep["stages"]["guide"]["pictures"]
+
+
+def test_no_guide(models_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "plain"
+    make(models_dir / "cube-12.obj", out, MakeOptions(guide=False, paper="letter"))
+    asm, rep = _read(out)
+    assert asm["steps"] == [] and rep["stages"]["guide"] is None
+    assert not (out / "guide.pdf").exists()
+    assert "Build steps" not in (out / "instructions.html").read_text()
+    make(models_dir / "cube-12.obj", out, MakeOptions(paper="letter"))  # and on again, into the same folder
+    from pypdf import PdfReader
+
+    w, h = (float(x) for x in PdfReader(out / "guide.pdf").pages[0].mediabox.upper_right)
+    assert abs(w - 612) < 1 and abs(h - 792) < 1  # Letter
+
+
+def test_non_linear_pieces_show_their_stages(folders: dict[str, Path]) -> None:
+    """bunny-128's sequential pieces say so and show each stage; straight ones show four frames."""
+    rep = _read(folders["bunny"])[1]
+    html = (folders["bunny"] / "instructions.html").read_text()
+    for row in rep["pieces"]:
+        section = re.search(rf"<h3>Step \d+: piece {row['piece']} \(sheet \d+\)</h3>(.*?)</section>", html, re.S)
+        assert section, row["piece"]
+        body = section.group(1)
+        if row["linear"]:
+            assert "Fold all its creases together" in body
+            assert len(re.findall(rf"{row['piece']}: \d+ % folded", body)) >= 4
+        elif row["path_verified"] and row["faces"] > 1:
+            assert "does not fold in one motion" in body and row["planner"] in body
+            assert re.search(rf"{row['piece']}: stage 2", body)
