@@ -15,6 +15,7 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 import zlib
+from collections import Counter
 from fractions import Fraction
 from pathlib import Path
 
@@ -634,6 +635,43 @@ def check_sheet(sheet: dict, margin: float) -> list[str]:
         for k, g in enumerate(group):
             if not union.contains(g):
                 problems.append(f"{name} {k} lies outside every cut outline")
+    return problems
+
+
+def guide_problems(asm: dict) -> list[str]:
+    """What is wrong with the build steps of a make folder's assembly.json (issue 22): every glue
+    label in exactly one step, every net piece brought in by exactly one step and every glue strip
+    used in exactly one, each step gluing only pieces already in the model, and attaching only
+    to pieces placed before it (for a join: of other parts)."""
+    problems = []
+    steps = asm["steps"]
+    if [s["step"] for s in steps] != list(range(1, len(steps) + 1)):
+        problems.append("steps not numbered 1..n")
+    labels = Counter(label for s in steps for label in s["labels"])
+    glue = {g["label"]: g for g in asm["glue"]}
+    if set(labels) != set(glue) or any(n != 1 for n in labels.values()):
+        problems.append(f"labels not in exactly one step: {sorted(set(glue) ^ set(labels))[:5]} "
+                        f"{[k for k, n in labels.items() if n > 1][:5]}")
+    new = Counter(s["piece"] for s in steps if s["piece"] is not None)
+    if set(new) != {p["piece"] for p in asm["pieces"]} or any(n != 1 for n in new.values()):
+        problems.append("net pieces not brought in by exactly one step each")
+    strips = Counter(name for s in steps for name in s["strips"])
+    if set(strips) != {g["tab_on"] for g in asm["glue"] if g["tab_on"] and g["tab_on"].startswith("S")} \
+            or any(n != 1 for n in strips.values()):
+        problems.append("glue strips not used in exactly one step each")
+    part_of = {p["piece"]: p["part"] for p in asm["pieces"]}
+    placed: list[str] = []
+    for s in steps:
+        before = list(placed)
+        if s["piece"] is not None:
+            placed.append(s["piece"])
+        if not set(s["attach_to"]) <= set(before):
+            problems.append(f"step {s['step']} attaches to a piece not placed yet")
+        if s["kind"] == "join" and any(part_of[q] == s["part"] for q in s["attach_to"]):
+            problems.append(f"step {s['step']} joins part {s['part']} to itself")
+        for label in s["labels"]:
+            if label in glue and not set(glue[label]["pieces"]) <= set(placed):
+                problems.append(f"step {s['step']} glues {label} to a piece not placed yet")
     return problems
 
 

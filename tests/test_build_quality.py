@@ -58,7 +58,7 @@ def test_sheets_pass_the_build_checks(name: str, size: float, models_dir: Path, 
         mesh = _loop_bunny(tmp_path / f"{name}.obj", models_dir)
     else:
         mesh = models_dir / f"{name}.obj"
-    result = make(mesh, tmp_path / "out", MakeOptions(size=size, time_limit=30))
+    result = make(mesh, tmp_path / "out", MakeOptions(size=size, time_limit=30, guide=False))
     m = measure_folder(tmp_path / "out", mesh)
     lay = result.report.stages.layout
     runs = lay.seam_runs

@@ -32,7 +32,7 @@ GOOD = ("cube-12", "icosahedron-20", "octahedron-8")
 FAULTS = "crash:crash-me.obj,segv:segv-me.obj,hang:hang-me.obj"
 EXPECTED = {"crash-me": "crashed", "cube-12": "ok", "hang-me": "timeout", "icosahedron-20": "ok",
             "nan-vertex": "error", "octahedron-8": "ok", "segv-me": "crashed"}
-OPTS = MakeOptions(fold=False, size=100.0)  # short runs; the folding itself is tested elsewhere
+OPTS = MakeOptions(fold=False, size=100.0, guide=False)  # short runs; folding and the guide are tested elsewhere
 HARD = 12.0  # hard limit of the runs with hang-me: far above a small make (~1-3 s)
 
 
@@ -138,7 +138,7 @@ def test_resume(inputs, local, tmp_path) -> None:
     assert "skipped" in (local.out / "summary.csv").read_text()
     # --force, other options, or a mesh newer than its report: made again
     assert run_batch(pattern[:1], local.out, OPTS, force=True).rows[0].status == "ok"
-    assert run_batch(pattern[1:2], local.out, MakeOptions(fold=False, size=90.0)).rows[0].status == "ok"
+    assert run_batch(pattern[1:2], local.out, MakeOptions(fold=False, size=90.0, guide=False)).rows[0].status == "ok"
     st = os.stat(pattern[2])
     later = time.time() + 60
     os.utime(pattern[2], (later, later))

@@ -28,7 +28,7 @@ def spot(models_dir):
 @pytest.fixture(scope="module")
 def control(spot, tmp_path_factory):
     out = tmp_path_factory.mktemp("spot-control")
-    return make(spot / "spot_control_mesh.obj", out, MakeOptions(fold=False)), out
+    return make(spot / "spot_control_mesh.obj", out, MakeOptions(fold=False, guide=False)), out
 
 
 def printed_triangles(out, loaded):
@@ -89,7 +89,7 @@ def test_the_sheets_embed_one_picture_per_piece(control):
 
 
 def test_the_fine_spot_is_simplified_with_its_texture(spot, tmp_path):
-    result = make(spot / "spot_triangulated.obj", tmp_path, MakeOptions(fold=False))
+    result = make(spot / "spot_triangulated.obj", tmp_path, MakeOptions(fold=False, guide=False))
     report = result.report
     simp, color = report.stages.simplify, report.stages.color
     assert simp.faces_before == 5856 and simp.faces_after < 1000  # --faces auto
@@ -99,10 +99,10 @@ def test_the_fine_spot_is_simplified_with_its_texture(spot, tmp_path):
 
 
 def test_flat_and_none(spot, tmp_path):
-    flat = make(spot / "spot_control_mesh.obj", tmp_path / "flat", MakeOptions(fold=False, color="flat"))
+    flat = make(spot / "spot_control_mesh.obj", tmp_path / "flat", MakeOptions(fold=False, color="flat", guide=False))
     assert flat.report.stages.color.printed == "flat" and flat.report.stages.color.pictures == 0
     assert "<image" not in (tmp_path / "flat" / "sheet-01.svg").read_text()
-    none = make(spot / "spot_control_mesh.obj", tmp_path / "none", MakeOptions(fold=False, color="none"))
+    none = make(spot / "spot_control_mesh.obj", tmp_path / "none", MakeOptions(fold=False, color="none", guide=False))
     assert none.report.stages.color.printed == "none"
     assert not (tmp_path / "none" / "model.glb").exists()
     assert b"/DCTDecode" not in (tmp_path / "none" / "sheets.pdf").read_bytes()

@@ -32,7 +32,7 @@ PDF_DPI = 600
 
 def _make(models_dir: Path, tmp_path_factory, name: str, **kw) -> Path:
     out = tmp_path_factory.mktemp(name) / "bunny-128"
-    make(models_dir / "bunny-128.obj", out, MakeOptions(fold=False, time_limit=20.0, **kw))
+    make(models_dir / "bunny-128.obj", out, MakeOptions(fold=False, time_limit=20.0, guide=False, **kw))
     return out
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import check_sheet, closed_meshes, read_sheet
+from conftest import check_sheet, closed_meshes, guide_problems, read_sheet
 from polyfold.formats.meshes import load_mesh
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions
@@ -43,6 +43,7 @@ def test_every_closed_mesh_makes_clean_sheets(path, tmp_path):
     assert report["stages"]["layout"]["untabbed_edges"] == []
     assert {label: n for label, n in glue.items() if n != 2} == {label: 4 for label in strips}  # both sides (+ a strip)
     assert sum(r["faces"] for r in report["pieces"]) == report["input"]["faces"]
+    assert guide_problems(json.loads((out / "assembly.json").read_text())) == []  # the guide's steps (issue 22)
 
 
 def test_parts_are_glued_across(models_dir, tmp_path):

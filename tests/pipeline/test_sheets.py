@@ -29,7 +29,7 @@ BLENDER_PAGES = {"bunny-128": 3, "horse-302": 3, "fish-472": 2, "bunny-348": 5, 
 @pytest.mark.parametrize("name", list(BLENDER_PAGES))
 def test_no_more_pages_than_blender_and_the_reported_utilisation_is_on_the_sheets(name, models_dir, tmp_path):
     out = tmp_path / name
-    report = make(models_dir / f"{name}.obj", out, MakeOptions()).report  # the defaults: A4, 150 mm, folded
+    report = make(models_dir / f"{name}.obj", out, MakeOptions(guide=False)).report  # the defaults (A4, 150 mm, folded); the guide: tests/guide
     lay = report.stages.layout
     assert lay.pages <= BLENDER_PAGES[name]
     svgs = sorted(out.glob("sheet-*.svg"))
@@ -46,7 +46,7 @@ def test_no_more_pages_than_blender_and_the_reported_utilisation_is_on_the_sheet
 
 
 def test_bumpy_is_split_to_fill_its_pages(models_dir, tmp_path):
-    report = make(models_dir / "bumpy-528.obj", tmp_path / "bumpy", MakeOptions(fold=False)).report
+    report = make(models_dir / "bumpy-528.obj", tmp_path / "bumpy", MakeOptions(fold=False, guide=False)).report
     lay = report.stages.layout
     assert lay.pages <= 4 and lay.splits_for_packing > 0 and lay.utilisation > 0.4
     net_pieces = [r for r in report.pieces if r.faces > 0]  # not the glue strips
@@ -58,7 +58,7 @@ def test_bumpy_is_split_to_fill_its_pages(models_dir, tmp_path):
 def test_sprawling_nets_are_cut_into_compact_parts_to_fit_one_page(name, models_dir, tmp_path):
     # their nets cover about half a page but, cut only where a piece fits nowhere, needed two pages
     out = tmp_path / name
-    report = make(models_dir / f"{name}.obj", out, MakeOptions(fold=False)).report
+    report = make(models_dir / f"{name}.obj", out, MakeOptions(fold=False, guide=False)).report
     lay = report.stages.layout
     assert lay.pages == 1 and lay.splits_for_packing > 0
     assert sum(r.faces for r in report.pieces) == report.input.faces
@@ -67,7 +67,7 @@ def test_sprawling_nets_are_cut_into_compact_parts_to_fit_one_page(name, models_
 
 
 def test_pieces_that_fit_one_page_are_not_cut(models_dir, tmp_path):
-    report = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False, size=80.0)).report
+    report = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False, size=80.0, guide=False)).report
     lay = report.stages.layout
     assert lay.pages == 1 and lay.splits_for_packing == 0
     assert len([r for r in report.pieces if r.faces > 0]) == 1 + lay.splits_for_page
@@ -75,7 +75,7 @@ def test_pieces_that_fit_one_page_are_not_cut(models_dir, tmp_path):
 
 def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     mesh = load_mesh(models_dir / "bunny-348.obj").mesh
-    opts = MakeOptions(fold=False)
+    opts = MakeOptions(fold=False, guide=False)
     deadline = Deadline.after(60)
     parts, _, _ = make_parts(mesh, opts, deadline, lambda *a: None)
     scale = model_scale([mesh], opts.size)
@@ -96,8 +96,8 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
 
 
 def test_same_seed_same_pages(models_dir, tmp_path):
-    a = make(models_dir / "bunny-128.obj", tmp_path / "a", MakeOptions(fold=False))
-    b = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False))
+    a = make(models_dir / "bunny-128.obj", tmp_path / "a", MakeOptions(fold=False, guide=False))
+    b = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False, guide=False))
     assert (tmp_path / "a" / "assembly.json").read_text() == (tmp_path / "b" / "assembly.json").read_text()
     for sa, sb in zip(sorted((tmp_path / "a").glob("sheet-*.svg")), sorted((tmp_path / "b").glob("sheet-*.svg"))):
         assert sa.read_text() == sb.read_text()

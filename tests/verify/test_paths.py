@@ -138,7 +138,7 @@ def test_make_pieces_are_verified_as_written(tmp_path, models_dir):
     from polyfold.pipeline.make import make
     from polyfold.pipeline.options import MakeOptions
 
-    rep = make(models_dir / "bunny-128.obj", tmp_path, MakeOptions(thickness=0.3)).report
+    rep = make(models_dir / "bunny-128.obj", tmp_path, MakeOptions(thickness=0.3, guide=False)).report
     assert rep.stages.fold.thickness_mm == 0.3 and rep.checks.paths_verified == len(rep.pieces)
     for f in sorted(tmp_path.glob("piece-*.fold")):
         fold = json.loads(f.read_text())

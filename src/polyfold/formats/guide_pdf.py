@@ -15,7 +15,7 @@ def _image(pic, width_pt: float):
     from reportlab.platypus import Image
 
     h, w = pic.image.shape[:2]
-    return Image(io.BytesIO(pic.png), width=width_pt, height=width_pt * h / w)
+    return Image(io.BytesIO(pic.jpeg), width=width_pt, height=width_pt * h / w)
 
 
 def _grid(pics, per_row: int, width_pt: float):

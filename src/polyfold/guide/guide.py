@@ -9,6 +9,7 @@ In: the mesh as made, the pieces on their sheets and the seams (`fabricate.piece
 
 from __future__ import annotations
 
+import io
 import time
 from dataclasses import dataclass
 from functools import cached_property
@@ -25,8 +26,9 @@ from .order import BuildPlan, Seam, plan_build
 OVERVIEW_PX = (300, 225)
 PART_PX = (240, 180)
 STEP_PX = (420, 315)
-FRAME_PX = (240, 180)
+FRAME_PX = (200, 150)
 CHOOSE_PX = (96, 72)  # pictures a step's view is chosen with
+TRIES = 3  # views drawn part-built per step: the best ones for the whole model
 FRAME_VIEW = (40.0, -30.0)  # elevation, azimuth of the folding pictures, the sheet's printed side up
 LINEAR_FRACTIONS = (0.0, 1 / 3, 2 / 3, 1.0)
 
@@ -44,14 +46,24 @@ class Picture:
 
         return png_bytes(self.image)
 
+    @cached_property
+    def jpeg(self) -> bytes:
+        """The picture as a JPEG (quality 92: a PDF embeds it as it is, without re-encoding)."""
+        from PIL import Image
+
+        buf = io.BytesIO()
+        Image.fromarray(self.image).save(buf, "JPEG", quality=92)
+        return buf.getvalue()
+
 
 @dataclass(frozen=True, eq=False)
 class GuideStep:
     """One step as a person reads it: its number and kind ("piece", "glue", "join"), a title,
     the instructions (plain sentences), one line per seam (or seam run) to glue, in order, notes
-    after them (how to close the last seams), the picture of the model after it, the folding pictures of its piece (piece steps), and for
-    checking: the glue labels of its seams, the new piece's name, the pieces it attaches to, the
-    sheets it uses and the glue strips it uses."""
+    after them (how to close the last seams), the picture of the model after it, the folding
+    pictures of its piece (piece steps), and for checking: the glue labels of its seams, the new
+    piece's name, the pieces it attaches to, the sheets it uses (the new piece's first) and the
+    glue strips it uses."""
 
     number: int
     kind: str
@@ -158,6 +170,7 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
                                   face_piece, palette, pieces, pages, PART_PX, f"part {k + 1}") for k in part_ids)
 
     rotations = P.corner_rotations(mesh.vertices[np.unique(mesh.faces)])
+    whole = _seen_from(tris, rotations)
     runs: dict[str, list[int]] = {}
     for k, g in enumerate(glue):
         runs.setdefault(g.printed, []).append(k)
@@ -167,7 +180,7 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
         placed = np.flatnonzero(np.isin(face_piece, st.placed))
         focus = np.flatnonzero(face_piece == st.piece) if st.piece is not None else np.zeros(0, dtype=np.int64)
         seam_faces = np.array([f for k in st.seams for f in seams[k].faces], dtype=np.int64)
-        view = _best_view(mesh, tris, placed, np.union1d(focus, seam_faces), rotations, view)
+        view = _best_view(tris, placed, np.union1d(focus, seam_faces), rotations, whole, view)
         picture = _step_picture(mesh, tris, placed, face_piece, palette, st, seams, glue, rotations[view], n + 1)
         done_runs, glue_lines, labels, strips = set(), [], [], []
         for k in st.seams:
@@ -183,15 +196,15 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
         used = ([st.piece] if st.piece is not None else []) + [glue[k].tab_piece for k in st.seams
                                                                if glue[k].tab_piece is not None
                                                                and glue[k].tab_piece >= n_net]
-        sheets = sorted({pages[i] + 1 for i in used})
+        sheets = list(dict.fromkeys(pages[i] + 1 for i in used))  # the new piece's sheet first
         if st.kind == "piece":
             title = f"Step {n + 1}: piece {pieces[st.piece].name} (sheet {pages[st.piece] + 1})"
         elif st.kind == "join":
             title = f"Step {n + 1}: join part {st.part + 1} to the model"
         else:
             title = f"Step {n + 1}: piece {pieces[st.placed[-1]].name}, more seams"
-        steps.append(GuideStep(number=n + 1, kind=st.kind, title=title, lines=tuple(lines), glue=tuple(glue_lines), notes=tuple(notes),
-                               picture=picture, folding=folding, labels=tuple(labels),
+        steps.append(GuideStep(number=n + 1, kind=st.kind, title=title, lines=tuple(lines), glue=tuple(glue_lines),
+                               notes=tuple(notes), picture=picture, folding=folding, labels=tuple(labels),
                                piece=pieces[st.piece].name if st.piece is not None else None,
                                attach_to=tuple(pieces[i].name for i in st.attach_to), sheets=tuple(sheets),
                                strips=tuple(strips)))
@@ -218,19 +231,31 @@ def _sides(mesh: Mesh, tris: np.ndarray, faces: np.ndarray, face_piece: np.ndarr
     return tuple(out)
 
 
-def _best_view(mesh: Mesh, tris: np.ndarray, placed: np.ndarray, focus: np.ndarray, rotations: list, keep: int) -> int:
+def _seen_from(tris: np.ndarray, rotations: list) -> np.ndarray:
+    """(R, F): pixels of every face seen from outside (its printed side) in a small picture of
+    the whole model from each rotation."""
+    normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    out = np.zeros((len(rotations), len(tris)))
+    for k, rot in enumerate(rotations):
+        ids, _ = P.face_ids(P.fit_camera(tris, rot, *CHOOSE_PX), tris)
+        seen = ids[ids >= 0]
+        out[k] = np.bincount(seen, minlength=len(tris)) * (normal @ rot[2] > 0)
+    return out
+
+
+def _best_view(tris: np.ndarray, placed: np.ndarray, focus: np.ndarray, rotations: list, whole: np.ndarray,
+               keep: int) -> int:
     """The rotation (index) that shows most of the `focus` faces of the part-built model from
-    outside (ties: `keep`, the last step's, so the view changes only when it must)."""
+    outside: the TRIES best for the whole model (`_seen_from`) drawn part-built (ties: `keep`,
+    the last step's, so the view changes only when it must)."""
     sub = tris[placed]
     want = np.isin(placed, focus)
     normal = np.cross(sub[:, 1] - sub[:, 0], sub[:, 2] - sub[:, 0])
+    ranked = np.argsort(-whole[:, focus].sum(axis=1), kind="stable")[:TRIES]
     best, best_score = keep, -1
-    order = [keep] + [k for k in range(len(rotations)) if k != keep]
-    for k in order:
-        cam = P.fit_camera(tris, rotations[k], *CHOOSE_PX)
-        ids, _ = P.face_ids(cam, sub)
+    for k in [keep] + [int(r) for r in ranked if r != keep]:
+        ids, _ = P.face_ids(P.fit_camera(tris, rotations[k], *CHOOSE_PX), sub)
         seen = ids[ids >= 0]
-        # pixels of the focus faces seen from outside (their printed side)
         score = int((want[seen] & (normal[seen] @ rotations[k][2] > 0)).sum())
         if score > best_score * 1.15 or best_score < 0:  # a clearly better view, else the one we had
             best, best_score = k, score
@@ -282,8 +307,8 @@ def _instructions(st, seams: list[Seam], pieces, pages: list[int], folded, paths
                 lines.append("Fold all its creases together, a little at a time: mountains (red, dash-dot) away "
                              "from you, valleys (blue, dashed) towards you, as the pictures show.")
             else:
-                lines.append(f"This piece does not fold in one motion (its verified path: {fp.path.planner}): close its "
-                             f"creases in {len(stages)} stages, in the order of the pictures; the creases drawn thick "
+                lines.append(f"This piece does not fold in one motion (its verified path: {fp.path.planner}): "
+                             f"close its creases in {len(stages)} stages, in the order of the pictures; the creases drawn thick "
                              "close in that stage, mountains red, valleys blue.")
             folding = _folding_pictures(fp, paths.get(st.piece), palette[st.piece], name, stages)
         if st.attach_to:

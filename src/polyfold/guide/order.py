@@ -52,8 +52,8 @@ class Step:
     """One step of the build: kind "piece" (fold `piece`, glue the seams it closes), "glue" (more
     seams of the step before) or "join" (a built part glued to the parts before it); the seams
     (indices into the plan's seams) in gluing order, the pieces placed before this step that
-    they glue to (for a join, those of the other parts), the pieces in the model after it, and the seams glued through an opening under
-    REACH_MM."""
+    they glue to (for a join, those of the other parts), the pieces in the model after it, and
+    the seams glued through an opening under REACH_MM."""
 
     kind: str
     part: int

@@ -82,17 +82,18 @@ def fit_camera(points: np.ndarray, rotation: np.ndarray, width: int, height: int
 
 def face_ids(cam: Camera, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(ids (H, W) int64, -1 on the background; depth (H, W)) of triangles (F, 3, 3), nearest
-    face wins: one pass of the rasteriser with each face's id as its colour."""
+    face wins: one pass of the rasteriser with each face's id as its colour (written into the
+    low three bytes of a 4-byte pixel, read back as one little-endian integer)."""
     n = len(tris)
-    ids_rgb = np.empty((n, 3), dtype=np.uint8)
     k = np.arange(n, dtype=np.int64)
-    ids_rgb[:, 0], ids_rgb[:, 1], ids_rgb[:, 2] = k & 255, (k >> 8) & 255, (k >> 16) & 255
-    img = np.full((cam.height, cam.width, 3), 255, dtype=np.uint8)
+    ids_rgb = np.stack([k & 255, (k >> 8) & 255, (k >> 16) & 255], axis=1).astype(np.uint8)
+    img = np.zeros((cam.height, cam.width, 4), dtype=np.uint8)
+    img[..., :3] = 255
     zbuf = np.full((cam.height, cam.width), np.inf)
     if n:
         px, depth = cam.project(tris)
         _zfill(img, zbuf, np.ascontiguousarray(px), np.ascontiguousarray(depth), ids_rgb)
-    ids = img[..., 0].astype(np.int64) | (img[..., 1].astype(np.int64) << 8) | (img[..., 2].astype(np.int64) << 16)
+    ids = img.view("<u4")[..., 0].astype(np.int64)
     ids[ids == NO_FACE] = -1
     return ids, zbuf
 
@@ -116,15 +117,16 @@ def draw_faces(cam: Camera, tris: np.ndarray, front: np.ndarray, back: np.ndarra
     (back: their other side); ghost (G, 3, 3): triangles drawn faintly only where nothing else is
     (the model not built yet)."""
     ids, zbuf = face_ids(cam, tris)
-    img = np.empty((cam.height, cam.width, 3), dtype=np.uint8)
-    img[:] = BACKGROUND
+    # one gather from a colour table: the faces, then the ghost, then the background
+    table = np.empty((len(tris) + 2, 3), dtype=np.uint8)
+    table[-2], table[-1] = GHOST_RGB, BACKGROUND
+    if len(tris):
+        table[:-2] = shaded(cam, tris, front, back)
+    pick = np.where(ids >= 0, ids, len(tris) + 1)
     if ghost is not None and len(ghost):
         gids, _ = face_ids(cam, ghost)
-        img[(gids >= 0) & (ids < 0)] = GHOST_RGB
-    if len(tris):
-        cols = shaded(cam, tris, front, back)
-        img[ids >= 0] = cols[ids[ids >= 0]]
-    return img, ids, zbuf
+        pick[(gids >= 0) & (ids < 0)] = len(tris)
+    return table[pick], ids, zbuf
 
 
 def draw_lines(img: np.ndarray, cam: Camera, zbuf: np.ndarray | None, segs: np.ndarray, color, width: float = 2.5,

@@ -122,7 +122,7 @@ def test_small_edges_are_said(models_dir, tmp_path):
     """The summary line and report.json give the smallest printed edge and face; under 5 mm, one
     warning line names the --size that reaches 5 mm, and at that size there is no warning."""
     src = models_dir / "bumpy-528.obj"
-    proc = run_cli("make", src, "-o", tmp_path / "a")
+    proc = run_cli("make", src, "-o", tmp_path / "a", "--no-guide")
     assert proc.returncode == 0, proc.stderr
     lay = json.loads((tmp_path / "a" / "report.json").read_text())["stages"]["layout"]
     edge = _smallest_edge_mm(src, 150.0)
@@ -135,7 +135,7 @@ def test_small_edges_are_said(models_dir, tmp_path):
     summary = proc.stderr.strip().splitlines()[-1]
     assert (f"smallest edge {lay['smallest_edge_mm']:.3g} mm, narrowest face {lay['smallest_face_mm']:.3g} mm"
             in summary)
-    proc = run_cli("make", src, "-o", tmp_path / "b", "--size", size)
+    proc = run_cli("make", src, "-o", tmp_path / "b", "--size", size, "--no-guide")
     assert proc.returncode == 0, proc.stderr
     assert "smallest printed edge" not in proc.stderr
     lay = json.loads((tmp_path / "b" / "report.json").read_text())["stages"]["layout"]
