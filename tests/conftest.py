@@ -656,7 +656,8 @@ def guide_problems(asm: dict) -> list[str]:
     if set(new) != {p["piece"] for p in asm["pieces"]} or any(n != 1 for n in new.values()):
         problems.append("net pieces not brought in by exactly one step each")
     strips = Counter(name for s in steps for name in s["strips"])
-    if set(strips) != {g["tab_on"] for g in asm["glue"] if g["tab_on"] and g["tab_on"].startswith("S")} \
+    nets = {p["piece"] for p in asm["pieces"]}  # (a glue strip is a piece of the sheets, not of the net)
+    if set(strips) != {g["tab_on"] for g in asm["glue"] if g["tab_on"] and g["tab_on"] not in nets} \
             or any(n != 1 for n in strips.values()):
         problems.append("glue strips not used in exactly one step each")
     part_of = {p["piece"]: p["part"] for p in asm["pieces"]}
