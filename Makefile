@@ -19,8 +19,10 @@ demo: $(STAMP)
 	$(BIN)/polyfold make examples/bunny-128.obj -o out/bunny-128
 	@echo "open out/bunny-128/instructions.html; print out/bunny-128/sheets.pdf at 100 %"
 
+# two workers (the CI machine's two cores), then the tests that must run alone
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n 2 -m "not serial"
+	$(BIN)/python -m pytest -m serial
 
 bench: $(STAMP)
 	$(BIN)/python bench/bench_unfold.py

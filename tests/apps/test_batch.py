@@ -269,6 +269,7 @@ def _marked(marker: str) -> list[int]:
     return pids
 
 
+@pytest.mark.serial  # (under a pytest-xdist worker its batch never shows up in /proc: run alone)
 @pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc")
 @pytest.mark.parametrize("sig", ["SIGTERM", "SIGKILL"])
 def test_a_killed_batch_leaves_no_process_and_no_temp_folder(inputs, tmp_path, sig) -> None:
