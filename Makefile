@@ -17,7 +17,7 @@ setup: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/polyfold info examples/bunny-128.obj
 	$(BIN)/polyfold make examples/bunny-128.obj -o out/bunny-128
-	@echo "open out/bunny-128/instructions.html; print out/bunny-128/sheets.pdf at 100 %"
+	@echo "open out/bunny-128/instructions.html (the assembly guide, also guide.pdf); print out/bunny-128/sheets.pdf at 100 %"
 
 # two workers (the CI machine's two cores), then the tests that must run alone
 test: $(STAMP)
