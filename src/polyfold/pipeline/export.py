@@ -169,7 +169,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         if guide is not None:
             from ..formats.guide_pdf import guide_pdf_bytes
 
-            intro = guide_intro(opts, sheets.packing.n_pages, len(parts), len(sheets.pieces),
+            intro = guide_intro(opts, sheets.packing.n_pages, len(parts), sheets.pieces,
                                 any(g.printed != g.label for g in sheets.glue))
             guide_pdf, guide_pages = guide_pdf_bytes(guide, f"Building {model}", (sheets.width, sheets.height), intro)
             stage.write("guide.pdf", guide_pdf)

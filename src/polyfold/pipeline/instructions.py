@@ -32,9 +32,12 @@ def _edge(g) -> str:
     return g.label if g.printed == g.label else f"{g.label} (run {g.printed})"
 
 
-def guide_intro(opts: MakeOptions, n_pages: int, n_parts: int, n_pieces: int, seam_runs: bool) -> list[str]:
-    """The paragraphs (plain text) before the guide's pictures, in instructions.html and guide.pdf."""
-    out = [f"{n_parts} part(s), {n_pieces} piece(s) on {n_pages} {opts.paper} page(s); model {opts.size:g} mm long. "
+def guide_intro(opts: MakeOptions, n_pages: int, n_parts: int, pieces, seam_runs: bool) -> list[str]:
+    """The paragraphs (plain text) before the guide's pictures, in instructions.html and guide.pdf
+    (pieces: the sheets' pieces, glue strips included)."""
+    strips = sum(1 for p in pieces if len(p.face_ids) == 0)
+    counted = f"{len(pieces) - strips} piece(s)" + (f" and {strips} glue strip(s)" if strips else "")
+    out = [f"{n_parts} part(s), {counted} on {n_pages} {opts.paper} page(s); model {opts.size:g} mm long. "
            "Print sheets.pdf (or sheet-NN.svg) at 100 % (no scaling: measure the scale bar in the footer) and cut "
            "with cut-NN.svg on a cutting machine (black is cut; red mountain and blue valley lines are scored), or "
            "by hand along the black lines; on paper mountains are red dash-dot and valleys blue dashed."]
@@ -108,7 +111,7 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
          f"<h1>Building {escape(name)}</h1>"]
     if guide is None:
         h.append(f"<p><img src='data:image/png;base64,{_png_b64(mesh, part_faces, None)}' alt='the model, parts in colour'></p>")
-    h += [f"<p>{escape(p)}</p>" for p in guide_intro(opts, n_pages, len(part_faces), len(pieces), seam_runs)]
+    h += [f"<p>{escape(p)}</p>" for p in guide_intro(opts, n_pages, len(part_faces), pieces, seam_runs)]
     if guide is not None:
         h.append("<p>Contents: <a href='#where'>where each piece goes</a>, <a href='#steps'>build steps</a>, "
                  "<a href='#sheets'>sheets</a>, <a href='#seams'>every seam by part</a>. The same steps are in "
