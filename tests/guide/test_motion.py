@@ -58,7 +58,7 @@ def test_a_box_closes_last_around_its_lid() -> None:
         if face_piece[f0] != face_piece[f1]:
             u, v = (int(x) for x in topo.edges[e])
             seams.append(Seam(pieces=(int(face_piece[f0]), int(face_piece[f1])), faces=(int(f0), int(f1)),
-                              mesh_edge=(u, v), length_mm=100.0, run=str(len(seams) + 1)))
+                              mesh_edge=(u, v), edge=e, length_mm=100.0, run=str(len(seams) + 1)))
     assert len(seams) == 12
     plan = plan_build(box, [0] * 6, piece_faces, seams, mm_per_unit=100.0, max_seams=4)
     assert sorted(plan.piece_order) == list(range(6))

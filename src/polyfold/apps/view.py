@@ -485,14 +485,15 @@ class Viewer:
                 return
             k = min(k, len(steps))
             step = steps[k - 1]
-            placed = set(self.folder.placed_after(k))
+            order = self.folder.placed_after(k)
+            placed = set(order)
             names = [p.name for p in self.folder.pieces]
             if step.piece in names:
                 new = {names.index(step.piece)}
             else:  # gluing on: the pieces of its seams (the last placed and those it glues to)
                 new = {names.index(n) for n in step.attach_to if n in names}
-                if step.kind == "glue" and self.folder.placed_after(k):
-                    new.add(self.folder.placed_after(k)[-1])
+                if step.kind == "glue" and order:
+                    new.add(order[-1])
             for node in (*self._part_nodes, *self.look_nodes, *self._net_nodes, *(h for _, h in self._fold_nodes)):
                 node.visible = False
             for i, h in enumerate(self._build_nodes):

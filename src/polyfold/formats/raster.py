@@ -64,18 +64,24 @@ def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> Non
     _zfill(img, zbuf, tris, np.zeros(tris.shape[:2]), np.ascontiguousarray(colors, dtype=np.uint8))
 
 
+def segment_samples(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points every half pixel along pixel-space segments (n, 2, 2+) (ends included): (segment
+    of each point, its fraction t along it), from the first two coordinates' lengths."""
+    length = np.hypot(seg[:, 1, 0] - seg[:, 0, 0], seg[:, 1, 1] - seg[:, 0, 1])
+    counts = np.ceil(length / 0.5).astype(np.int64) + 1
+    idx = np.repeat(np.arange(len(seg)), counts)
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    return idx, (np.arange(counts.sum()) - starts) / np.repeat(np.maximum(counts - 1, 1), counts)
+
+
 def draw_segments(img: np.ndarray, seg: np.ndarray, color: tuple[int, int, int], thick: int = 1) -> None:
     """Draw pixel-space segments (n, 2, 2) into img (H, W, 3) in place: points every half pixel
     along each segment, one pixel wide, or a 2 x 2 pixel pen when thick > 1."""
     if len(seg) == 0:
         return
     H, W = img.shape[:2]
+    idx, t = segment_samples(seg)
     a, b = seg[:, 0], seg[:, 1]
-    length = np.hypot(*(b - a).T)
-    counts = np.ceil(length / 0.5).astype(np.int64) + 1
-    idx = np.repeat(np.arange(len(seg)), counts)
-    starts = np.repeat(np.cumsum(counts) - counts, counts)
-    t = (np.arange(counts.sum()) - starts) / np.repeat(np.maximum(counts - 1, 1), counts)
     pts = a[idx] + t[:, None] * (b - a)[idx]
     offs = [0.0] if thick <= 1 else [-0.5, 0.5]
     for dx in offs:

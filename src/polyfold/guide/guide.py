@@ -91,6 +91,11 @@ class Guide:
     plan: BuildPlan
     seconds: float
 
+    @property
+    def pictures(self) -> int:
+        """How many pictures it has (each embedded once in guide.pdf and in instructions.html)."""
+        return len(self.overview) + sum(map(len, self.parts)) + sum(1 + len(s.folding) for s in self.steps)
+
 
 def _seams(mesh: Mesh, pieces, glue, folded, scale: float) -> tuple[list[Seam], dict[int, dict]]:
     """The plan's seams of the sheets' glue pairs (meeting times from the pieces' paths), and per
@@ -119,8 +124,8 @@ def _seams(mesh: Mesh, pieces, glue, folded, scale: float) -> tuple[list[Seam], 
             k = seam_meet_frame(p["tree"].parent, p["tree"].crease, p["done"], p["face_of"][fa], p["face_of"][fb])
             meet = k / (len(p["frames"]) - 1)
         length = float(np.linalg.norm(mesh.vertices[u] - mesh.vertices[v])) * scale
-        out.append(Seam(pieces=(int(a), int(b)), faces=(fa, fb), mesh_edge=(u, v), length_mm=length, run=g.printed,
-                        meet=meet))
+        out.append(Seam(pieces=(int(a), int(b)), faces=(fa, fb), mesh_edge=(u, v), edge=e, length_mm=length,
+                        run=g.printed, meet=meet))
     return out, paths
 
 

@@ -42,6 +42,7 @@ class Seam:
     pieces: tuple[int, int]
     faces: tuple[int, int]
     mesh_edge: tuple[int, int]
+    edge: int  # its row in the mesh's edge table (`Mesh.topology`)
     length_mm: float
     run: str  # seams with the same run are glued together (a seam run printed under one label)
     meet: float = 1.0
@@ -133,8 +134,7 @@ def _lid(mesh: Mesh, faces: np.ndarray, seam_faces: np.ndarray) -> int:
     from ..mesh.geometry import face_areas
 
     area = face_areas(mesh.vertices, mesh.faces[faces])
-    seams = np.bincount(np.searchsorted(np.sort(faces), seam_faces[np.isin(seam_faces, faces)]),
-                        minlength=len(faces))[np.argsort(np.argsort(faces))]
+    seams = np.bincount(seam_faces, minlength=mesh.n_faces)[faces]
     return int(faces[np.lexsort((-area, -seams))[0]])
 
 
@@ -160,7 +160,6 @@ def plan_build(mesh: Mesh, piece_part: list[int], piece_faces: list[np.ndarray],
     lid = _lid(mesh, np.asarray(piece_faces[piece_order[-1]], dtype=np.int64), seam_faces)
     dist = face_distances(mesh, lid)
     far = np.array([min(dist[s.faces[0]], dist[s.faces[1]]) for s in seams]) if seams else np.zeros(0)
-    far = np.where(np.isfinite(far), far, np.inf)
 
     # every seam to the step where both its sides are in the model
     buckets: dict[tuple, list[int]] = {}
@@ -229,9 +228,7 @@ def opening_rims(mesh: Mesh, piece_faces: list[np.ndarray], seams: list[Seam], s
     topo = mesh.topology
     edges, ef = topo.edges, topo.edge_faces
     length = np.linalg.norm(mesh.vertices[edges[:, 0]] - mesh.vertices[edges[:, 1]], axis=1) * mm_per_unit
-    keys = edges[:, 0] * mesh.n_vertices + edges[:, 1]
-    seam_edge = np.array([np.searchsorted(keys, min(s.mesh_edge) * mesh.n_vertices + max(s.mesh_edge))
-                          for s in seams], dtype=np.int64)
+    seam_edge = np.array([s.edge for s in seams], dtype=np.int64)
     is_seam = np.zeros(len(edges), dtype=bool)
     is_seam[seam_edge] = True
     face_piece = np.full(mesh.n_faces, -1, dtype=np.int64)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..formats.raster import _zfill, part_colors, view_rotation
+from ..formats.raster import _zfill, part_colors, segment_samples, view_rotation
 
 BACKGROUND = (255, 255, 255)
 INSIDE_RGB = (214, 214, 214)  # the unprinted side of the paper
@@ -139,9 +139,7 @@ def draw_lines(img: np.ndarray, cam: Camera, zbuf: np.ndarray | None, segs: np.n
         return np.zeros(0)
     px, depth = cam.project(segs)
     a, b = px[:, 0], px[:, 1]
-    counts = np.ceil(np.hypot(*(b - a).T) / 0.5).astype(np.int64) + 2
-    idx = np.repeat(np.arange(len(segs)), counts)
-    t = (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)) / np.repeat(counts - 1, counts)
+    idx, t = segment_samples(px)
     pts = a[idx] + t[:, None] * (b - a)[idx]
     d = depth[idx, 0] + t * (depth[idx, 1] - depth[idx, 0])
     h, w = img.shape[:2]
@@ -165,7 +163,7 @@ def draw_lines(img: np.ndarray, cam: Camera, zbuf: np.ndarray | None, segs: np.n
             y = np.floor(pts[seen, 1] + dy).astype(np.int64)
             ok = (x >= 0) & (x < w) & (y >= 0) & (y < h)
             img[y[ok], x[ok]] = color
-    return np.bincount(idx, weights=seen, minlength=len(segs)) / counts
+    return np.bincount(idx, weights=seen, minlength=len(segs)) / np.bincount(idx, minlength=len(segs))
 
 
 def label_spots(region: np.ndarray, labels: np.ndarray, min_px: int = 40) -> dict[int, tuple[float, float, float]]:

@@ -173,9 +173,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                                 any(g.printed != g.label for g in sheets.glue))
             guide_pdf, guide_pages = guide_pdf_bytes(guide, f"Building {model}", (sheets.width, sheets.height), intro)
             stage.write("guide.pdf", guide_pdf)
-            pictures = len(guide.overview) + sum(map(len, guide.parts)) + sum(1 + len(s.folding) for s in guide.steps)
             closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
-            guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=pictures,
+            guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=guide.pictures,
                                        pdf_pages=guide_pages, closing_seams=closing)
         report = finish(rows, list(stage.names), printed, len(pdf), guide_report)
         stage.write("report.json", report.to_json())
