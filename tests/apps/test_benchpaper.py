@@ -41,7 +41,7 @@ def test_bench_paper_quick(models_dir, tmp_path):
             assert w["runs"] == 3 and w["paths"] >= 1, name
             for row in (w, w["paper_planner"]):
                 assert sum(row["planners"].values()) == row["paths"] <= row["runs"], name
-                assert set(row["planners"]) <= {"linear", "sequential", "sequential-rrt", "lazy-prm"}
+                assert set(row["planners"]) <= {"linear", "two-phase", "sequential", "sequential-rrt", "lazy-prm"}
             assert set(w["paper_planner"]["planners"]) <= {"linear", "lazy-prm"}
     # Fig. 3: constrained inflation needs far less deformation than uniform (paper: about 1/4)
     f3 = data["fig3"]

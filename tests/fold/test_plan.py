@@ -1,5 +1,5 @@
-"""The planners behind fold/plan.py's `plan_fold` (linear, sequential with its RRT-Connect
-unlocking, Lazy PRM), their paths judged by the independent path checker (tests/path_checker.py,
+"""The planners behind fold/plan.py's `plan_fold` (linear, two-phase, sequential with its
+RRT-Connect unlocking, Lazy PRM), their paths judged by the independent path checker (tests/path_checker.py,
 which does not import polyfold): a net whose straight-line fold collides, whole meshes, a net
 without creases."""
 
@@ -14,8 +14,11 @@ from path_checker import FoldNet, check_path
 from polyfold.fold.plan import is_linearly_foldable, plan_fold
 from polyfold.formats.fold import fold_tree, net_to_fold, with_path
 from polyfold.formats.meshes import load_mesh
+from polyfold.fold.tree import FoldTree
 from polyfold.mesh.geometry import merged_edges
+from polyfold.segment.segment import segment
 from polyfold.unfold.search import unfold
+from polyfold.verify.paths import check_fold_path
 
 
 # ----------------------------------------------------------------------------------------------
@@ -95,7 +98,50 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
         assert hit is None, f"segment {s} collides at {hit}"
 
 
-@pytest.mark.parametrize("planner", ["auto", "linear", "sequential", "lazy-prm"])
+# ----------------------------------------------------------------------------------------------
+# Two-phase: the straight line with one crease out of step
+
+
+def test_two_phase_folds_one_crease_apart_where_the_straight_line_collides(models_dir):
+    """periscope-28 in two parts: some seeds' nets of the 26-face part collide on the straight
+    line (two flaps close onto each other); holding one crease back gives a 3-frame path that the
+    two independent checkers accept, at zero and at the default thickness."""
+    part = segment(load_mesh(models_dir / "periscope-28.obj").mesh, parts=2).parts[0]
+    found = 0
+    for seed in range(1, 21):
+        net, stats = unfold(part, seed=seed)
+        assert stats.pieces == 1
+        fold = net_to_fold([net])
+        tree = FoldTree.from_net(net)
+        thick = tree.with_thickness(1e-3 * tree.scale)
+        if plan_fold(thick, planner="linear") is not None:
+            continue
+        path = plan_fold(thick, planner="two-phase", seed=seed)
+        assert path is not None and path.planner == "two-phase" and not path.linear
+        assert path.frames.shape == (3, tree.n_edges)
+        # the middle frame: one crease out of step (alone flat, the rest folded; or the reverse)
+        mid, goal = path.frames[1][tree.creases], tree.goal[tree.creases]
+        at_goal, flat = np.isclose(mid, goal), np.isclose(mid, 0.0)
+        moving = goal != 0.0
+        assert (at_goal | flat).all()
+        assert min(int((flat & moving).sum()), int((at_goal & moving).sum())) == 1
+        written = with_path(fold, path, 1.0, 1e-7, thick.thickness)
+        assert check_path(written).ok
+        report = check_fold_path(written, thickness=thick.thickness)
+        assert report.ok, report.why()
+        assert plan_fold(thick, seed=seed).planner == "two-phase"  # "auto" tries it before the sequential planner
+        found += 1
+    assert found >= 2, "expected some seeds whose straight line collides"
+
+
+def test_two_phase_returns_the_straight_line_when_it_is_free(models_dir):
+    net, _ = unfold(load_mesh(models_dir / "cube-12.obj").components[0], seed=1)
+    tree = FoldTree.from_net(net)
+    path = plan_fold(tree, planner="two-phase")
+    assert path.linear and path.planner == "linear" and len(path.frames) == 2
+
+
+@pytest.mark.parametrize("planner", ["auto", "linear", "two-phase", "sequential", "lazy-prm"])
 def test_every_planner_handles_a_net_without_creases(models_dir, planner):
     mesh = load_mesh(models_dir / "tetrahedron-4.obj").mesh.submesh(np.array([0]))
     net, _ = unfold(mesh)

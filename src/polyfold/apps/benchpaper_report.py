@@ -218,7 +218,8 @@ def _speedups(t2: dict) -> list[str]:
 def _table2_notes(t2: dict) -> list[str]:
     """Markdown lines under Table 2: the planners, the contact tolerances, the fish's inflation."""
     L = ["", "Planners: 'whole' and 'parts' rows use `plan_fold`'s default: the straight line (the paper's LC "
-         "test), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
+         "test), then 'two-phase' (not in the paper: the straight line with one crease, on the tree path between the "
+         "faces that collided, folded after or before the rest), then the sequential planner (not in the paper: the folded shape is unfolded one crease at a time, "
          "the first free crease in a priority order, restarts with the stuck creases first, two base orders in turn; "
          "'sequential-rrt': when at most 32 creases lock, an RRT-Connect search over their continuous angles), then Lazy PRM. "
          f"'whole, paper's planner' rows: the straight line, then Lazy PRM only (ALGORITHMS.md 6.5), on the first "

@@ -140,6 +140,7 @@ def sweep_collides(tris, geo, sb, si, tol, big, ids, thick):
     piece, rigid, non-degenerate, scratch. thick (2,): the paper's thickness and the reach of a
     shared point (`triangles.thick_collides`, which then tests the pairs, with ids (F, 6) the net
     and mesh vertex ids of every corner); thickness 0: `faces_cross`, ids unread.
+    Returns the first crossing pair as the key i * F + j (face ids, i the face swept from), or -1.
     """
     n = tris.shape[0]
     h = thick[0]
@@ -194,10 +195,10 @@ def sweep_collides(tris, geo, sb, si, tol, big, ids, thick):
             if h > 0.0:
                 fa, fb = (i, j) if c < later else (j, i)
                 if thick_collides(a, b, ga, gb, _ids(ids, fa), _ids(ids, fb), tol, h, thick[1]):
-                    return True
+                    return i * n + j
             elif faces_cross(a, b, ga, gb, tol):
-                return True
-    return False
+                return i * n + j
+    return -1
 
 
 @njit(cache=True, inline="always")

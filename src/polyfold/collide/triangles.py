@@ -394,7 +394,7 @@ def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
     return _beside(a, ga, b, mb, d, tol)  # b's corner beside a's, seen along a's normal
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _wedge_clear(a, ga, b, mb, gap, reach, tol):
     """True when b neither crosses a's plane nor comes within gap of it farther than reach from
     its shared corners (mb): b's other corners lie beyond gap on one side, its shared corners not
@@ -417,7 +417,8 @@ def _wedge_clear(a, ga, b, mb, gap, reach, tol):
     if flat or sides == 3:  # b meets a's plane along a segment from the shared corner
         return _straddle_clear(a, ga, b, mb, d, gap, reach, tol)
     up = sides == 1
-    wedge = 0.0
+    short = True  # the wedge |e| gap / |d| (e: shared -> free corner) plus gap within reach, squared: no sqrt
+    room = (reach - gap) * (reach - gap)
     for k in range(3):
         if mb & (1 << k):
             if (d[k] < -tol) if up else (d[k] > tol):
@@ -425,9 +426,9 @@ def _wedge_clear(a, ga, b, mb, gap, reach, tol):
             for c in range(3):
                 if not mb & (1 << c):
                     e = (b[c][0] - b[k][0], b[c][1] - b[k][1], b[c][2] - b[k][2])
-                    wedge = max(wedge, math.sqrt(_dot(e, e)) * gap / abs(d[c]))
+                    short &= _dot(e, e) * gap * gap <= room * d[c] * d[c]
     # a short wedge; or, seen along a's normal, b's corner beside a's (nearly flat neighbours)
-    return wedge + gap <= reach or _beside(a, ga, b, mb, d, tol)
+    return (short and reach >= gap) or _beside(a, ga, b, mb, d, tol)
 
 
 @njit(cache=True, inline="always")

@@ -41,18 +41,20 @@ def collision_work(n_faces):
     order (face ids by lo x; kept from call to call, it is the next call's starting guess), then
     per position parent, piece, rigid group, non-degenerate flag, and scratch for the candidates
     of one face; last (F, 2), R, T,
-    out: the folded state of the previous call (see `kinematics.fold_faces`); meta (1,): the tol geo was filled
-    with (NaN: geo not of out). The state changes only the cost, never a verdict. ids (F, 6),
+    out: the folded state of the previous call (see `kinematics.fold_faces`); meta (3,): the tol geo was filled
+    with (NaN: geo not of out), then the face pair of the last collision found (`last_hit`). The state changes only the cost, never a verdict. ids (F, 6),
     thick (2,): the corners' net and mesh vertex ids and (thickness, reach) for the thickness test
     (`collide.sweep.sweep_collides`; thickness 0 here: `with_thickness` sets them).
     """
     si = np.empty((6, n_faces), dtype=np.int64)
     last = np.empty((n_faces, 2))
-    meta = np.empty(1)
+    meta = np.empty(3)
     for f in range(n_faces):  # (loops, not np.full: that takes seconds to compile)
         si[0, f] = f
         last[f, 0] = np.nan
     meta[0] = np.nan
+    meta[1] = -1.0
+    meta[2] = -1.0
     ids = np.empty((n_faces, 6), dtype=np.int64)
     ids[:] = -1
     return (np.empty((n_faces, GEO_SIZE)), np.empty((7, n_faces)), si, last,
@@ -89,7 +91,10 @@ def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, ri
         fill_face_geometry(out, tol, geo, last)
         sort_by_lo_x(geo, sb, si)
         gather_boxes(geo, parent, piece, rigid, sb, si)
-        if sweep_collides(out, geo, sb, si, tol, big, ids, thick):
+        key = sweep_collides(out, geo, sb, si, tol, big, ids, thick)
+        if key >= 0:
+            meta[1] = key // out.shape[0]
+            meta[2] = key % out.shape[0]
             return True, checked
     return False, checked
 
@@ -189,12 +194,24 @@ class ValidityChecker:
         self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
         self.configs = 0
         self.edges = 0
+        self.hit_q: np.ndarray | None = None
 
     def valid(self, q: np.ndarray) -> bool:
         t = self.tree
         self.configs += 1
-        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
-                                          t.tol, self.work)
+        if config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
+                                  t.tol, self.work):
+            self.hit_q = np.array(q, dtype=np.float64)
+            return False
+        return True
+
+    def last_hit(self) -> tuple[np.ndarray, int, int] | None:
+        """The last collision a query met: (configuration (E,), face i, face j), or None when
+        none has failed yet. (A planner's hint where a motion is blocked: which faces meet.)"""
+        if self.hit_q is None:
+            return None
+        meta = self.work[7]
+        return self.hit_q.copy(), int(meta[1]), int(meta[2])
 
     def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
         """The straight motion qa -> qb sampled every `step` radians at most (default: the
@@ -210,6 +227,8 @@ class ValidityChecker:
         free, n = segment_free(qa, qb, m, t.order, t.parent, t.crease, t.axis,
                                t.flat, t.piece, t.tol, self.q, max_samples, self.work)
         self.configs += n
+        if not free:
+            self.hit_q = self.q.copy()
         return bool(free)
 
 

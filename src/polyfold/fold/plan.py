@@ -6,6 +6,10 @@ sampled at `resolution` (ALGORITHMS.md 6.3-6.5).
 
 Planners ("auto" runs them in this order):
 1. linear: the straight line C_s -> C_g (bisection order, early exit) — the paper's LC test;
+   "auto" asks it through two-phase, which starts with the straight line;
+1b. two-phase: where the straight line is blocked, the same with one crease out of step (the
+   rest first with it flat, then it alone; or the reverse), the crease chosen on the tree path
+   between the two faces that collided (not in the paper);
 2. sequential: unfold the folded shape one crease at a time (not in the paper, `sequential.py`),
    with a continuous RRT-Connect search over the last few creases when they lock (the path is
    then reported as "sequential-rrt");
@@ -101,6 +105,60 @@ def plan_linear(tree: FoldTree, check: ValidityChecker, deadline: Deadline, sett
     return None
 
 
+TWO_PHASE_CANDIDATES = 4  # creases the two-phase planner tries out of step, nearest the collision first
+
+
+def plan_two_phase(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
+                   settings: PlannerSettings) -> Found | None:
+    """The straight line with one crease out of step: two segments, flat -> mid -> goal.
+
+    Where the straight line is blocked, the two faces the check found colliding are usually a
+    flap closing too early onto the face it ends beside. One crease on the tree path between them
+    is moved apart from the rest: the rest fold first with it held flat, then it folds alone (or
+    it first, then the rest). Candidates: the creases of the two faces first, then their
+    parents' and so on, at most TWO_PHASE_CANDIDATES. Each segment is checked at half the
+    resolution, as the straight line; the one where a single crease moves (cheap: most pairs
+    keep their pose) first. The straight line itself when it is free.
+    """
+    zero, goal = np.zeros(len(tree.goal)), tree.goal
+    fine = check.step / 2
+    if check.segment(zero, goal, fine):
+        return Found(np.stack([zero, goal.copy()]), "linear", 2, True)
+    hit = check.last_hit()
+    if hit is None or hit[1] < 0:
+        return None
+    moving = [c for c in _creases_between(tree, hit[1], hit[2]) if goal[c] != 0.0]
+    for c in moving[:TWO_PHASE_CANDIDATES]:
+        for alone_last in (True, False):
+            if deadline.expired():
+                return None
+            mid = goal.copy() if alone_last else zero.copy()
+            mid[c] = 0.0 if alone_last else goal[c]
+            single, rest = ((mid, goal), (zero, mid)) if alone_last else ((zero, mid), (mid, goal))
+            if check.valid(mid) and check.segment(*single, fine) and check.segment(*rest, fine):
+                return Found(np.stack([zero, mid, goal.copy()]), "two-phase", 3, False)
+    return None
+
+
+def _creases_between(tree: FoldTree, i: int, j: int) -> list[int]:
+    """The creases (edge ids) on the tree path between faces i and j, nearest the two faces
+    first (j's crease, i's crease, then their parents', ...)."""
+    up_i = [i]
+    while tree.parent[up_i[-1]] >= 0:
+        up_i.append(int(tree.parent[up_i[-1]]))
+    on_i = {f: k for k, f in enumerate(up_i)}
+    up_j = [j]
+    while up_j[-1] not in on_i:
+        if tree.parent[up_j[-1]] < 0:
+            return []  # different pieces: no path
+        up_j.append(int(tree.parent[up_j[-1]]))
+    side_i, side_j = up_i[:on_i[up_j[-1]]], up_j[:-1]  # faces below the common ancestor
+    out = []
+    for k in range(max(len(side_i), len(side_j))):
+        out += [int(tree.crease[side[k]]) for side in (side_j, side_i) if k < len(side)]
+    return out
+
+
 def _sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settings: PlannerSettings) -> Found | None:
     found = plan_sequential(tree, check, deadline, np.random.default_rng(settings.seed))
     if found is None:
@@ -118,11 +176,12 @@ def _lazy_prm(tree: FoldTree, check: ValidityChecker, deadline: Deadline, settin
 
 
 # Planners by name, interchangeable over one validity checker and one deadline.
-PLANNER_REGISTRY: dict[str, Planner] = {"linear": plan_linear, "sequential": _sequential, "lazy-prm": _lazy_prm}
+PLANNER_REGISTRY: dict[str, Planner] = {"linear": plan_linear, "two-phase": plan_two_phase,
+                                         "sequential": _sequential, "lazy-prm": _lazy_prm}
 # "auto": each in turn, each until its share of the time limit (from the start) is used; the Lazy
 # PRM keeps a third for the rare net the sequential planner cannot unlock (it finds nothing on
 # large nets, but may on a small one).
-AUTO = (("linear", 1.0), ("sequential", SEQUENTIAL_SHARE), ("lazy-prm", 1.0))
+AUTO = (("two-phase", 1.0), ("sequential", SEQUENTIAL_SHARE), ("lazy-prm", 1.0))
 PLANNERS = ("auto", *PLANNER_REGISTRY)
 
 
@@ -139,19 +198,24 @@ def plan_fold(
     """Plan a collision-free folding path; None when none is found in time (`time_limit` seconds,
     or until `deadline` when one is given).
 
-    planner: "linear" (straight line only), "sequential" (crease-by-crease unfolding of the goal
-    only), "lazy-prm" (Lazy PRM only, as the paper after its LC test), "auto" (straight line,
-    then sequential, then Lazy PRM for the time left). Raises PolyfoldError when the flat net or
+    planner: "linear" (straight line only), "two-phase" (the straight line, else one crease out of
+    step), "sequential" (crease-by-crease unfolding of the goal only), "lazy-prm" (Lazy PRM only,
+    as the paper after its LC test), "auto" (straight line, two-phase, then sequential, then Lazy
+    PRM for the time left). Raises PolyfoldError when the flat net or
     the goal itself self-intersects (then no path can exist).
     """
     if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}")
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit) if deadline is None else deadline
+    straight = Found(np.stack([np.zeros(len(tree.goal)), tree.goal.copy()]), "linear", 2, True)
+    if tree.n_faces <= 2:  # no pair to test (a crease pair, or two pieces): every configuration is free
+        return FoldPath(frames=straight.frames, linear=True, planner="linear", seconds=time.perf_counter() - t0,
+                        edges_checked=0, configs_checked=0, nodes=2)
     check = ValidityChecker(tree, math.radians(resolution_deg))
     _check_ends(tree, check)
     if len(tree.creases) == 0:  # single faces (no DOF): the flat net is the goal, whatever the planner
-        found = Found(np.stack([np.zeros(len(tree.goal)), tree.goal.copy()]), "linear", 2, True)
+        found = straight
     else:
         settings = PlannerSettings(seed, n0, k_neighbours)
         steps = AUTO if planner == "auto" else ((planner, 1.0),)

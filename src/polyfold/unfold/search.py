@@ -413,7 +413,9 @@ def unfold(
     if max_pieces == 1 and problem.single_net_blocked():  # no search can succeed: say so at once
         raise NoNetFound("no single-piece net can keep the flat regions whole (hyperbolic vertices on their "
                          "edges need cuts that split the net)")
-    if mesh.n_faces == 1:
+    if np.count_nonzero(mesh.topology.interior) == mesh.n_faces - 1:
+        # the faces' adjacency is a tree (one face, or a strip that closes no loop): the one
+        # spanning tree there is, whatever the weights
         weights = np.zeros(mesh.topology.n_edges)
         fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
     elif method == "auto":

@@ -227,7 +227,7 @@ def test_unfold_fold_gives_a_checked_path(folded_parts, name):
     fold = json.loads(net.read_text())
     assert fold["polyfold:path_resolutionDeg"] == 1.0
     assert fold.get("polyfold:path_contactTol", 1e-7) == 1e-7
-    assert fold["polyfold:path_planner"] in ("linear", "sequential", "sequential-rrt", "lazy-prm")
+    assert fold["polyfold:path_planner"] in ("linear", "two-phase", "sequential", "sequential-rrt", "lazy-prm")
     assert fold["polyfold:path_linear"] == (len(fold["polyfold:path"]) == 2)
     report = check_path(net)
     assert report.ok, str(report)

@@ -19,6 +19,7 @@ _D = MakeOptions()
 class Planner(str, Enum):
     auto = "auto"
     linear = "linear"
+    two_phase = "two-phase"
     sequential = "sequential"
     lazy_prm = "lazy-prm"
 
