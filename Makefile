@@ -10,6 +10,8 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[test,viewer,batch,bench]'
+	@echo "compiling polyfold's numba kernels into their cache (about a minute, once), so the first run does not wait"
+	$(BIN)/polyfold warm-up
 	touch $(STAMP)
 
 setup: $(STAMP)

@@ -107,7 +107,7 @@ def collision_table() -> None:
             best = min(best, time.thread_time() - t)
         return best
 
-    def line_us(tree) -> float:
+    def line_us(tree) -> float | None:
         """The straight line's 0.5 degree samples in order, up to the first that collides, in one
         call (as a segment)."""
         m = int(math.ceil(np.abs(tree.goal).max() / math.radians(0.5) - 1e-12))
@@ -116,6 +116,8 @@ def collision_table() -> None:
         args = (zero, tree.goal, ks, m, tree.order, tree.parent, tree.crease, tree.axis, tree.flat, tree.piece,
                 np.arange(tree.n_faces), tree.tol, work, np.empty(tree.n_edges))
         checked = segment_collides(*args)[1]
+        if checked == 0:  # a goal within half a degree of flat: no sample to time
+            return None
         return best_of(lambda: segment_collides(*args)) / checked * 1e6
 
     def path_us(tree, frames) -> float:

@@ -289,13 +289,14 @@ def kernel_signatures() -> dict[str, set[str]]:
 
     from numba.core.registry import CPUDispatcher
 
+    root = __package__.partition(".")[0]  # polyfold (this module is in polyfold.apps)
     out: dict[str, set[str]] = {}
     for module_name, module in list(sys.modules.items()):
-        if module is None or not module_name.startswith(f"{__package__}."):
+        if module is None or not module_name.startswith(f"{root}."):
             continue
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module_name:
-                out[f"{module_name.removeprefix(__package__ + '.')}.{name}"] = {str(s) for s in obj.signatures}
+                out[f"{module_name.removeprefix(root + '.')}.{name}"] = {str(s) for s in obj.signatures}
     return out
 
 
@@ -303,6 +304,7 @@ def _warm_up(models: Path) -> None:
     """Call every timed stage once on small models, so numba compiles (fresh checkout) or loads
     its caches before the clock runs: without it the first timed run of a stage carries seconds
     of compilation (a cold checkout put 35 s into one horse segmentation)."""
+    from ..collide.self_intersect import crossing_pairs
     from ..fold.cspace import sample_ratio
     from ..inflate.inflate import inflate
     from ..formats.meshes import load_mesh
@@ -311,6 +313,9 @@ def _warm_up(models: Path) -> None:
     small = load_mesh(models / "periscope-28.obj").mesh
     inflate(small, mode="constrained", max_steps=20)
     inflate(small, mode="uniform", max_steps=20)
+    # inflation's self-intersection guard with pairs to skip (a mesh that crosses itself at the
+    # start, as the fish): its own compiled variant
+    crossing_pairs(small.vertices, small.faces, 1e-9, 1, np.array([1], dtype=np.int64))
     # the bunny reaches the segmentation's concavity kernels and the unfolder's local search;
     # a horse patch the planners' kernels for a net that does not fold along a straight line
     bunny = load_mesh(models / "bunny-128.obj").mesh

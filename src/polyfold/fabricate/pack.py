@@ -201,8 +201,11 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     a, b = p0[e], p1[e]
     u = a[:, 0] + (r + 0.5 - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
     c = np.clip(np.ceil(u - 0.5), 0, w).astype(np.int64)  # first column whose centre is right of u
-    toggles = np.bincount(r * (w + 1) + c, minlength=h * (w + 1)).reshape(h, w + 1)[:, :w]
-    return (np.cumsum(toggles, axis=1) & 1).astype(bool)
+    # parity only: counts and running sums modulo 256 (uint8 wraps) keep it, at an eighth of the memory
+    toggles = np.bincount(r * (w + 1) + c, minlength=h * (w + 1)).astype(np.uint8).reshape(h, w + 1)[:, :w]
+    inside = np.cumsum(toggles, axis=1, dtype=np.uint8)
+    inside &= 1
+    return inside.view(bool)
 
 
 @dataclass
@@ -428,9 +431,26 @@ def _phase(seed: int, angles: int, rng: np.random.Generator | None = None) -> fl
     return float(rng.uniform(0.0, 360.0 / max(angles, 1)))
 
 
+_PIECE_CACHE: dict[tuple, tuple[_Piece, float]] = {}
+_PIECE_CACHE_SIZE = 512  # pieces kept (a make's page planning packs the same outlines dozens of times)
+
+
 def _piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:
     """A `_Piece` for the outline with the rotations to try, and the largest scale at which it fits
-    the printable area in one of them."""
+    the printable area in one of them. The same outline on the same grid gives the same piece, its
+    rasters included: page planning packs one set of outlines many times (every split tried), so
+    pieces are kept, by the outline's exact coordinates, in a bounded cache."""
+    key = (shapely.to_wkb(g), angles, phase, grid)
+    got = _PIECE_CACHE.get(key)
+    if got is None:
+        got = _new_piece(g, angles, phase, grid)
+        if len(_PIECE_CACHE) >= _PIECE_CACHE_SIZE:
+            del _PIECE_CACHE[next(iter(_PIECE_CACHE))]  # the oldest
+        _PIECE_CACHE[key] = got
+    return got
+
+
+def _new_piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:
     xy = _hull_xy(g)
     degs = _angles(g, angles, phase)
     if phase != 0.0:  # keep fits_page's best rotation, so its "fits" always holds here too

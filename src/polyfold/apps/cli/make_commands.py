@@ -325,3 +325,16 @@ def bench_paper(
     if not data["figures"]:
         say("warning: matplotlib is not installed (pip install polyfold[bench]): no figures, tables only")
     say(f"bench paper: {time.perf_counter() - t0:.0f} s -> {output / 'report.md'}")
+
+
+@app.command("warm-up")
+@guard
+def warm_up() -> None:
+    """Compile the numba kernels into numba's cache now (about a minute, once per install), so the
+    first real command does not wait for them; `make setup` runs it."""
+    from ..warmup import warm_up as run
+
+    t0 = time.perf_counter()
+    seconds = run(progress=say)
+    parts = ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items())
+    say(f"warm-up: kernels compiled and cached in {time.perf_counter() - t0:.1f} s ({parts})")

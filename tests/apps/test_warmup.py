@@ -1,0 +1,32 @@
+"""apps/warmup.py (`polyfold warm-up`, run by `make setup`): it reaches the kernels a first
+`polyfold make` needs, so numba has them in its cache before the user's first run."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from polyfold.apps.benchpaper import kernel_signatures
+from polyfold.apps.warmup import bumpy_sphere, warm_up
+
+
+def test_warm_up_reaches_the_kernels_of_every_stage():
+    seconds = warm_up()
+    assert set(seconds) == {"make", "fold", "segment", "inflate"} and all(s >= 0 for s in seconds.values())
+    sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
+    for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
+                   "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps"):
+        assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
+
+
+def test_bumpy_sphere_is_closed_and_seeded():
+    v, f = bumpy_sphere()
+    assert v.shape == (42, 3) and f.shape == (80, 3)
+    v2, _ = bumpy_sphere()
+    assert (v == v2).all()
+
+
+def test_cli_warm_up_says_what_it_did():
+    proc = subprocess.run([sys.executable, "-m", "polyfold", "warm-up"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "kernels compiled and cached" in proc.stderr
