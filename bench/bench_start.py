@@ -1,0 +1,111 @@
+"""Where a user waits (issue 23), not a test: the first run, start-up, and peak memory.
+
+    .venv/bin/python bench/bench_start.py [--skip-cold] [--sizes 128,1500,5000]
+
+Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-clock, with its
+peak resident memory (the child's own rusage). Cold rows use an empty numba cache of their own
+($NUMBA_CACHE_DIR in a temporary folder, so the project's cache is left alone):
+
+- cold make: `polyfold make` of bunny-128 with nothing compiled (a bare `pip install`);
+- warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
+- warm: `--help`, `info`, `make` with the kernels cached (every later run);
+- make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
+  faces), warm cache, fold on, A4 at 150 mm: seconds and peak memory.
+Prints a table; compile seconds per stage are the cold make's stage times minus the warm ones.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "polyfold").exists() else [sys.executable, "-m", "polyfold"]
+BUNNY = ROOT / "examples" / "bunny-128.obj"
+
+
+def run(args: list[str], env: dict | None = None) -> tuple[float, float, int]:
+    """(wall seconds, peak RSS MB, exit code) of one CLI process."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    err = proc.stderr.read().decode() if proc.stderr else ""
+    if proc.returncode != 0:
+        print(f"  ! {' '.join(args)}: exit {proc.returncode}: {err.strip().splitlines()[-1:]}", file=sys.stderr)
+    return wall, usage.ru_maxrss / 1024.0, proc.returncode
+
+
+def stages(out: Path) -> dict[str, float]:
+    report = json.loads((out / "report.json").read_text())
+    return {k: float(v["seconds"]) for k, v in report.get("stages", {}).items()
+            if isinstance(v, dict) and v.get("seconds")}
+
+
+def sphere_obj(path: Path, faces: int, seed: int = 1) -> int:
+    """A noisy icosphere of about `faces` faces (refined by subdivision), written as OBJ."""
+    import trimesh
+
+    sub = max(1, int(round(np.log(faces / 20) / np.log(4))))
+    sphere = trimesh.creation.icosphere(subdivisions=sub)
+    v = np.asarray(sphere.vertices, dtype=float)
+    v = v * np.clip(1 + np.random.default_rng(seed).normal(0, 0.03, len(v)), 0.8, 1.2)[:, None]
+    f = np.asarray(sphere.faces)
+    path.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f))
+    return len(f)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--skip-cold", action="store_true", help="no cold rows (each compiles for about a minute)")
+    ap.add_argument("--sizes", default="128,1500,5000", help="face counts of the make rows")
+    a = ap.parse_args()
+    rows: list[tuple[str, float, float, str]] = []
+    tmp = Path(tempfile.mkdtemp(prefix="bench-start-"))
+    if not a.skip_cold:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
+        wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env)
+        cold = stages(tmp / "cold")
+        rows.append(("cold make bunny-128 (bare pip install)", wall, mb, ""))
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-setup"))
+        wall, mb, _ = run(["warm-up"], env)
+        rows.append(("warm-up (make setup adds it)", wall, mb, ""))
+        wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "after"), "-q"], env)
+        rows.append(("make bunny-128 after warm-up", wall, mb, ""))
+        warm_stages = stages(tmp / "after")
+        compile_s = {k: cold[k] - warm_stages.get(k, 0.0) for k in cold}
+        rows.append(("  compile s per stage (cold - warm)", sum(compile_s.values()), 0.0,
+                     ", ".join(f"{k} {v:.1f}" for k, v in compile_s.items() if v > 0.05)))
+    run(["make", str(BUNNY), "-o", str(tmp / "prime"), "-q"])  # the project's cache, as after setup
+    for label, args in (("--help", ["--help"]), ("info bunny-128", ["info", str(BUNNY)]),
+                        ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"])):
+        best = min((run(args) for _ in range(3)), key=lambda r: r[0])
+        rows.append((label, best[0], best[1], ""))
+    for n in (int(s) for s in a.sizes.split(",")):
+        if n == 128:
+            continue
+        mesh = tmp / f"sphere-{n}.obj"
+        got = sphere_obj(mesh, n)
+        wall, mb, code = run(["make", str(mesh), "-o", str(tmp / f"make-{n}"), "-q"])
+        note = "" if code == 0 else f"exit {code}"
+        if code == 0:
+            st = stages(tmp / f"make-{n}")
+            note = ", ".join(f"{k} {v:.1f}" for k, v in st.items() if v > 0.05)
+        rows.append((f"make noisy sphere, {got} faces", wall, mb, note))
+    print(f"{'what':44s} {'wall s':>8s} {'peak MB':>8s}  notes")
+    for label, wall, mb, note in rows:
+        print(f"{label:44s} {wall:8.2f} {mb:8.0f}  {note}")
+
+
+if __name__ == "__main__":
+    main()
