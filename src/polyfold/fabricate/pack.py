@@ -187,25 +187,27 @@ def _ring_edges(geom) -> tuple[np.ndarray, np.ndarray]:
     return xy[:-1][same], xy[1:][same]
 
 
+@njit(cache=True)
 def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
-    """(h, w) bool: cells whose centre (c + 0.5, r + 0.5) is inside the rings p0 -> p1 given in
-    cell units (even-odd rule, so holes work). Vectorised scanline: each edge toggles the cells
-    to the right of where it crosses a row's centre line; a cumulative sum gives the parity."""
-    v0, v1 = p0[:, 1], p1[:, 1]
-    lo, hi = np.minimum(v0, v1), np.maximum(v0, v1)
-    r0 = np.clip(np.ceil(lo - 0.5), 0, h).astype(np.int64)  # rows with lo <= r + 0.5 < hi
-    r1 = np.clip(np.ceil(hi - 0.5), 0, h).astype(np.int64)
-    cnt = np.maximum(r1 - r0, 0)
-    e = np.repeat(np.arange(len(cnt)), cnt)
-    r = np.repeat(r0, cnt) + (np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    a, b = p0[e], p1[e]
-    u = a[:, 0] + (r + 0.5 - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    c = np.clip(np.ceil(u - 0.5), 0, w).astype(np.int64)  # first column whose centre is right of u
-    # parity only: counts and running sums modulo 256 (uint8 wraps) keep it, at an eighth of the memory
-    toggles = np.bincount(r * (w + 1) + c, minlength=h * (w + 1)).astype(np.uint8).reshape(h, w + 1)[:, :w]
-    inside = np.cumsum(toggles, axis=1, dtype=np.uint8)
-    inside &= 1
-    return inside.view(bool)
+    """(h, w) bool: cells whose centre (c + 0.5, r + 0.5) is inside the rings p0 -> p1 (e, 2) given
+    in cell units (even-odd rule, so holes work). Scanline: each edge toggles, in every row whose
+    centre line it crosses, the first cell whose centre lies right of the crossing; a running
+    parity along the row then says inside. (Hot: every piece in every rotation tried.)"""
+    toggles = np.zeros((h, w + 1), dtype=np.uint8)
+    for e in range(p0.shape[0]):
+        a0, a1, b0, b1 = p0[e, 0], p0[e, 1], p1[e, 0], p1[e, 1]
+        r0 = min(max(math.ceil(min(a1, b1) - 0.5), 0), h)  # rows with lo <= r + 0.5 < hi
+        r1 = min(max(math.ceil(max(a1, b1) - 0.5), 0), h)
+        for r in range(r0, r1):
+            u = a0 + (r + 0.5 - a1) * (b0 - a0) / (b1 - a1)
+            toggles[r, min(max(math.ceil(u - 0.5), 0), w)] ^= 1  # column w: right of every cell
+    inside = np.empty((h, w), dtype=np.bool_)
+    for r in range(h):
+        parity = 0
+        for c in range(w):
+            parity ^= toggles[r, c]
+            inside[r, c] = parity == 1
+    return inside
 
 
 @dataclass
