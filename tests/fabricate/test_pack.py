@@ -317,3 +317,31 @@ def test_twenty_hundred_vertex_pieces_on_a4_fast():
     packing = pack_outlines(pieces, A4)
     assert time.perf_counter() - t < 1.0
     assert_valid(pieces, packing, 2.0)
+
+
+def test_raster_marks_exactly_the_cells_whose_centres_are_inside():
+    """The packer's scanline raster against shapely's point-in-polygon at every cell centre, on
+    rotated buffered triangles and a ring with a hole (even-odd rule)."""
+    import shapely
+    from shapely import affinity
+
+    from polyfold.fabricate.pack import _raster
+
+    rng = np.random.default_rng(3)
+    shapes = [affinity.rotate(shapely.Polygon(rng.uniform(0, 40, (3, 2))).buffer(rng.uniform(0.5, 3), quad_segs=4),
+                              rng.uniform(0, 360)) for _ in range(20)]
+    shapes.append(shapely.Point(20, 20).buffer(15).difference(shapely.Point(22, 19).buffer(6)))
+    for g in shapes:
+        rings = shapely.get_rings(shapely.get_parts(g))
+        xy, idx = shapely.get_coordinates(rings, return_index=True)
+        same = idx[1:] == idx[:-1]
+        lo = xy.min(axis=0) - 1.3
+        p0, p1 = xy[:-1][same] - lo, xy[1:][same] - lo
+        h, w = (np.ceil(xy.max(axis=0) - lo) + 2).astype(int)[::-1]
+        mask = _raster(p0, p1, int(h), int(w))
+        r, c = np.mgrid[0:h, 0:w]
+        centres = shapely.points(c.ravel() + 0.5 + lo[0], r.ravel() + 0.5 + lo[1])
+        inside = shapely.contains_xy(g, c.ravel() + 0.5 + lo[0], r.ravel() + 0.5 + lo[1]).reshape(h, w)
+        on_edge = (shapely.distance(g.boundary, centres) < 1e-9).reshape(h, w)
+        assert mask.shape == (h, w) and mask.any()
+        assert ((mask == inside) | on_edge).all()
