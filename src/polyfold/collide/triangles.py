@@ -394,7 +394,7 @@ def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
     return _beside(a, ga, b, mb, d, tol)  # b's corner beside a's, seen along a's normal
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _wedge_clear(a, ga, b, mb, gap, reach, tol):
     """True when b neither crosses a's plane nor comes within gap of it farther than reach from
     its shared corners (mb): b's other corners lie beyond gap on one side, its shared corners not
