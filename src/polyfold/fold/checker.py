@@ -4,7 +4,9 @@ between two configurations, free of self-intersection?
 Every planner asks `ValidityChecker` only (the pattern of OMPL's StateValidityChecker and
 MotionValidator): `valid(q)` for a configuration, `segment(qa, qb, step)` for the straight motion
 between two, sampled every `step` radians (largest angle change) in bisection order, midpoints
-first, so a blocked segment fails early. It counts what it checks.
+first, so a blocked segment fails early. It counts what it checks, and remembers the last
+collision it met (`last_hit`: the configuration and the two faces, a planner's hint where a motion
+is blocked).
 
 Underneath are numba kernels that planners may call inside their own loops: `segment_collides`
 (all the samples of a segment in one call, reusing per-face work from one configuration to the

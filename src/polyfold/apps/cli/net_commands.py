@@ -135,7 +135,7 @@ def _say_unfolded(name: str, result, seconds: float) -> None:
 def fold_cmd(
     net: Path = typer.Argument(..., help="Net as a FOLD file (from `polyfold unfold`)."),
     output: Path = typer.Option(..., "-o", "--output", help="FOLD file with the path added as polyfold:path."),
-    planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then crease-by-crease unfolding, then Lazy PRM."),
+    planner: Planner = typer.Option(Planner.auto, "--planner", help="auto: straight line, then two-phase (one crease out of step), then crease-by-crease unfolding, then Lazy PRM."),
     resolution_deg: float = typer.Option(1.0, "--resolution-deg", min=1e-3, help="Collision-check step along path segments, degrees."),
     time_limit: float = typer.Option(60.0, "--time-limit", min=0.0, help="Seconds for the planner."),
     seed: int = typer.Option(1, "--seed", min=0, help="Random seed of the sampling planner."),
