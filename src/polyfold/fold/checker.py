@@ -109,27 +109,25 @@ def config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, t
                             piece, rigid, tol, work, np.empty(q.shape[0]))[0]
 
 
-@njit(cache=True)
-def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out):
+def config_collides_moving(q, order, parent, crease, axis, flat, piece, rigid, tol, R, T, out) -> bool:
     """Like `config_collides`, but pairs with rigid[i] == rigid[j] >= 0 are not tested.
 
     Along a segment on which only some creases move, faces joined by non-moving creases keep
     their relative pose; if both endpoints are collision-free such pairs never collide, so a
-    planner can label those rigid groups once per segment and skip them.
+    planner can label those rigid groups once per segment and skip them. (Plain Python over
+    `config_collides_cached`: one compiled kernel fewer to build on a first run.)
     """
     work = collision_work(order.shape[0])
     hit = config_collides_cached(q, order, parent, crease, axis, flat, piece, rigid, tol, work)
     R[:] = work[4]
     T[:] = work[5]
     out[:] = work[6]
-    return hit
+    return bool(hit)
 
 
-@njit(cache=True)
-def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out):
+def config_collides(q, order, parent, crease, axis, flat, piece, tol, R, T, out) -> bool:
     """forward_kinematics into (R, T, out), then the collision test: True if q self-intersects."""
-    no_groups = np.empty(order.shape[0], dtype=np.int64)
-    no_groups[:] = -1
+    no_groups = np.full(order.shape[0], -1, dtype=np.int64)
     return config_collides_moving(q, order, parent, crease, axis, flat, piece, no_groups, tol, R, T, out)
 
 
@@ -206,6 +204,17 @@ class ValidityChecker:
             self.hit_q = np.array(q, dtype=np.float64)
             return False
         return True
+
+    def valid_without_thickness(self, q: np.ndarray) -> bool:
+        """`valid` of the zero-thickness test (crossing only), on this checker's work arrays: the
+        goal, where faces meet along glued seams and at mesh vertices by design."""
+        thick = self.work[9]
+        kept = thick[0]
+        thick[0] = 0.0
+        try:
+            return self.valid(q)
+        finally:
+            thick[0] = kept
 
     def last_hit(self) -> tuple[np.ndarray, int, int] | None:
         """The last collision a query met: (configuration (E,), face i, face j), or None when

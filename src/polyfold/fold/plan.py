@@ -35,7 +35,7 @@ from ..mesh.geometry import rho_to_fold_deg
 from .checker import ValidityChecker, first_blocked_segment
 from .lazy_prm import plan_lazy_prm
 from .sequential import plan_sequential
-from .tree import FoldTree, collides, colliding_pairs
+from .tree import FoldTree, colliding_pairs
 
 
 SEQUENTIAL_SHARE = 2 / 3  # of the time limit for the sequential planner when planner="auto"
@@ -237,7 +237,7 @@ def _check_ends(tree: FoldTree, check: ValidityChecker) -> None:
     if not check.valid(np.zeros(len(tree.goal))):
         raise PolyfoldError("the flat net overlaps itself: not a valid net")
     # the goal without thickness: there faces meet along glued seams and at mesh vertices by design
-    if collides(tree, tree.goal):
+    if not check.valid_without_thickness(tree.goal):
         pairs = colliding_pairs(tree, tree.goal)
         raise PolyfoldError(
             f"the folded goal shape intersects itself (net faces {pairs[0, 0]} and {pairs[0, 1]} cross, "
