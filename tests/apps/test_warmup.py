@@ -3,11 +3,12 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
 from polyfold.apps.benchpaper import kernel_signatures
-from polyfold.apps.warmup import bumpy_sphere, warm_up
+from polyfold.apps.warmup import bumpy_sphere, kernels_cached, warm_up
 
 
 def test_warm_up_reaches_the_kernels_of_every_stage():
@@ -30,3 +31,12 @@ def test_cli_warm_up_says_what_it_did():
     proc = subprocess.run([sys.executable, "-m", "polyfold", "warm-up"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "kernels compiled and cached" in proc.stderr
+
+
+def test_kernels_cached_tells_a_cold_cache_from_a_warm_one(tmp_path):
+    warm_up()
+    assert kernels_cached() is True
+    cold = subprocess.run([sys.executable, "-c", "from polyfold.apps.warmup import kernels_cached; print(kernels_cached())"],
+                          capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "empty")})
+    assert cold.returncode == 0 and cold.stdout.strip() == "False", cold.stderr

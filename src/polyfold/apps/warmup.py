@@ -22,6 +22,19 @@ from typing import Callable
 import numpy as np
 
 
+def kernels_cached() -> bool | None:
+    """Whether numba's cache holds the planners' main kernel (a first run compiles when not):
+    True or False, or None when this numba keeps its cache where this cannot look."""
+    import os
+
+    try:
+        from ..fold.checker import segment_free
+
+        return os.path.exists(segment_free._cache._cache_file._index_path)
+    except Exception:  # numba's cache layout is its own: no hint rather than a wrong one
+        return None
+
+
 def bumpy_sphere(subdivisions: int = 1, sigma: float = 0.12, seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
     """(vertices (V, 3), faces (F, 3)): an icosphere (80 faces at 1 subdivision, 320 at 2) with
     every vertex moved along its radius by a factor 1 + N(0, sigma) (within 0.6-1.4): dents

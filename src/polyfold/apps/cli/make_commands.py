@@ -47,7 +47,10 @@ def make(
                                     marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces,
                                     color=color, dpi=dpi, guide=guide)
     from ...pipeline.make import make as run_make
+    from ..warmup import kernels_cached
 
+    if not quiet and kernels_cached() is False:
+        say("first run: compiling polyfold's kernels (about a minute, once; `polyfold warm-up` does it ahead)")
     t0 = time.perf_counter()
     with options.make_progress(say, quiet, "polyfold make") as progress:
         result = run_make(mesh, output, opts, progress)
