@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import shapely
@@ -433,23 +434,13 @@ def _phase(seed: int, angles: int, rng: np.random.Generator | None = None) -> fl
     return float(rng.uniform(0.0, 360.0 / max(angles, 1)))
 
 
-_PIECE_CACHE: dict[tuple, tuple[_Piece, float]] = {}
-_PIECE_CACHE_SIZE = 512  # pieces kept (a make's page planning packs the same outlines dozens of times)
-
-
+@lru_cache(maxsize=512)
 def _piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:
     """A `_Piece` for the outline with the rotations to try, and the largest scale at which it fits
-    the printable area in one of them. The same outline on the same grid gives the same piece, its
-    rasters included: page planning packs one set of outlines many times (every split tried), so
-    pieces are kept, by the outline's exact coordinates, in a bounded cache."""
-    key = (shapely.to_wkb(g), angles, phase, grid)
-    got = _PIECE_CACHE.get(key)
-    if got is None:
-        got = _new_piece(g, angles, phase, grid)
-        if len(_PIECE_CACHE) >= _PIECE_CACHE_SIZE:
-            del _PIECE_CACHE[next(iter(_PIECE_CACHE))]  # the oldest
-        _PIECE_CACHE[key] = got
-    return got
+    the printable area in one of them. The same outline (shapely's equality: exactly the same
+    coordinates) on the same grid gives the same piece, its rasters included: page planning packs
+    one set of outlines many times (every split tried), so pieces are kept in a bounded cache."""
+    return _new_piece(g, angles, phase, grid)
 
 
 def _new_piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:

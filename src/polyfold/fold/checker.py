@@ -5,8 +5,7 @@ Every planner asks `ValidityChecker` only (the pattern of OMPL's StateValidityCh
 MotionValidator): `valid(q)` for a configuration, `segment(qa, qb, step)` for the straight motion
 between two, sampled every `step` radians (largest angle change) in bisection order, midpoints
 first, so a blocked segment fails early. It counts what it checks, and remembers the last
-collision it met (`last_hit`: the configuration and the two faces, a planner's hint where a motion
-is blocked).
+collision it met (`last_hit`: the two faces, a planner's hint where a motion is blocked).
 
 Underneath are numba kernels that planners may call inside their own loops: `segment_collides`
 (all the samples of a segment in one call, reusing per-face work from one configuration to the
@@ -194,16 +193,12 @@ class ValidityChecker:
         self.no_groups = np.full(len(tree.order), -1, dtype=np.int64)
         self.configs = 0
         self.edges = 0
-        self.hit_q: np.ndarray | None = None
 
     def valid(self, q: np.ndarray) -> bool:
         t = self.tree
         self.configs += 1
-        if config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
-                                  t.tol, self.work):
-            self.hit_q = np.array(q, dtype=np.float64)
-            return False
-        return True
+        return not config_collides_cached(q, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, self.no_groups,
+                                          t.tol, self.work)
 
     def valid_without_thickness(self, q: np.ndarray) -> bool:
         """`valid` of the zero-thickness test (crossing only), on this checker's work arrays: the
@@ -216,13 +211,11 @@ class ValidityChecker:
         finally:
             thick[0] = kept
 
-    def last_hit(self) -> tuple[np.ndarray, int, int] | None:
-        """The last collision a query met: (configuration (E,), face i, face j), or None when
-        none has failed yet. (A planner's hint where a motion is blocked: which faces meet.)"""
-        if self.hit_q is None:
-            return None
+    def last_hit(self) -> tuple[int, int] | None:
+        """The two faces of the last collision a query met, or None when none has failed yet (a
+        planner's hint where a motion is blocked)."""
         meta = self.work[7]
-        return self.hit_q.copy(), int(meta[1]), int(meta[2])
+        return None if meta[1] < 0 else (int(meta[1]), int(meta[2]))
 
     def segment(self, qa: np.ndarray, qb: np.ndarray, step: float | None = None, max_samples: int = 1 << 40) -> bool:
         """The straight motion qa -> qb sampled every `step` radians at most (default: the
@@ -238,8 +231,6 @@ class ValidityChecker:
         free, n = segment_free(qa, qb, m, t.order, t.parent, t.crease, t.axis,
                                t.flat, t.piece, t.tol, self.q, max_samples, self.work)
         self.configs += n
-        if not free:
-            self.hit_q = self.q.copy()
         return bool(free)
 
 

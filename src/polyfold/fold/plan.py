@@ -120,14 +120,15 @@ def plan_two_phase(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
     resolution, as the straight line; the one where a single crease moves (cheap: most pairs
     keep their pose) first. The straight line itself when it is free.
     """
+    straight = plan_linear(tree, check, deadline, settings)
+    if straight is not None:
+        return straight
+    hit = check.last_hit()  # the faces the straight line's check found colliding
+    if hit is None:
+        return None
     zero, goal = np.zeros(len(tree.goal)), tree.goal
     fine = check.step / 2
-    if check.segment(zero, goal, fine):
-        return Found(np.stack([zero, goal.copy()]), "linear", 2, True)
-    hit = check.last_hit()
-    if hit is None or hit[1] < 0:
-        return None
-    moving = [c for c in _creases_between(tree, hit[1], hit[2]) if goal[c] != 0.0]
+    moving = [c for c in _creases_between(tree, *hit) if goal[c] != 0.0]
     for c in moving[:TWO_PHASE_CANDIDATES]:
         for alone_last in (True, False):
             if deadline.expired():
@@ -208,14 +209,14 @@ def plan_fold(
         raise ValueError(f"unknown planner {planner!r}")
     t0 = time.perf_counter()
     deadline = Deadline(t0 + time_limit) if deadline is None else deadline
-    straight = Found(np.stack([np.zeros(len(tree.goal)), tree.goal.copy()]), "linear", 2, True)
-    if tree.n_faces <= 2:  # no pair to test (a crease pair, or two pieces): every configuration is free
-        return FoldPath(frames=straight.frames, linear=True, planner="linear", seconds=time.perf_counter() - t0,
-                        edges_checked=0, configs_checked=0, nodes=2)
     check = ValidityChecker(tree, math.radians(resolution_deg))
-    _check_ends(tree, check)
-    if len(tree.creases) == 0:  # single faces (no DOF): the flat net is the goal, whatever the planner
-        found = straight
+    # at most two faces: their one pair is a crease pair or in two pieces, never tested, so every
+    # configuration is free; single faces (no DOF): the flat net is the goal. Whatever the planner.
+    trivial = tree.n_faces <= 2 or len(tree.creases) == 0
+    if tree.n_faces > 2:
+        _check_ends(tree, check)
+    if trivial:
+        found = Found(np.stack([np.zeros(len(tree.goal)), tree.goal.copy()]), "linear", 2, True)
     else:
         settings = PlannerSettings(seed, n0, k_neighbours)
         steps = AUTO if planner == "auto" else ((planner, 1.0),)
