@@ -237,22 +237,35 @@ def _shallow_on(a, b, n, ref2, gap):
 
 
 @njit(cache=True)
+def faces_apart(a, b, ga, gb, gap):
+    """True when a normal or edge x edge axis separates triangles a, b by more than gap (then
+    they, and any parts of them, are farther apart than gap)."""
+    if ga.uok and _apart_on(a, b, ga.u, 1.0, gap):
+        return True
+    if gb.uok and _apart_on(a, b, gb.u, 1.0, gap):
+        return True
+    for i in range(3):
+        for j in range(3):
+            if _apart_on(a, b, _cross(ga.e[i], gb.e[j]), ga.l[i] * gb.l[j], gap):
+                return True
+    return False
+
+
+@njit(cache=True)
 def faces_near(a, b, ga, gb, gap):
     """True when triangles a, b come closer than gap with projections overlapping by more than gap:
     no normal or edge x edge axis separates them by more than gap, and one reaches more than gap
     into the other seen along the other's normal (on every axis in that plane normal to a side of
     either, their projections overlap by more than gap). Conservative (a separating-axis bound of the
     distance), so it may call near what the independent check (`verify.paths`) lets touch."""
-    if ga.uok and _apart_on(a, b, ga.u, 1.0, gap):
-        return False
-    if gb.uok and _apart_on(a, b, gb.u, 1.0, gap):
-        return False
-    for i in range(3):
-        for j in range(3):
-            if _apart_on(a, b, _cross(ga.e[i], gb.e[j]), ga.l[i] * gb.l[j], gap):
-                return False
-    # b reaches more than gap into a, seen along a's normal: the 2D separating-axis test in a's
-    # plane (a's sides and b's sides projected), every axis overlapping by more than gap; and a into b
+    return not faces_apart(a, b, ga, gb, gap) and _reaches_into(a, b, ga, gb, gap)
+
+
+@njit(cache=True)
+def _reaches_into(a, b, ga, gb, gap):
+    """The second half of `faces_near`: b reaches more than gap into a seen along a's normal (the
+    2D separating-axis test in a's plane, a's sides and b's sides projected, every axis overlapping
+    by more than gap), or a into b."""
     into_a, into_b = True, True
     for k in range(3):
         if into_a and (_shallow_on(a, b, _cross(ga.n, ga.e[k]), ga.n2 * ga.l[k], gap)
@@ -294,24 +307,18 @@ def _corner_at(a, p, tol):
 
 
 @njit(cache=True, inline="always")
-def _in_cone(n, e1, e2, u):
-    """True when direction u lies in the closed cone of e1, e2 (< 180 degrees) seen along n (on
-    its sides too, within a relative 1e-9)."""
-    s1 = _dot(n, _cross(e1, u))
-    s2 = _dot(n, _cross(u, e2))
-    if _dot(n, _cross(e1, e2)) < 0.0:
-        s1, s2 = -s1, -s2
-    lu = math.sqrt(_dot(u, u))
-    eps1 = 1e-9 * math.sqrt(_dot(e1, e1)) * lu
-    eps2 = 1e-9 * math.sqrt(_dot(e2, e2)) * lu
-    return s1 >= -eps1 and s2 >= -eps2 and (_dot(e1, u) > 0.0 or _dot(e2, u) > 0.0)
+def _turn_ok(det, ll, scale2):
+    """det >= -1e-9 |x| |y|, det being n . (x cross y) scaled by sqrt(scale2) (ll = |x|^2 |y|^2)."""
+    return det >= 0.0 or det * det <= 1e-18 * ll * scale2
 
 
 @njit(cache=True)
 def _beside(a, ga, b, mb, d, tol):
     """`_wedge_clear` when b (one shared corner s, on a's plane) lies within the thickness of a's
     plane: True when, seen along a's normal, b's corner at s and a's corner there are apart (no
-    side of one inside the other's corner), so b's projection meets a only at s."""
+    side of one inside the other's corner, within a relative 1e-9), so b's projection meets a only
+    at s. Directions are compared in a's plane: every n . (x cross y) is the 2D determinant of x
+    and y in the basis (e1, n cross e1), scaled by |e1|^2 (six of them; no square root)."""
     if not (mb == 1 or mb == 2 or mb == 4):
         return False
     k = 0 if mb == 1 else (1 if mb == 2 else 2)
@@ -320,14 +327,40 @@ def _beside(a, ga, b, mb, d, tol):
     j = _corner_at(a, b[k], tol)
     if j < 0:
         return False
-    n = ga.u
     s = a[j]
     e1 = (a[(j + 1) % 3][0] - s[0], a[(j + 1) % 3][1] - s[1], a[(j + 1) % 3][2] - s[2])
     e2 = (a[(j + 2) % 3][0] - s[0], a[(j + 2) % 3][1] - s[1], a[(j + 2) % 3][2] - s[2])
     u1 = (b[(k + 1) % 3][0] - s[0], b[(k + 1) % 3][1] - s[1], b[(k + 1) % 3][2] - s[2])
     u2 = (b[(k + 2) % 3][0] - s[0], b[(k + 2) % 3][1] - s[1], b[(k + 2) % 3][2] - s[2])
-    return not (_in_cone(n, e1, e2, u1) or _in_cone(n, e1, e2, u2) or _in_cone(n, u1, u2, e1)
-                or _in_cone(n, u1, u2, e2))
+    r = _cross(ga.u, e1)
+    l_e1, l_e2, l_u1, l_u2 = _dot(e1, e1), _dot(e2, e2), _dot(u1, u1), _dot(u2, u2)
+    scale2 = l_e1 * l_e1
+    # 2D coordinates (x . e1, x . r); e1 itself is (|e1|^2, 0)
+    x2, y2 = _dot(e2, e1), _dot(e2, r)
+    xu1, yu1 = _dot(u1, e1), _dot(u1, r)
+    xu2, yu2 = _dot(u2, e1), _dot(u2, r)
+    d_e = l_e1 * y2  # e1 x e2
+    d_u = xu1 * yu2 - yu1 * xu2  # u1 x u2
+    d_e1u1 = l_e1 * yu1
+    d_e1u2 = l_e1 * yu2
+    d_u1e2 = xu1 * y2 - yu1 * x2
+    d_u2e2 = xu2 * y2 - yu2 * x2
+    # u in a's corner (e1, e2): n . (e1 x u) >= 0 and n . (u x e2) >= 0 (both flipped for a
+    # clockwise corner), and u not opposite the corner
+    fe = -1.0 if d_e < 0.0 else 1.0
+    if (_turn_ok(fe * d_e1u1, l_e1 * l_u1, scale2) and _turn_ok(fe * d_u1e2, l_u1 * l_e2, scale2)
+            and (_dot(e1, u1) > 0.0 or _dot(e2, u1) > 0.0)):
+        return False
+    if (_turn_ok(fe * d_e1u2, l_e1 * l_u2, scale2) and _turn_ok(fe * d_u2e2, l_u2 * l_e2, scale2)
+            and (_dot(e1, u2) > 0.0 or _dot(e2, u2) > 0.0)):
+        return False
+    # a's sides in b's corner (u1, u2)
+    fu = -1.0 if d_u < 0.0 else 1.0
+    if (_turn_ok(-fu * d_e1u1, l_u1 * l_e1, scale2) and _turn_ok(fu * d_e1u2, l_e1 * l_u2, scale2)
+            and (_dot(u1, e1) > 0.0 or _dot(u2, e1) > 0.0)):
+        return False
+    return not (_turn_ok(fu * d_u1e2, l_u1 * l_e2, scale2) and _turn_ok(-fu * d_u2e2, l_e2 * l_u2, scale2)
+                and (_dot(u1, e2) > 0.0 or _dot(u2, e2) > 0.0))
 
 
 @njit(cache=True)
@@ -463,18 +496,30 @@ def thick_collides(a, b, ga, gb, ids_a, ids_b, tol, thick, reach):
 @njit(cache=True)
 def _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach):
     """`thick_collides` past its quick answers (a call: rarely reached, keeps compiling fast)."""
+    if ma == 0:
+        # whole faces farther apart than the thickness on some axis neither cross nor come near
+        if faces_apart(a, b, ga, gb, thick):
+            return False
+        return faces_cross(a, b, ga, gb, tol) or _reaches_into(a, b, ga, gb, thick)
+    one_corner = _one_bit(ma) and _one_bit(mb) and edge < 2
+    if one_corner:
+        # each face is cut to a quad away from the shared corner; while the corner's two copies are
+        # apart (a mesh vertex not yet closed) the whole faces are often farther apart than the
+        # thickness, and then so are their quads (and they do not cross)
+        ka, kb = 0 if ma == 1 else (1 if ma == 2 else 2), 0 if mb == 1 else (1 if mb == 2 else 2)
+        dk = (a[ka][0] - b[kb][0], a[ka][1] - b[kb][1], a[ka][2] - b[kb][2])
+        if _dot(dk, dk) > thick * thick and faces_apart(a, b, ga, gb, thick):
+            return False
     if faces_cross(a, b, ga, gb, tol):
         return True
-    if ma == 0:
-        return faces_near(a, b, ga, gb, thick)
     if edge >= 2:  # a mesh edge they share (a seam): what is left beyond reach of it
         sa, sb = _beyond_side(a, ma, reach), _beyond_side(b, mb, reach)
         if sa[1] <= 0.0 or sb[1] <= 0.0:
             return False
         return faces_near(sa[0], sb[0], face_geometry(sa[0], tol), face_geometry(sb[0], tol), thick)
-    if not (_one_bit(ma) and _one_bit(mb)):
+    if not one_corner:
         return faces_near(a, b, ga, gb, thick)  # (no such pair in a net: two shared net vertices are a crease)
-    qa, qb = _corner_cut(a, ma, reach), _corner_cut(b, mb, reach)  # one shared corner: each face a quad
+    qa, qb = _corner_cut(a, ma, reach), _corner_cut(b, mb, reach)
     for ta in qa:
         sa = face_geometry(ta, tol)
         if sa.sliver:
