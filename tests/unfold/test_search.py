@@ -281,3 +281,39 @@ def test_fallback_cuts_only_cuttable_creases(models_dir):
         if not cuttable[on_path].any():
             allowed[on_path] = True  # the only way to separate this pair
     assert cut.any() and not (cut & ~allowed).any()
+
+
+def test_luby_sequence() -> None:
+    """The restart lengths: t_i = 2^(k-1) when i = 2^k - 1, else t_(i - 2^(k-1) + 1) for
+    2^(k-1) <= i < 2^k - 1 (Luby, Sinclair and Zuckerman 1993)."""
+    from polyfold.unfold.search import luby
+
+    def reference(i: int) -> int:
+        k = 1
+        while (1 << k) - 1 < i:
+            k += 1
+        return 1 << (k - 1) if i == (1 << k) - 1 else reference(i - (1 << (k - 1)) + 1)
+
+    assert [luby(i) for i in range(1, 16)] == [1, 1, 2, 1, 1, 2, 4, 1, 1, 2, 1, 1, 2, 4, 8]
+    assert all(luby(i) == reference(i) for i in range(1, 2000))
+
+
+def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
+    """A search cut into restarts after 1, 1, 2, ... generations (restart unit 1): on horse-302,
+    seed 11 finds its net in the third generation, after two restarts, the same net every time,
+    and the net has no overlap."""
+    import polyfold.unfold.search as search
+
+    mesh = load_mesh(models_dir / "horse-302.obj").components[0]
+    problem = UnfoldProblem.from_mesh(mesh)
+    kept = search.RESTART_GENERATIONS
+    search.RESTART_GENERATIONS = 1
+    try:
+        runs = [search.run_memetic(problem, np.random.default_rng(11), Deadline.never(), 4, population=50)
+                for _ in range(2)]
+    finally:
+        search.RESTART_GENERATIONS = kept
+    (w1, f1, g1, _, _), (w2, f2, g2, _, _) = runs
+    assert (f1, g1) == (0.0, 3) and np.array_equal(w1, w2) and (f2, g2) == (f1, g1)
+    G, L = problem.evaluate(w1[None, :])
+    assert float(search._fitness(G, L)[0]) == 0.0

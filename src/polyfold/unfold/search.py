@@ -45,6 +45,7 @@ class UnfoldStats:
 
 
 FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
+RESTART_GENERATIONS = 3  # the memetic search's restart unit (generations, times the Luby sequence)
 
 
 # The GA's initial population draws from these creators (ALGORITHMS.md 5.5).
@@ -226,8 +227,9 @@ def run_memetic(
     Same heuristic-seeded population, tournament selection and uniform crossover as `run_ga`; each
     generation breeds one child, improves it with `tree_local_search` (a crease on the tree path
     between two overlapping faces is swapped for a cut edge that reconnects the halves), and writes
-    the improved tree back into the population in place of the worst individual. Returns the same
-    tuple as `run_ga`; stops like it.
+    the improved tree back into the population in place of the worst individual; restarted from a
+    new first batch after 3, 3, 6, 3, 3, 6, 12, ... generations (`luby`). Returns the same tuple as
+    `run_ga` (the best genome met across restarts); stops like it.
 
     accept: optional extra test of a valid (overlap-free) genome; the search goes on, within the
     budget, until a valid genome passes it, and falls back to the first valid one otherwise.
@@ -240,13 +242,31 @@ def run_memetic(
     pop, fit, origin, evaluations, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population), finished)
     if hit >= 0:
         return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
+    best, best_fit = pop[int(np.argmax(fit))].copy(), float(fit.max())
     generation = 0
+    since = 0  # generations since the population was last built
+    restarts = 0
     while generation < max_generations and not deadline.expired():
+        if since == RESTART_GENERATIONS * luby(restarts + 1):
+            # a restart: the time a search needs is heavy-tailed (one seed in seconds, the next
+            # stuck on one overlap for minutes), so runs are cut after a Luby sequence of
+            # generations (1, 1, 2, 1, 1, 2, 4, ... x RESTART_GENERATIONS) and start afresh from a
+            # new first batch, the random stream going on (deterministic for a seed)
+            restarts += 1
+            since = 0
+            pop, fit, origin, more_ev, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population),
+                                                              finished)
+            evaluations += more_ev
+            if hit >= 0:
+                return pop[hit].copy(), 0.0, generation, evaluations, origin[hit]
+            if deadline.expired():
+                break
         generation += 1
-        if generation == 1:
+        since += 1
+        if since == 1:
             child = pop[int(np.argmax(fit))].copy()
         else:
-            if generation == 2 and len(pop) < population:
+            if since == 2 and len(pop) < population:
                 more, more_fit, more_origin, more_ev, hit = _seed_population(
                     problem, rng, deadline, population - len(pop), finished)
                 evaluations += more_ev
@@ -263,15 +283,34 @@ def run_memetic(
         pop[worst] = genome
         fit[worst] = -float(score)
         if progress is not None:
-            progress(generation, float(fit.max()))
+            progress(generation, max(best_fit, float(fit.max())))
         if score == 0:
             if finished(genome):
                 return genome, 0.0, generation, evaluations, "ga+local-search"
             fit[worst] = -0.5
+        if fit[worst] > best_fit:
+            best, best_fit = genome.copy(), float(fit[worst])
     if finished.fallback is not None:
         return finished.fallback, 0.0, generation, evaluations, "ga+local-search"
     i = int(np.argmax(fit))
-    return pop[i].copy(), float(fit[i]), generation, evaluations, "ga+local-search"
+    if fit[i] > best_fit:
+        best, best_fit = pop[i].copy(), float(fit[i])
+    return best, best_fit, generation, evaluations, "ga+local-search"
+
+
+def luby(i: int) -> int:
+    """The i-th term (i >= 1) of the Luby sequence 1, 1, 2, 1, 1, 2, 4, 1, 1, 2, 1, 1, 2, 4, 8, ...
+    (restart lengths within a log factor of the best fixed cutoff, whatever the run-time
+    distribution: Luby, Sinclair and Zuckerman 1993)."""
+    k = 1
+    while (1 << k) - 1 < i:
+        k += 1
+    while i != (1 << k) - 1:
+        i -= (1 << (k - 1)) - 1
+        k = 1
+        while (1 << k) - 1 < i:
+            k += 1
+    return 1 << (k - 1)
 
 
 def run_heuristic(problem: UnfoldProblem, name: str, rng: np.random.Generator,
