@@ -14,9 +14,17 @@ class MeshError(PolyfoldError):
 
 
 class NoNetFound(PolyfoldError):
-    """No net satisfying the request (e.g. --max-pieces 1) was found within the budget."""
+    """No net satisfying the request (e.g. --max-pieces 1) was found within the budget.
+
+    pieces: when a search ran, a function that returns its best net cut into pieces and the
+    search's stats (what `unfold` would have returned without the request), so a caller that
+    settles for pieces need not search again; None when no search ran."""
 
     exit_code = 1
+
+    def __init__(self, message: str, pieces=None):
+        super().__init__(message)
+        self.pieces = pieces
 
 
 class OutOfTime(PolyfoldError):

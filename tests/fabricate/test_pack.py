@@ -345,3 +345,19 @@ def test_raster_marks_exactly_the_cells_whose_centres_are_inside():
         on_edge = (shapely.distance(g.boundary, centres) < 1e-9).reshape(h, w)
         assert mask.shape == (h, w) and mask.any()
         assert ((mask == inside) | on_edge).all()
+
+
+def test_page_filler_keeps_a_bounded_raster_cache() -> None:
+    """Page planning asks for spots of hundreds of candidate outlines: the filler keeps the rasters
+    of at most RASTER_CACHE_PIECES (least recently used dropped; a 1,280-face net's plans reached
+    840 MB unbounded), and an outline asked again after it was dropped gets the same spot."""
+    from polyfold.fabricate import pack
+
+    filler = PageFiller(A4, 10.0, 2.0, 1, seed=3)
+    outlines = [box(0, 0, 10 + (i % 37), 8 + (i % 23)) for i in range(pack.RASTER_CACHE_PIECES + 60)]
+    first = [filler.spot(0, g, ("part", i)) for i, g in enumerate(outlines)]
+    assert len(filler._pieces) == pack.RASTER_CACHE_PIECES
+    assert ("part", 0) not in filler._pieces  # the oldest went first
+    again = filler.spot(0, outlines[0], ("part", 0))
+    assert (again.y, again.x, again.shape.angle) == (first[0].y, first[0].x, first[0].shape.angle)
+    assert len(filler._pieces) == pack.RASTER_CACHE_PIECES

@@ -317,3 +317,20 @@ def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     assert (f1, g1) == (0.0, 3) and np.array_equal(w1, w2) and (f2, g2) == (f1, g1)
     G, L = problem.evaluate(w1[None, :])
     assert float(search._fitness(G, L)[0]) == 0.0
+
+
+def test_no_single_net_carries_the_searched_net_in_pieces(models_dir) -> None:
+    """max_pieces=1 without success raises NoNetFound whose `pieces` gives the net the same search
+    returns without the request (several pieces, valid), so `make` need not search again; the
+    blocked case, where no search runs, carries none."""
+    mesh = single_component(models_dir, "torus-12x6-144")
+    with pytest.raises(NoNetFound) as caught:
+        unfold(mesh, seed=3, time_limit=600, max_generations=2, max_pieces=1)
+    net, stats = caught.value.pieces()
+    plain, plain_stats = unfold(mesh, seed=3, time_limit=600, max_generations=2)
+    assert net.n_pieces > 1 and stats.pieces == net.n_pieces and stats.timed_out
+    assert _same_net(net, plain) and plain_stats.pieces == stats.pieces
+    assert_valid_net(net, n_pieces=net.n_pieces)
+    with pytest.raises(NoNetFound) as blocked:
+        unfold(single_component(models_dir, "star-4split-96"), seed=1, time_limit=60, max_pieces=1)
+    assert blocked.value.pieces is None

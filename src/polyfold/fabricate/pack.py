@@ -47,6 +47,10 @@ _QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
 _TOL = 1e-9  # mm: float noise allowed by check_packing
 ANGLES = 16  # rotations tried per piece (every 22.5 degrees), plus its minimum-rectangle ones
 ORDER_TRIES = 2  # piece orders pack_outlines fills: a caller's hint, then larger first
+# outlines whose rasters a PageFiller keeps (least recently used dropped): page planning tries
+# hundreds of candidate parts, each up to ANGLES rasters (about 1 MB a part on a 1,280-face net,
+# where an unbounded cache reached 840 MB)
+RASTER_CACHE_PIECES = 128
 
 
 @dataclass(frozen=True)
@@ -434,7 +438,7 @@ def _phase(seed: int, angles: int, rng: np.random.Generator | None = None) -> fl
     return float(rng.uniform(0.0, 360.0 / max(angles, 1)))
 
 
-@lru_cache(maxsize=512)
+@lru_cache(maxsize=RASTER_CACHE_PIECES)
 def _piece(g, angles: int, phase: float, grid: _Grid) -> tuple[_Piece, float]:
     """A `_Piece` for the outline with the rotations to try, and the largest scale at which it fits
     the printable area in one of them. The same outline (shapely's equality: exactly the same
@@ -533,8 +537,8 @@ class PageFiller:
         self.angles = angles
         self.phase = _phase(seed, angles)
         self.printable_area = pw * ph
-        # key -> rasters of the outline; a dict shared by fillers with the same page, gap, angles and
-        # seed keeps them across fillers (each key naming one outline)
+        # key -> rasters of the outline (at most RASTER_CACHE_PIECES); a dict shared by fillers with
+        # the same page, gap, angles and seed keeps them across fillers (each key naming one outline)
         self._pieces: dict[object, _Piece] = {} if rasters is None else rasters
 
     def free_area(self, page: int) -> float:
@@ -546,9 +550,13 @@ class PageFiller:
         """Where the fill would put the outline on `page` (nothing is placed yet), or None when it
         fits nowhere there."""
         g = self.grid
-        piece = self._pieces.get(key)
+        cache = self._pieces
+        piece = cache.pop(key, None)
         if piece is None:
-            piece = self._pieces[key] = _piece(outline, self.angles, self.phase, g)[0]
+            piece = _piece(outline, self.angles, self.phase, g)[0]
+            while len(cache) >= RASTER_CACHE_PIECES:  # the least recently used out first
+                del cache[next(iter(cache))]
+        cache[key] = piece  # (re)inserted last: dicts keep insertion order
         hit = _best_on_page(self.pages[page], piece, g.res)
         return None if hit is None else Spot(page, *hit)
 

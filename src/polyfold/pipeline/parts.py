@@ -104,8 +104,9 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
             # single net, nor for segmenting (one kernel run, 19 s on 22k faces, minutes on 89k)
             single = mode == "auto" and len(faces) > 1 and not deadline.expired()
             net, st = unfold(part_mesh, seed=opts.seed, time_limit=left, max_pieces=1 if single else None)
-        except NoNetFound:
+        except NoNetFound as exc:
             # auto: no single net for this component in time -> split it into nearly convex parts
+            in_pieces = exc.pieces
             unfold_s += time.perf_counter() - tu
             if deadline.expired() or len(faces) * SEGMENT_S_PER_FACE > deadline.left():
                 say("segment", f"no single net for a {len(faces)}-face component, and no time left to segment it: "
@@ -116,7 +117,9 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
                 segmented.append(int(comp[faces[0]]))
                 subs = segmenter(faces, None, None)
             if len(subs) == 1:  # already nearly convex: accept several pieces instead
-                net, st = unfold(part_mesh, seed=opts.seed, time_limit=share())
+                tu = time.perf_counter()
+                # the search's best net in pieces (the same seed would only search it again)
+                net, st = in_pieces() if in_pieces is not None else unfold(part_mesh, seed=opts.seed, time_limit=share())
             else:
                 todo = subs + todo
                 continue

@@ -474,17 +474,26 @@ def unfold(
     parent, parent_edge, order, coords = problem.decode(weights)
     pairs = problem.overlaps(coords, parent)
     timed_out = len(pairs) > 0
-    cut = None
-    if len(pairs):
-        if max_pieces == 1:
-            raise NoNetFound(
-                f"no single-piece net found in {time.perf_counter() - t0:.1f} s "
-                f"({generations} generations, best net has {len(pairs)} overlapping face pairs)"
-            )
+
+    def in_pieces() -> Net:
         cuttable = (parent_edge >= 0) & ~problem.merged[parent_edge]
         cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5),
                                 cuttable=cuttable)
-    net = _net_from_tree(problem, parent, parent_edge, order, coords, cut)
+        return _net_from_tree(problem, parent, parent_edge, order, coords, cut)
+
+    if len(pairs) and max_pieces == 1:
+        searched = time.perf_counter() - t0
+
+        def fallback() -> tuple[Net, UnfoldStats]:
+            net = in_pieces()
+            return net, UnfoldStats(seconds=searched, generations=generations, evaluations=evaluations, method=winner,
+                                    pieces=net.n_pieces, timed_out=True, best_overlaps=len(pairs))
+
+        raise NoNetFound(
+            f"no single-piece net found in {searched:.1f} s "
+            f"({generations} generations, best net has {len(pairs)} overlapping face pairs)",
+            pieces=fallback)
+    net = in_pieces() if len(pairs) else _net_from_tree(problem, parent, parent_edge, order, coords, None)
     accepted = None
     if accept is not None:
         accepted = net.n_pieces == 1 and bool(accept(net))
