@@ -176,3 +176,35 @@ def test_non_linear_pieces_show_their_stages(folders: dict[str, Path]) -> None:
         elif row["path_verified"] and row["faces"] > 1:
             assert "does not fold in one motion" in body and row["planner"] in body
             assert re.search(rf"{row['piece']}: stage 2", body)
+
+
+def _cube_pose() -> np.ndarray:
+    """(12, 3, 3) the triangles of a unit cube, outward."""
+    v = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return np.array([v[[a, b, c]] for a, b, c, d in quads for a, b, c in ((a, b, c), (a, c, d))])
+
+
+def test_a_stage_picture_turns_to_show_a_hidden_crease() -> None:
+    """A crease the folding pictures' direction cannot see (behind the shape) gets a picture turned
+    about the vertical that shows most of it; a crease in sight keeps the usual direction."""
+    from polyfold.formats.raster import view_rotation
+    from polyfold.guide import pictures as P
+    from polyfold.guide.guide import FRAME_PX, FRAME_VIEW, _stage_view
+
+    pose = _cube_pose()
+    rotation = view_rotation(*FRAME_VIEW, 2)
+    front = np.full((len(pose), 3), 200, dtype=np.uint8)
+    back = np.full_like(front, 90)
+    cam = P.fit_camera(pose, rotation, *FRAME_PX)
+    img, _ids, zbuf = P.draw_faces(cam, pose, front, back)
+    edges = np.array([[pose[f, i], pose[f, (i + 1) % 3]] for f in range(len(pose)) for i in range(3)])
+    seen = P.draw_lines(img.copy(), cam, zbuf, edges, P.MOUNTAIN_RGB, width=3.0)
+    hidden, shown = edges[int(np.argmin(seen))], edges[int(np.argmax(seen))]
+    assert seen.min() == 0.0 and seen.max() == 1.0
+
+    cam2, img2, zbuf2, turned = _stage_view(pose, rotation, front, back, [(hidden[None], P.MOUNTAIN_RGB)])
+    assert turned
+    assert P.draw_lines(img2.copy(), cam2, zbuf2, hidden[None], P.MOUNTAIN_RGB, width=3.0)[0] > 0.75
+    *_rest, kept = _stage_view(pose, rotation, front, back, [(shown[None], P.VALLEY_RGB)])
+    assert not kept

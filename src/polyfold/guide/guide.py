@@ -332,7 +332,8 @@ def _instructions(st, seams: list[Seam], pieces, pages: list[int], folded, paths
 
 
 def _folding_pictures(fp, facts: dict | None, color: np.ndarray, name: str, stages) -> tuple[Picture, ...]:
-    """The piece along its verified path, from one direction (the printed side up), each picture
+    """The piece along its verified path, from one direction (the printed side up; a stage picture
+    turned a quarter at a time when that direction hides its creases, `_stage_view`), each picture
     filled by the piece: flat, a
     third, two thirds, folded for a straight path; flat and the end of each stage (the creases
     closing in it thick) for one that folds stage by stage."""
@@ -361,16 +362,45 @@ def _folding_pictures(fp, facts: dict | None, color: np.ndarray, name: str, stag
     goal = frames[-1]
     out = []
     for (t, creases, caption), pose in zip(shots, poses):
-        cam = P.fit_camera(pose, rotation, *FRAME_PX)  # each as large as it fits: a folded piece is small
-        img, ids, zbuf = P.draw_faces(cam, pose, front, back)
+        lines = []  # (segments, colour) of the creases closing in this stage, mountains then valleys
         for want, rgb in ((True, P.MOUNTAIN_RGB), (False, P.VALLEY_RGB)):
-            sel = [e for e in creases if (goal[e] > 0) == want]
-            if sel:
-                segs = []
-                for e in sel:
+            segs = []
+            for e in creases:
+                if (goal[e] > 0) == want:
                     u, v = (int(x) for x in fp.pattern.edges[e])
                     f, c0, c1 = side[(min(u, v), max(u, v))]
                     segs.append(pose[f, [c0, c1]])
-                P.draw_lines(img, cam, zbuf, np.array(segs), rgb, width=3.0)
-        out.append(Picture(img, caption))
+            if segs:
+                lines.append((np.array(segs), rgb))
+        cam, img, zbuf, turned = _stage_view(pose, rotation, front, back, lines)
+        for segs, rgb in lines:
+            P.draw_lines(img, cam, zbuf, segs, rgb, width=3.0)
+        out.append(Picture(img, caption + (" (turned to show its creases)" if turned else "")))
     return tuple(out)
+
+
+def _stage_view(pose: np.ndarray, rotation: np.ndarray, front: np.ndarray, back: np.ndarray,
+                lines: list) -> tuple:
+    """(camera, picture of the faces, depth buffer, turned) for one folding picture: from the
+    folding pictures' direction, each as large as it fits; when that hides most of the creases to
+    draw (a stage's single crease behind the shape), turned about the vertical in quarter turns
+    to the view that shows the most of them (turned: not the usual direction)."""
+    from ..formats.raster import view_rotation
+
+    best = None
+    turns = (0.0, 90.0, 180.0, 270.0) if lines else (0.0,)
+    for turn in turns:
+        rot = rotation if turn == 0.0 else view_rotation(FRAME_VIEW[0], FRAME_VIEW[1] + turn, 2)
+        cam = P.fit_camera(pose, rot, *FRAME_PX)  # a folded piece is small
+        img, _ids, zbuf = P.draw_faces(cam, pose, front, back)
+        if not lines:
+            return cam, img, zbuf, False
+        scratch = img.copy()
+        seen = np.concatenate([P.draw_lines(scratch, cam, zbuf, segs, rgb, width=3.0) for segs, rgb in lines])
+        lengths = np.concatenate([np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1) for segs, _ in lines])
+        score = float(seen @ lengths / max(lengths.sum(), 1e-300))  # the share of the creases' length seen
+        if best is None or score > best[0] + 0.25:  # turn only for a much better view
+            best = (score, cam, img, zbuf, turn != 0.0)
+        if best[0] >= 0.75:
+            break
+    return best[1:]
