@@ -321,7 +321,7 @@ def _beside(a, ga, b, mb, d, tol):
     and y in the basis (e1, n cross e1), scaled by |e1|^2 (six of them; no square root)."""
     if not (mb == 1 or mb == 2 or mb == 4):
         return False
-    k = 0 if mb == 1 else (1 if mb == 2 else 2)
+    k = _corner_of(mb)
     if abs(d[k]) > tol:
         return False
     j = _corner_at(a, b[k], tol)
@@ -372,7 +372,7 @@ def _straddle_clear(a, ga, b, mb, d, gap, reach, tol):
     of the plane reaches into a only within reach of s."""
     if not (mb == 1 or mb == 2 or mb == 4):
         return False
-    k = 0 if mb == 1 else (1 if mb == 2 else 2)
+    k = _corner_of(mb)
     if abs(d[k]) > tol:
         return False
     c1, c2 = b[(k + 1) % 3], b[(k + 2) % 3]
@@ -506,7 +506,7 @@ def _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach):
         # each face is cut to a quad away from the shared corner; while the corner's two copies are
         # apart (a mesh vertex not yet closed) the whole faces are often farther apart than the
         # thickness, and then so are their quads (and they do not cross)
-        ka, kb = 0 if ma == 1 else (1 if ma == 2 else 2), 0 if mb == 1 else (1 if mb == 2 else 2)
+        ka, kb = _corner_of(ma), _corner_of(mb)
         dk = (a[ka][0] - b[kb][0], a[ka][1] - b[kb][1], a[ka][2] - b[kb][2])
         if _dot(dk, dk) > thick * thick and faces_apart(a, b, ga, gb, thick):
             return False
@@ -536,11 +536,17 @@ def _one_bit(m):
     return m == 1 or m == 2 or m == 4
 
 
+@njit(cache=True, inline="always")
+def _corner_of(m):
+    """The corner (0, 1, 2) of a one-bit corner mask m (`_one_bit`)."""
+    return 0 if m == 1 else (1 if m == 2 else 2)
+
+
 @njit(cache=True)
 def _corner_cut(t, mask, reach):
     """Triangle t with its corner in mask (one bit) cut off at reach along its two sides (at most
     half of each): what is left away from the point it shares, as the two triangles of a quad."""
-    k = 0 if mask == 1 else (1 if mask == 2 else 2)
+    k = _corner_of(mask)
     c, p, n = t[k], t[(k + 2) % 3], t[(k + 1) % 3]
     dp = (p[0] - c[0], p[1] - c[1], p[2] - c[2])
     dn = (n[0] - c[0], n[1] - c[1], n[2] - c[2])

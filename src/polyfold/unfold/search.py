@@ -239,28 +239,25 @@ def run_memetic(
     # The first batch of the population only, then one local search from its best: most nets
     # are finished by that search, and building the whole population (hundreds of heuristic
     # trees) first would cost ten times more. The rest of the population is built only if not.
-    pop, fit, origin, evaluations, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population), finished)
-    if hit >= 0:
-        return pop[hit].copy(), 0.0, 0, evaluations, origin[hit]
-    best, best_fit = pop[int(np.argmax(fit))].copy(), float(fit.max())
-    generation = 0
-    since = 0  # generations since the population was last built
-    restarts = 0
-    while generation < max_generations and not deadline.expired():
-        if since == RESTART_GENERATIONS * luby(restarts + 1):
-            # a restart: the time a search needs is heavy-tailed (one seed in seconds, the next
-            # stuck on one overlap for minutes), so runs are cut after a Luby sequence of
-            # generations (1, 1, 2, 1, 1, 2, 4, ... x RESTART_GENERATIONS) and start afresh from a
-            # new first batch, the random stream going on (deterministic for a seed)
-            restarts += 1
-            since = 0
+    # Restarts: the time a search needs is heavy-tailed (one seed in seconds, the next stuck on one
+    # overlap for minutes), so runs are cut after a Luby sequence of generations (1, 1, 2, 1, 1,
+    # 2, 4, ... x RESTART_GENERATIONS) and start afresh from a new first batch, the random stream
+    # going on (deterministic for a seed).
+    pop = fit = best = None
+    best_fit = -np.inf
+    generation = evaluations = since = batches = 0
+    while pop is None or (generation < max_generations and not deadline.expired()):
+        if pop is None or since == RESTART_GENERATIONS * luby(batches):
             pop, fit, origin, more_ev, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population),
                                                               finished)
             evaluations += more_ev
             if hit >= 0:
                 return pop[hit].copy(), 0.0, generation, evaluations, origin[hit]
-            if deadline.expired():
-                break
+            if fit.max() > best_fit:
+                best, best_fit = pop[int(np.argmax(fit))].copy(), float(fit.max())
+            batches += 1
+            since = 0
+            continue  # (the deadline may have passed while building)
         generation += 1
         since += 1
         if since == 1:
@@ -476,9 +473,12 @@ def unfold(
     timed_out = len(pairs) > 0
 
     def in_pieces() -> Net:
-        cuttable = (parent_edge >= 0) & ~problem.merged[parent_edge]
-        cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5),
-                                cuttable=cuttable)
+        """The net, cut into pieces where faces overlap (none: as it is)."""
+        cut = None
+        if len(pairs):
+            cuttable = (parent_edge >= 0) & ~problem.merged[parent_edge]
+            cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5),
+                                    cuttable=cuttable)
         return _net_from_tree(problem, parent, parent_edge, order, coords, cut)
 
     if len(pairs) and max_pieces == 1:
@@ -493,7 +493,7 @@ def unfold(
             f"no single-piece net found in {searched:.1f} s "
             f"({generations} generations, best net has {len(pairs)} overlapping face pairs)",
             pieces=fallback)
-    net = in_pieces() if len(pairs) else _net_from_tree(problem, parent, parent_edge, order, coords, None)
+    net = in_pieces()
     accepted = None
     if accept is not None:
         accepted = net.n_pieces == 1 and bool(accept(net))
