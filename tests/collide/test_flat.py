@@ -93,3 +93,25 @@ def test_crease_pairs_are_skipped():
     tris = np.stack([a, a + 0.1])
     assert len(find_overlaps(tris, np.array([-1, -1]))) == 1
     assert len(find_overlaps(tris, np.array([-1, 0]))) == 0
+
+
+def test_pairs_between_two_sets_are_the_brute_force_pairs_across():
+    """`overlapping_pairs_between` (the grid of the smaller set) finds exactly the oracle's
+    overlapping pairs with one face in each set: random triangles of mixed sizes (the grid's cell
+    follows the smaller set), sets of every proportion, some crease pairs skipped."""
+    from polyfold.collide.flat import face_bounds, overlapping_pairs_between
+
+    rng = np.random.default_rng(5)
+    for n, share in ((30, 0.5), (120, 0.1), (120, 0.9), (200, 0.02), (60, 1.0)):
+        scale = np.where(rng.random(n) < 0.2, 4.0, 1.0)[:, None, None]
+        tris = rng.random((n, 1, 2)) * 12 + (rng.random((n, 3, 2)) - 0.5) * scale
+        parent = np.where(rng.random(n) < 0.3, rng.integers(0, n, n), -1)
+        bounds = [np.empty(n) for _ in range(4)]
+        face_bounds(tris, np.arange(n), *bounds)
+        in_a = rng.random(n) < share
+        a, b = np.flatnonzero(in_a), np.flatnonzero(~in_a)
+        got = overlapping_pairs_between(tris, parent, a, b, *bounds, 0.0)
+        assert len({tuple(p) for p in got}) == len(got)  # each pair once
+        want = {(min(i, j), max(i, j)) for i in a for j in b
+                if parent[i] != j and parent[j] != i and oracle_overlap(tris[i].tolist(), tris[j].tolist())}
+        assert {tuple(p) for p in got} == want and (len(want) > 0 or len(a) in (0, n))

@@ -300,7 +300,7 @@ def test_luby_sequence() -> None:
 
 def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     """A search cut into restarts after 1, 1, 2, ... generations (restart unit 1): on horse-302,
-    seed 11 finds its net in the third generation, after two restarts, the same net every time,
+    seed 12 finds its net in the third generation, after two restarts, the same net every time,
     and the net has no overlap."""
     import polyfold.unfold.search as search
 
@@ -309,7 +309,7 @@ def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     kept = search.RESTART_GENERATIONS
     search.RESTART_GENERATIONS = 1
     try:
-        runs = [search.run_memetic(problem, np.random.default_rng(11), Deadline.never(), 4, population=50)
+        runs = [search.run_memetic(problem, np.random.default_rng(12), Deadline.never(), 4, population=50)
                 for _ in range(2)]
     finally:
         search.RESTART_GENERATIONS = kept
@@ -334,3 +334,33 @@ def test_no_single_net_carries_the_searched_net_in_pieces(models_dir) -> None:
     with pytest.raises(NoNetFound) as blocked:
         unfold(single_component(models_dir, "star-4split-96"), seed=1, time_limit=60, max_pieces=1)
     assert blocked.value.pieces is None
+
+
+@pytest.mark.parametrize("name", ["horse-302", "bunny-348"])
+def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> None:
+    """The local search keeps its overlapping pairs across moves (re-testing only pairs across
+    the moved subtree): the score it reports must equal G + 100 L counted afresh, by the plain
+    sweep over every pair, on the tree it returns, for runs of several lengths from random and
+    steepest-edge trees."""
+    from polyfold.unfold.problem import random_weights, steepest_edge_weights
+    from polyfold.unfold.search import _genome_of_tree
+
+    mesh = single_component(models_dir, name)
+    topo = mesh.topology
+    problem = UnfoldProblem.from_mesh(mesh)
+    scores = []
+    for seed in range(4):
+        weights = (steepest_edge_weights if seed % 2 else random_weights)(problem, np.random.default_rng(seed))
+        _, parent_edge, _, _ = problem.decode(weights)
+        crease = np.zeros(topo.n_edges, dtype=np.bool_)
+        crease[parent_edge[parent_edge >= 0]] = True
+        for iterations in (20, 200, 1000):
+            score, _ = K.local_search(crease, problem.merged, problem.base, problem.adj_ptr, problem.adj_face,
+                                      problem.adj_edge, topo.edge_faces, mesh.faces, topo.face_edges, topo.edges,
+                                      problem.hyperbolic, problem.local, problem.tol, iterations, seed, 0.5)
+            parent, _, _, tris = problem.decode(_genome_of_tree(crease, np.random.default_rng(0)))
+            pairs = find_overlaps(tris, parent, problem.tol)
+            G, L = len(pairs), K.local_overlaps(pairs.astype(np.int64), topo.face_edges, topo.edges, problem.hyperbolic)
+            assert score == G + 100 * L, (seed, iterations)
+            scores.append(score)
+    assert max(scores) > 0 and len(set(scores)) > 4  # overlapping trees and moves that changed them

@@ -110,3 +110,92 @@ def find_overlaps(tris: np.ndarray, parent: np.ndarray | None = None, tol: float
     count, _ = overlapping_pairs(tris, np.asarray(parent, np.int64), float(tol), 0)
     _, pairs = overlapping_pairs(tris, np.asarray(parent, np.int64), float(tol), int(count))
     return pairs
+
+
+@njit(cache=True)
+def face_bounds(tris: np.ndarray, faces: np.ndarray, xmin: np.ndarray, xmax: np.ndarray, ymin: np.ndarray,
+                ymax: np.ndarray) -> None:
+    """Write the axis-aligned bounds of tris[f] (F, 3, 2) to xmin[f], ... for each f in `faces`."""
+    for f in faces:
+        xmin[f] = min(tris[f, 0, 0], tris[f, 1, 0], tris[f, 2, 0])
+        xmax[f] = max(tris[f, 0, 0], tris[f, 1, 0], tris[f, 2, 0])
+        ymin[f] = min(tris[f, 0, 1], tris[f, 1, 1], tris[f, 2, 1])
+        ymax[f] = max(tris[f, 0, 1], tris[f, 1, 1], tris[f, 2, 1])
+
+
+@njit(cache=True)
+def overlapping_pairs_between(tris: np.ndarray, parent: np.ndarray, a: np.ndarray, b: np.ndarray, xmin: np.ndarray,
+                              xmax: np.ndarray, ymin: np.ndarray, ymax: np.ndarray, tol: float) -> np.ndarray:
+    """The overlapping pairs (k, 2) (smaller index first) of one face of `a` and one of `b`.
+
+    a, b: disjoint face indices; xmin..ymax (F,): the faces' bounds (`face_bounds`); crease pairs
+    (f, parent[f]) skipped. The same test as `overlapping_pairs` restricted to pairs across the two
+    sets: the smaller set is binned in a uniform grid over its bounds, and each face of the other
+    set looks only in the cells its bounds cover, so the cost is one pass over the larger set plus
+    the pairs that are near each other.
+    """
+    if a.shape[0] > b.shape[0]:
+        a, b = b, a
+    out = np.empty((16, 2), dtype=np.int64)
+    count = 0
+    if a.shape[0] == 0:
+        return out[:0]
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
+    size = 0.0
+    for f in a:
+        x0 = min(x0, xmin[f])
+        x1 = max(x1, xmax[f])
+        y0 = min(y0, ymin[f])
+        y1 = max(y1, ymax[f])
+        size += max(xmax[f] - xmin[f], ymax[f] - ymin[f])
+    # cells about one face across, at most ~4 per face of `a`
+    cell = max(size / a.shape[0], np.sqrt((x1 - x0) * (y1 - y0) / (4.0 * a.shape[0])), 1e-300)
+    nx = int((x1 - x0) / cell) + 1
+    ny = int((y1 - y0) / cell) + 1
+    start = np.zeros(nx * ny + 1, dtype=np.int64)
+    for f in a:
+        for i in range(int((xmin[f] - x0) / cell), int((xmax[f] - x0) / cell) + 1):
+            for j in range(int((ymin[f] - y0) / cell), int((ymax[f] - y0) / cell) + 1):
+                start[i * ny + j + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    binned = np.empty(start[-1], dtype=np.int64)
+    for f in a:
+        for i in range(int((xmin[f] - x0) / cell), int((xmax[f] - x0) / cell) + 1):
+            for j in range(int((ymin[f] - y0) / cell), int((ymax[f] - y0) / cell) + 1):
+                binned[fill[i * ny + j]] = f
+                fill[i * ny + j] += 1
+    for g in b:
+        if xmin[g] >= x1 - tol or xmax[g] <= x0 + tol or ymin[g] >= y1 - tol or ymax[g] <= y0 + tol:
+            continue
+        i0 = max(int((xmin[g] - x0) / cell), 0)
+        i1 = min(int((xmax[g] - x0) / cell), nx - 1)
+        j0 = max(int((ymin[g] - y0) / cell), 0)
+        j1 = min(int((ymax[g] - y0) / cell), ny - 1)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for q in range(start[i * ny + j], start[i * ny + j + 1]):
+                    f = binned[q]
+                    if xmin[f] >= xmax[g] - tol or xmin[g] >= xmax[f] - tol:
+                        continue
+                    if ymin[f] >= ymax[g] - tol or ymin[g] >= ymax[f] - tol:
+                        continue
+                    # each pair once: in the cell holding the lower-left corner of the bounds' overlap
+                    if (min(max(int((max(xmin[f], xmin[g]) - x0) / cell), 0), nx - 1) != i
+                            or min(max(int((max(ymin[f], ymin[g]) - y0) / cell), 0), ny - 1) != j):
+                        continue
+                    if parent[f] == g or parent[g] == f:
+                        continue
+                    if triangles_overlap(tris[f], tris[g], tol):
+                        if count == out.shape[0]:
+                            grown = np.empty((2 * count, 2), dtype=np.int64)
+                            grown[:count] = out
+                            out = grown
+                        out[count, 0] = min(f, g)
+                        out[count, 1] = max(f, g)
+                        count += 1
+    return out[:count]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..collide.flat import overlapping_pairs
+from ..collide.flat import face_bounds, overlapping_pairs, overlapping_pairs_between
 
 
 # Prim's heap: parallel arrays (weight, push counter, face, parent, edge) ordered by (weight,
@@ -115,12 +115,18 @@ def layout_tree(order, parent, parent_edge, faces, face_edges, local, out):
     local (F, 3, 2) is each triangle in its own frame (CCW). The base face keeps its local frame;
     each child is rotated and translated so that its crease corners land exactly on the parent's.
     """
-    n = order.shape[0]
     base = order[0]
     for c in range(3):
         out[base, c, 0] = local[base, c, 0]
         out[base, c, 1] = local[base, c, 1]
-    for idx in range(1, n):
+    place_children(order[1:], parent, parent_edge, faces, face_edges, local, out)
+
+
+@njit(cache=True)
+def place_children(order, parent, parent_edge, faces, face_edges, local, out):
+    """Lay out the faces of `order` (F',) in turn, each from its parent's corners in out (F, 3, 2):
+    the parent of each must be placed already (earlier in `order`, or before the call)."""
+    for idx in range(order.shape[0]):
         f = order[idx]
         p = parent[f]
         e = parent_edge[f]
@@ -242,7 +248,7 @@ def _score(pairs, count, face_edges, edges, hyperbolic):
 
 @njit(cache=True)
 def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, faces, face_edges, edges, hyperbolic,
-                 local, tol, max_pairs, iterations, seed, temperature):
+                 local, tol, iterations, seed, temperature):
     """Edge-swap local search on the spanning tree (in place on `crease`, a bool mask per edge).
 
     A move picks an overlapping pair, a crease on the tree path between the two faces that is not
@@ -250,6 +256,11 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     and reconnects the two halves; it is kept when the score (G + 100 L) does not grow, or with
     probability exp(-delta / temperature). Returns (best score, iterations done); `crease` holds
     the best tree seen.
+
+    A move turns the subtree it detaches as one rigid body, so only pairs across the subtree's
+    boundary can change: those are re-tested (`overlapping_pairs_between`) and the pairs on either
+    side carried over. A score of 0 is
+    confirmed by testing every pair.
     """
     np.random.seed(seed)
     n = faces.shape[0]
@@ -257,10 +268,22 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     parent, parent_edge, order, tris = tree_arrays(n)
     depth = np.empty(n, dtype=np.int64)
     in_sub = np.empty(n, dtype=np.bool_)
+    sub = np.empty(n, dtype=np.int64)
+    saved = np.empty((n, 3, 2))
+    saved_parent = np.empty(n, dtype=np.int64)
+    saved_edge = np.empty(n, dtype=np.int64)
+    new_order = np.empty(n, dtype=np.int64)
+    hung = np.full(n, -1, dtype=np.int64)
+    xmin = np.empty(n)
+    xmax = np.empty(n)
+    ymin = np.empty(n)
+    ymax = np.empty(n)
     best_crease = crease.copy()
     tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
     layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
-    count, pairs = overlapping_pairs(tris, parent, tol, max_pairs)
+    face_bounds(tris, order, xmin, xmax, ymin, ymax)
+    count, pairs = overlapping_pairs(tris, parent, tol, 0)
+    count, pairs = overlapping_pairs(tris, parent, tol, count)
     score = _score(pairs, count, face_edges, edges, hyperbolic)
     best = score
     it = 0
@@ -288,10 +311,13 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         for idx in range(n):
             in_sub[order[idx]] = False
         in_sub[x] = True
+        n_sub = 0
         for idx in range(n):
             y = order[idx]
-            if parent[y] >= 0 and in_sub[parent[y]]:
+            if y == x or (parent[y] >= 0 and in_sub[parent[y]]):
                 in_sub[y] = True
+                sub[n_sub] = y
+                n_sub += 1
         # reservoir-sample a reconnecting cut edge
         pick = -1
         seen = 0
@@ -310,21 +336,66 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             continue
         crease[c] = False
         crease[pick] = True
-        tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
-        layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
-        new_count, new_pairs = overlapping_pairs(tris, parent, tol, max_pairs)
-        new_score = _score(new_pairs, new_count, face_edges, edges, hyperbolic)
+        # Re-hang the subtree from the new crease (a BFS from its end of `pick`, placed after the
+        # other faces, whose parents and exact coordinates do not change) and lay out only it.
+        moved = sub[:n_sub]
+        for f in moved:
+            saved[f] = tris[f]
+            saved_parent[f] = parent[f]
+            saved_edge[f] = parent_edge[f]
+        hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
+        n_rest = 0
+        for idx in range(n):
+            if not in_sub[order[idx]]:
+                new_order[n_rest] = order[idx]
+                n_rest += 1
+        parent[hang] = edge_faces[pick, 0] + edge_faces[pick, 1] - hang
+        parent_edge[hang] = pick
+        hung[hang] = it
+        new_order[n_rest] = hang
+        head = n_rest
+        tail = n_rest + 1
+        while head < tail:
+            y = new_order[head]
+            head += 1
+            for k in range(adj_ptr[y], adj_ptr[y + 1]):
+                z = adj_face[k]
+                if crease[adj_edge[k]] and in_sub[z] and hung[z] != it:
+                    hung[z] = it
+                    parent[z] = y
+                    parent_edge[z] = adj_edge[k]
+                    new_order[tail] = z
+                    tail += 1
+        place_children(new_order[n_rest:], parent, parent_edge, faces, face_edges, local, tris)
+        face_bounds(tris, moved, xmin, xmax, ymin, ymax)
+        across = overlapping_pairs_between(tris, parent, moved, new_order[:n_rest], xmin, xmax, ymin, ymax, tol)
+        keep = np.empty(npairs, dtype=np.bool_)
+        for q in range(npairs):
+            keep[q] = in_sub[pairs[q, 0]] == in_sub[pairs[q, 1]]
+        gone = pairs[~keep]
+        new_pairs = np.concatenate((pairs[keep], across))
+        new_score = (score - _score(gone, gone.shape[0], face_edges, edges, hyperbolic)
+                     + _score(across, across.shape[0], face_edges, edges, hyperbolic))
+        if new_score == 0:  # confirmed on every pair before the search stops on it
+            new_count, new_pairs = overlapping_pairs(tris, parent, tol, 0)
+            new_count, new_pairs = overlapping_pairs(tris, parent, tol, new_count)
+            new_score = _score(new_pairs, new_count, face_edges, edges, hyperbolic)
         delta = new_score - score
         if delta <= 0 or (temperature > 0 and np.random.random() < np.exp(-delta / temperature)):
             score = new_score
             pairs = new_pairs
+            order, new_order = new_order, order
             if score < best:
                 best = score
                 best_crease[:] = crease
         else:
             crease[c] = True
             crease[pick] = False
-            tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
+            for f in moved:
+                tris[f] = saved[f]
+                parent[f] = saved_parent[f]
+                parent_edge[f] = saved_edge[f]
+            face_bounds(tris, moved, xmin, xmax, ymin, ymax)
     crease[:] = best_crease
     return best, it
 

@@ -182,6 +182,9 @@ class _AcceptFirst:
         return False
 
 
+LOCAL_SEARCH_CALL = 1_000_000
+
+
 def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.Generator, deadline: Deadline,
                       temperature: float) -> tuple[np.ndarray, int, int]:
     """Edge-swap local search from the tree of a child genome (ALGORITHMS.md 5.5): (improved
@@ -192,8 +195,9 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
     # Effort per generation: enough to finish most nets, small enough to restart from a fresh
     # child when the search is stuck in a local minimum.
     chunk_iters = max(1000, 4 * mesh.n_faces)
-    step = max(10, 100_000 // mesh.n_faces)  # iterations per kernel call: keeps the time checks frequent
-    max_pairs = 4 * mesh.n_faces
+    # iterations per kernel call: tens of milliseconds a call (an iteration costs ~40 ns per face; a
+    # call starts with a full overlap test), so the time checks stay frequent
+    step = max(10, LOCAL_SEARCH_CALL // mesh.n_faces)
     parent, parent_edge, _, _ = problem.decode(child)
     crease = np.zeros(topo.n_edges, dtype=np.bool_)
     crease[parent_edge[parent_edge >= 0]] = True
@@ -201,7 +205,7 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
     while done_iters < chunk_iters:
         score, it = K.local_search(
             crease, problem.merged, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
-            mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol, max_pairs,
+            mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol,
             step, int(rng.integers(2**31)), temperature,
         )
         done_iters += max(it, 1)
