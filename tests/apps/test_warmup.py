@@ -16,7 +16,8 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     assert set(seconds) == {"make", "fold", "segment", "inflate"} and all(s >= 0 for s in seconds.values())
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
-                   "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps"):
+                   "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
+                   "unfold.tabroom._swap_gains"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
 
 

@@ -21,28 +21,66 @@ from polyfold.unfold.tabroom import NOTCH_DEG, open_notches
 
 
 def _free_angles(net) -> list[float]:
-    """Free angle (degrees) of every outline corner of a single-piece net, counted here again: at
-    each vertex, 360 minus the face angles held between a cut edge and the next one."""
-    mesh = net.mesh
-    crease = net.crease_mask
+    """Free angle (degrees) of every outline corner of a single-piece net, counted here again."""
+    return [a for v in range(net.mesh.n_vertices) for a in _free_angles_at(net.mesh, net.crease_mask, v)]
+
+
+def _free_angles_at(mesh, crease, v) -> list[float]:
+    """The free angles (degrees) of the outline corners at vertex v: 360 minus the face angles
+    held between a cut edge and the next one."""
     angles = corner_angles(mesh.vertices, mesh.faces)
     topo = mesh.topology
     out = []
-    for v in range(mesh.n_vertices):
-        fan = [(f, int(np.flatnonzero(mesh.faces[f] == v)[0])) for f in np.flatnonzero((mesh.faces == v).any(axis=1))]
-        cut_in = [(f, j) for f, j in fan if not crease[topo.face_edges[f, (j + 2) % 3]]]
-        for f, j in cut_in:  # turn around v through creases to the next cut edge
-            held = 0.0
-            for _ in range(len(fan)):
-                held += angles[f, j]
-                e = topo.face_edges[f, j]
-                if not crease[e]:
-                    break
-                a, b = topo.edge_faces[e]
-                f = b if a == f else a
-                j = int(np.flatnonzero(mesh.faces[f] == v)[0])
-            out.append(360.0 - math.degrees(held))
+    fan = [(f, int(np.flatnonzero(mesh.faces[f] == v)[0])) for f in np.flatnonzero((mesh.faces == v).any(axis=1))]
+    cut_in = [(f, j) for f, j in fan if not crease[topo.face_edges[f, (j + 2) % 3]]]
+    for f, j in cut_in:  # turn around v through creases to the next cut edge
+        held = 0.0
+        for _ in range(len(fan)):
+            held += angles[f, j]
+            e = topo.face_edges[f, j]
+            if not crease[e]:
+                break
+            a, b = topo.edge_faces[e]
+            f = b if a == f else a
+            j = int(np.flatnonzero(mesh.faces[f] == v)[0])
+        out.append(360.0 - math.degrees(held))
     return out
+
+
+def test_corner_penalties_and_swap_gains_match_a_recount(models_dir) -> None:
+    """The compiled corner walk (`_Fans.penalties`, `_Fans.swap_gains`) against the free angles
+    counted here: each vertex's penalty is the sum of max(0, 1 - free / NOTCH_DEG) over its
+    corners, on a net's creases and on random crease masks; a swap's gain is the change of the
+    recounted penalties of the four end vertices, and the mask comes back unchanged."""
+    from polyfold.unfold.tabroom import _Fans
+
+    mesh = load_mesh(models_dir / "bunny-128.obj").components[0]
+    net, _ = unfold(mesh, seed=3)
+    fans = _Fans(net)
+    edges = mesh.topology.edges
+
+    def recount(crease, v):
+        return sum(max(0.0, 1.0 - a / NOTCH_DEG) for a in _free_angles_at(mesh, crease, v))
+
+    rng = np.random.default_rng(0)
+    for crease in (net.crease_mask.copy(), rng.random(mesh.topology.n_edges) < 0.7):
+        pen = fans.penalties(np.arange(mesh.n_vertices), crease)
+        want = np.array([recount(crease, v) for v in range(mesh.n_vertices)])
+        assert np.allclose(pen, want, atol=1e-9) and want.max() > 0
+        e2 = int(rng.choice(np.flatnonzero(crease)))
+        cand = np.flatnonzero(~crease)[:40]
+        kept = crease.copy()
+        delta, touched, after = fans.swap_gains(e2, cand, crease, edges, pen)
+        assert np.array_equal(crease, kept)
+        for c, g in enumerate(cand):
+            swapped = crease.copy()
+            swapped[e2], swapped[g] = False, True
+            verts = sorted({*edges[e2].tolist(), *edges[g].tolist()})
+            assert sorted(u for u in touched[c] if u >= 0) == verts
+            gain = sum(recount(swapped, u) - recount(crease, u) for u in verts)
+            assert delta[c] == pytest.approx(gain, abs=1e-9)
+            assert all(after[c][k] == pytest.approx(recount(swapped, touched[c][k]), abs=1e-9)
+                       for k in range(4) if touched[c][k] >= 0)
 
 
 @pytest.mark.parametrize("name", ["fish-472", "bunny-128"])

@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from ..collide.flat import overlapping_pairs
 from ..deadline import Deadline
@@ -79,13 +80,83 @@ class _Fans:
             out.append((e_in, e_out, held))
         return out
 
-    def penalty(self, v: int, crease: np.ndarray) -> float:
-        return sum(corner_penalty(2 * math.pi - held) for _, _, held in self.corners(v, crease))
+    def penalties(self, verts: np.ndarray, crease: np.ndarray) -> np.ndarray:
+        """(len(verts),) the summed `corner_penalty` of the outline corners at each vertex."""
+        return _vertex_penalties(np.asarray(verts, dtype=np.int64), crease, self.ptr, self.inc_face, self.inc_corner,
+                                 self.face_edges, self.edge_faces, self.faces, self.angle)
+
+    def swap_gains(self, e2: int, cand: np.ndarray, crease: np.ndarray, edges: np.ndarray, pen: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """For cutting crease e2 and gluing each cut edge of `cand`: the change of the total penalty
+        (C,), the vertices it touches (C, 4; -1 pads) and their penalties after the swap (C, 4)."""
+        return _swap_gains(e2, cand, crease, edges, pen, self.ptr, self.inc_face, self.inc_corner, self.face_edges,
+                           self.edge_faces, self.faces, self.angle)
+
+
+NOTCH_RAD = math.radians(NOTCH_DEG)
 
 
 def corner_penalty(free: float) -> float:
     """Shortfall of a corner's free angle (radians) below NOTCH_DEG, as a fraction of it."""
-    return max(0.0, 1.0 - free / math.radians(NOTCH_DEG))
+    return max(0.0, 1.0 - free / NOTCH_RAD)
+
+
+@njit(cache=True)
+def _vertex_penalty(v, crease, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle):
+    """`corner_penalty` summed over the outline corners at vertex v (`_Fans.corners`' walk)."""
+    total = 0.0
+    for i in range(ptr[v], ptr[v + 1]):
+        f = inc_face[i]
+        j = inc_corner[i]
+        if crease[face_edges[f, (j + 2) % 3]]:
+            continue
+        held = 0.0
+        for _ in range(ptr[v + 1] - ptr[v]):
+            held += angle[f, j]
+            e_out = face_edges[f, j]
+            if not crease[e_out]:
+                break
+            f = edge_faces[e_out, 1] if edge_faces[e_out, 0] == f else edge_faces[e_out, 0]
+            for m in range(3):
+                if faces[f, m] == v:
+                    j = m
+        total += max(0.0, 1.0 - (2 * np.pi - held) / NOTCH_RAD)
+    return total
+
+
+@njit(cache=True)
+def _vertex_penalties(verts, crease, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle):
+    out = np.empty(verts.shape[0])
+    for k in range(verts.shape[0]):
+        out[k] = _vertex_penalty(verts[k], crease, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle)
+    return out
+
+
+@njit(cache=True)
+def _swap_gains(e2, cand, crease, edges, pen, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle):
+    """`_Fans.swap_gains` (crease is restored before returning)."""
+    n = cand.shape[0]
+    delta = np.zeros(n)
+    touched = np.full((n, 4), -1, dtype=np.int64)
+    new = np.zeros((n, 4))
+    for c in range(n):
+        g = cand[c]
+        crease[e2] = False
+        crease[g] = True
+        k = 0
+        for u in (edges[e2, 0], edges[e2, 1], edges[g, 0], edges[g, 1]):
+            seen = False
+            for m in range(k):
+                seen |= touched[c, m] == u
+            if seen:
+                continue
+            touched[c, k] = u
+            new[c, k] = _vertex_penalty(u, crease, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle)
+            delta[c] += new[c, k] - pen[u]
+            k += 1
+        crease[e2] = True
+        crease[g] = False
+    return delta, touched, new
 
 
 def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
@@ -114,7 +185,7 @@ def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = 
     crease = net.crease_mask.copy()
     fans = _Fans(net)
     n_v = net.mesh.n_vertices
-    pen = np.array([fans.penalty(v, crease) for v in range(n_v)])
+    pen = fans.penalties(np.arange(n_v), crease)
     before = int(np.count_nonzero(pen > 0))
     if net.n_pieces != 1 or before == 0:
         return net, TabRoomStats(before, before, 0, False)
@@ -167,15 +238,9 @@ def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep
         in_sub = (tin >= tin[child]) & (tin < tout[child])
         fa, fb = edge_faces[:, 0], edge_faces[:, 1]
         cand = np.flatnonzero(inner & ~crease & (in_sub[np.maximum(fa, 0)] != in_sub[np.maximum(fb, 0)]))
-        scored = []
-        for g in cand:
-            touched = {int(x) for x in (*edges[e2], *edges[g])}
-            crease[e2], crease[g] = False, True
-            new = {u: fans.penalty(u, crease) for u in touched}
-            crease[e2], crease[g] = True, False
-            delta = sum(new.values()) - sum(pen[u] for u in touched)
-            if delta < -1e-9:
-                scored.append((delta, int(g), new))
+        delta, touched, after = fans.swap_gains(int(e2), cand, crease, edges, pen)
+        scored = [(float(delta[c]), int(cand[c]), {int(u): float(p) for u, p in zip(touched[c], after[c]) if u >= 0})
+                  for c in np.flatnonzero(delta < -1e-9)]
         # equal gains: the cut edge nearest v first (the moved half turns least, overlaps least)
         scored.sort(key=lambda s: (round(s[0], 2), float(np.linalg.norm(mid[s[1]] - here)), s[1]))
         for delta, g, new in scored[:MAX_TRIES]:
