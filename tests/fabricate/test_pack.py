@@ -361,3 +361,25 @@ def test_page_filler_keeps_a_bounded_raster_cache() -> None:
     again = filler.spot(0, outlines[0], ("part", 0))
     assert (again.y, again.x, again.shape.angle) == (first[0].y, first[0].x, first[0].shape.angle)
     assert len(filler._pieces) == pack.RASTER_CACHE_PIECES
+
+
+def test_points_hull_is_shapelys_hull_of_the_points():
+    """`points_hull` (the compiled monotone chain, then shapely on its corners only) gives the same
+    geometry as shapely's hull of all the points: random clouds, rounded ones (duplicates, several
+    points on a hull side), collinear ones, one and two points."""
+    import shapely
+
+    from polyfold.fabricate.pack import hull_corners, points_hull
+
+    rng = np.random.default_rng(0)
+    for n in (1, 2, 3, 5, 50, 1000):
+        for t in range(30):
+            xy = rng.random((n, 2)) * 100
+            if t % 3 == 0:
+                xy = np.round(xy / 25) * 25
+            if t % 5 == 0:
+                xy[:, 1] = 2 * xy[:, 0] - 3
+            want = shapely.convex_hull(shapely.multipoints(xy))
+            assert points_hull(xy).equals(want), (n, t)
+            if n >= 3 and want.geom_type == "Polygon":
+                assert len(hull_corners(xy)) <= len(shapely.get_coordinates(want)) - 1 + 2

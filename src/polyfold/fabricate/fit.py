@@ -20,7 +20,7 @@ from ..mesh.geometry import face_areas
 from ..mesh.mesh import Mesh
 from ..unfold import kernels as K
 from ..unfold.net import Net, cut_creases, subtree_areas
-from .pack import _best_fit
+from .pack import _best_fit, points_hull
 from .tabs import TAB_ROOM_MM
 
 MAX_PEEL_TRIES = 64
@@ -57,7 +57,7 @@ def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> 
     the fit too (a better rotation of the hull alone need not be one it tries for the outline)."""
     import shapely
 
-    hull = shapely.convex_hull(shapely.multipoints(points_mm)).buffer(pad, quad_segs=2)
+    hull = points_hull(points_mm).buffer(pad, quad_segs=2)
     pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
     return _best_fit(shapely.get_coordinates(hull), PACK_ANGLES, pw, ph)[0]
 
@@ -84,7 +84,7 @@ def _model_factor(points_mm: np.ndarray, page_size, margin: float, pad: float) -
     def fits(factor: float) -> bool:
         return _hull_scale(points_mm * factor, page_size, margin, pad) >= 1.0
 
-    hull = shapely.get_coordinates(shapely.convex_hull(shapely.multipoints(points_mm)))
+    hull = shapely.get_coordinates(points_hull(points_mm))
     lo = _best_fit(hull, PACK_ANGLES, page_size[0] - 2 * (margin + pad), page_size[1] - 2 * (margin + pad))[0]
     while lo > 0 and not fits(lo):  # rounding only
         lo *= 1 - 1e-9

@@ -145,6 +145,46 @@ def _angles(outline: Polygon | MultiPolygon, angles: int, phase: float) -> np.nd
     return np.asarray(keep)
 
 
+@njit(cache=True)
+def hull_corners(xy: np.ndarray) -> np.ndarray:
+    """Indices of the corners of the convex hull of the points xy (n, 2), counter-clockwise from
+    the lowest-x (then lowest-y) point; points on a hull side are left out (Andrew's monotone
+    chain). Collinear points: the two ends; fewer than three points: all of them."""
+    n = xy.shape[0]
+    if n < 3:
+        return np.arange(n)
+    order = np.argsort(xy[:, 1], kind="mergesort")
+    order = order[np.argsort(xy[order, 0], kind="mergesort")]  # by x, then y
+    out = np.empty(2 * n + 1, dtype=np.int64)
+    k = 0
+    for half in range(2):
+        start = k
+        for m in range(n):
+            i = order[m] if half == 0 else order[n - 1 - m]
+            while k >= start + 2:
+                a = out[k - 2]
+                b = out[k - 1]
+                cross = ((xy[b, 0] - xy[a, 0]) * (xy[i, 1] - xy[a, 1])
+                         - (xy[b, 1] - xy[a, 1]) * (xy[i, 0] - xy[a, 0]))
+                if cross > 0:
+                    break
+                k -= 1
+            out[k] = i
+            k += 1
+        k -= 1  # each chain's last point starts the other
+    return out[:k]
+
+
+def points_hull(xy: np.ndarray):
+    """The convex hull of the points xy (n, 2) as a shapely geometry (Polygon; LineString or Point
+    when they are collinear or one), from `hull_corners`: quicker than shapely's own on thousands
+    of points, which builds a geometry for each."""
+    xy = np.ascontiguousarray(xy, dtype=np.float64)
+    if len(xy) == 0:
+        return shapely.Polygon()
+    return shapely.convex_hull(shapely.multipoints(xy[hull_corners(xy)]))
+
+
 def _hull_xy(outline) -> np.ndarray:
     """(n, 2) corners of the outline's convex hull: the same extents in every rotation as all its
     points (they are some of them), from far fewer points."""

@@ -35,7 +35,7 @@ import shapely
 from shapely import MultiPolygon, Polygon
 
 from ..unfold.net import Net, subtree_areas
-from .pack import ANGLES, PageFiller, Spot
+from .pack import ANGLES, PageFiller, Spot, points_hull
 from .pieces import SheetPiece
 from .tabs import CutSide, full_depth, tab_polygon
 
@@ -117,7 +117,7 @@ class _Tree:
             hulls = shapely.convex_hull(self.polys)
             self._corners = (shapely.get_coordinates(hulls), shapely.get_num_coordinates(hulls))
         corners, counts = self._corners
-        return float(shapely.convex_hull(shapely.multipoints(corners[np.repeat(mask, counts)])).area)
+        return float(points_hull(corners[np.repeat(mask, counts)]).area)
 
     def room(self, f: int, side: int) -> Polygon | None:
         """Room for a full-size tab on the crease of face f to its parent, on f (side 0) or on the
