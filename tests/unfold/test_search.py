@@ -300,7 +300,7 @@ def test_luby_sequence() -> None:
 
 def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     """A search cut into restarts after 1, 1, 2, ... generations (restart unit 1): on horse-302,
-    seed 12 finds its net in the third generation, after two restarts, the same net every time,
+    seed 29 finds its net in the third generation, after two restarts, the same net every time,
     and the net has no overlap."""
     import polyfold.unfold.search as search
 
@@ -309,7 +309,7 @@ def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     kept = search.RESTART_GENERATIONS
     search.RESTART_GENERATIONS = 1
     try:
-        runs = [search.run_memetic(problem, np.random.default_rng(12), Deadline.never(), 4, population=50)
+        runs = [search.run_memetic(problem, np.random.default_rng(29), Deadline.never(), 4, population=50)
                 for _ in range(2)]
     finally:
         search.RESTART_GENERATIONS = kept
