@@ -66,18 +66,10 @@ class _Fans:
         for i in range(self.ptr[v], self.ptr[v + 1]):
             f, j = int(self.inc_face[i]), int(self.inc_corner[i])
             e_in = int(self.face_edges[f, (j + 2) % 3])
-            if crease[e_in]:
-                continue
-            held = 0.0
-            for _ in range(self.ptr[v + 1] - self.ptr[v]):
-                held += float(self.angle[f, j])
-                e_out = int(self.face_edges[f, j])
-                if not crease[e_out]:
-                    break
-                a, b = self.edge_faces[e_out]
-                f = int(b if a == f else a)
-                j = int(np.flatnonzero(self.faces[f] == v)[0])
-            out.append((e_in, e_out, held))
+            if not crease[e_in]:
+                e_out, held = _turn(v, f, j, crease, self.ptr[v + 1] - self.ptr[v], self.face_edges, self.edge_faces,
+                                    self.faces, self.angle)
+                out.append((e_in, int(e_out), float(held)))
         return out
 
     def penalties(self, verts: np.ndarray, crease: np.ndarray) -> np.ndarray:
@@ -96,31 +88,40 @@ class _Fans:
 NOTCH_RAD = math.radians(NOTCH_DEG)
 
 
+@njit(cache=True)
 def corner_penalty(free: float) -> float:
     """Shortfall of a corner's free angle (radians) below NOTCH_DEG, as a fraction of it."""
     return max(0.0, 1.0 - free / NOTCH_RAD)
 
 
 @njit(cache=True)
+def _turn(v, f, j, crease, n_fan, face_edges, edge_faces, faces, angle):
+    """From corner j of face f at vertex v, turning around v through creases (at most n_fan
+    faces): (the first cut or boundary edge met, the face angle held up to it)."""
+    held = 0.0
+    e_out = -1
+    for _ in range(n_fan):
+        held += angle[f, j]
+        e_out = face_edges[f, j]
+        if not crease[e_out]:
+            break
+        f = edge_faces[e_out, 1] if edge_faces[e_out, 0] == f else edge_faces[e_out, 0]
+        for m in range(3):
+            if faces[f, m] == v:
+                j = m
+    return e_out, held
+
+
+@njit(cache=True)
 def _vertex_penalty(v, crease, ptr, inc_face, inc_corner, face_edges, edge_faces, faces, angle):
-    """`corner_penalty` summed over the outline corners at vertex v (`_Fans.corners`' walk)."""
+    """`corner_penalty` summed over the outline corners at vertex v (those of `_Fans.corners`)."""
     total = 0.0
     for i in range(ptr[v], ptr[v + 1]):
         f = inc_face[i]
         j = inc_corner[i]
-        if crease[face_edges[f, (j + 2) % 3]]:
-            continue
-        held = 0.0
-        for _ in range(ptr[v + 1] - ptr[v]):
-            held += angle[f, j]
-            e_out = face_edges[f, j]
-            if not crease[e_out]:
-                break
-            f = edge_faces[e_out, 1] if edge_faces[e_out, 0] == f else edge_faces[e_out, 0]
-            for m in range(3):
-                if faces[f, m] == v:
-                    j = m
-        total += max(0.0, 1.0 - (2 * np.pi - held) / NOTCH_RAD)
+        if not crease[face_edges[f, (j + 2) % 3]]:
+            _, held = _turn(v, f, j, crease, ptr[v + 1] - ptr[v], face_edges, edge_faces, faces, angle)
+            total += corner_penalty(2 * np.pi - held)
     return total
 
 
