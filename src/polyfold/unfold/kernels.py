@@ -361,29 +361,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             saved[f] = tris[f]
             saved_parent[f] = parent[f]
             saved_edge[f] = parent_edge[f]
-        hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
-        n_rest = 0
-        for idx in range(n):
-            if not in_sub[order[idx]]:
-                new_order[n_rest] = order[idx]
-                n_rest += 1
-        parent[hang] = edge_faces[pick, 0] + edge_faces[pick, 1] - hang
-        parent_edge[hang] = pick
-        hung[hang] = it
-        new_order[n_rest] = hang
-        head = n_rest
-        tail = n_rest + 1
-        while head < tail:
-            y = new_order[head]
-            head += 1
-            for k in range(adj_ptr[y], adj_ptr[y + 1]):
-                z = adj_face[k]
-                if crease[adj_edge[k]] and in_sub[z] and hung[z] != it:
-                    hung[z] = it
-                    parent[z] = y
-                    parent_edge[z] = adj_edge[k]
-                    new_order[tail] = z
-                    tail += 1
+        n_rest = _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face,
+                         adj_edge, hung, it)
         place_children(new_order[n_rest:], parent, parent_edge, faces, face_edges, local, tris)
         face_bounds(tris, moved, xmin, xmax, ymin, ymax)
         across = overlapping_pairs_between(tris, parent, moved, new_order[:n_rest], xmin, xmax, ymin, ymax, tol)
@@ -416,6 +395,39 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             face_bounds(tris, moved, xmin, xmax, ymin, ymax)
     crease[:] = best_crease
     return best, it
+
+
+@njit(cache=True)
+def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face, adj_edge,
+            hung, stamp):
+    """Hang the subtree (in_sub) from the crease `pick` that now joins it to the other faces: its
+    faces' parents by a BFS over creases from its end of `pick` (hung[f] = stamp marks those
+    reached). new_order: the other faces in `order`'s order, then the subtree's in BFS order (parents
+    first). Returns the number of other faces."""
+    hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
+    n_rest = 0
+    for idx in range(order.shape[0]):
+        if not in_sub[order[idx]]:
+            new_order[n_rest] = order[idx]
+            n_rest += 1
+    parent[hang] = edge_faces[pick, 0] + edge_faces[pick, 1] - hang
+    parent_edge[hang] = pick
+    hung[hang] = stamp
+    new_order[n_rest] = hang
+    head = n_rest
+    tail = n_rest + 1
+    while head < tail:
+        y = new_order[head]
+        head += 1
+        for k in range(adj_ptr[y], adj_ptr[y + 1]):
+            z = adj_face[k]
+            if crease[adj_edge[k]] and in_sub[z] and hung[z] != stamp:
+                hung[z] = stamp
+                parent[z] = y
+                parent_edge[z] = adj_edge[k]
+                new_order[tail] = z
+                tail += 1
+    return n_rest
 
 
 @njit(cache=True)
