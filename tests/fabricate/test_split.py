@@ -25,10 +25,11 @@ from polyfold.unfold.net import cut_creases, piece_net
 MARGIN = 10.0
 
 
-def drawn(models_dir, name: str) -> dict:
-    """A model at the defaults (A4, 150 mm): its pieces as make draws them before folding."""
+def drawn(models_dir, name: str, seed: int = 1) -> dict:
+    """A model at the defaults (A4, 150 mm; the unfolder's `seed`): its pieces as make draws them
+    before folding."""
     mesh = load_mesh(models_dir / f"{name}.obj").mesh
-    opts = MakeOptions()
+    opts = MakeOptions(seed=seed)
     parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
     scale = model_scale([mesh], opts.size)
     box = pack_box(*paper_size(opts.paper), opts)
@@ -169,10 +170,12 @@ def test_flat_polygons_are_never_cut(models_dir):
 
 
 def test_a_cap_cuts_sprawling_pieces_into_compact_parts_that_fill_one_page(models_dir):
-    # star-24's two nets cover 0.59 of a page, but their spikes enclose gaps that the bottom-left fill
-    # cannot use: however the plan cuts them they need two pages, cut into parts whose convex hulls
-    # are at most 0.2 of a page they fit one
-    star = drawn(models_dir, "star-24")
+    # star-24's two nets (seed 3) cover 0.59 of a page, but their spikes enclose gaps that the
+    # bottom-left fill cannot use: however the plan cuts them they need two pages, cut into parts
+    # whose convex hulls are at most 0.2 of a page they fit one. (Which nets a seed gives follows
+    # the unfolder's search: on seeds 1-12, 3 and 5 give such nets now; 8 others fit one page
+    # uncapped or do not fit with the cap either.)
+    star = drawn(models_dir, "star-24", seed=3)
     area = sum(p.footprint.area for p in star["pieces"]) / printable_area(star["page"])
     assert 0.5 < area < 0.65
     assert plan(star, 1) is None
