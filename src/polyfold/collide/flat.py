@@ -102,14 +102,21 @@ def overlapping_pairs(tris: np.ndarray, parent: np.ndarray, tol: float, max_pair
     return count, pairs[: min(count, max_pairs)]
 
 
+@njit(cache=True)
+def all_overlapping_pairs(tris: np.ndarray, parent: np.ndarray, tol: float) -> np.ndarray:
+    """Every overlapping pair (k, 2) of `overlapping_pairs` (one sweep counts, a second collects)."""
+    count, pairs = overlapping_pairs(tris, parent, tol, 0)
+    if count:
+        count, pairs = overlapping_pairs(tris, parent, tol, count)
+    return pairs
+
+
 def find_overlaps(tris: np.ndarray, parent: np.ndarray | None = None, tol: float = 0.0) -> np.ndarray:
     """All overlapping face pairs (k, 2) of a 2D net `tris` (F, 3, 2); crease pairs skipped."""
     tris = np.ascontiguousarray(tris, dtype=np.float64)
     if parent is None:
         parent = np.full(len(tris), -1, dtype=np.int64)
-    count, _ = overlapping_pairs(tris, np.asarray(parent, np.int64), float(tol), 0)
-    _, pairs = overlapping_pairs(tris, np.asarray(parent, np.int64), float(tol), int(count))
-    return pairs
+    return all_overlapping_pairs(tris, np.asarray(parent, np.int64), float(tol))
 
 
 @njit(cache=True)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..collide.flat import face_bounds, overlapping_pairs, overlapping_pairs_between
+from ..collide.flat import all_overlapping_pairs, face_bounds, overlapping_pairs, overlapping_pairs_between
 
 
 # Prim's heap: parallel arrays (weight, push counter, face, parent, edge) ordered by (weight,
@@ -218,24 +218,35 @@ def evaluate_batch(weights, base, adj_ptr, adj_face, adj_edge, faces, face_edges
 
 @njit(cache=True)
 def tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order):
-    """BFS over crease edges from `base`: fills parent, parent_edge, order; returns faces reached."""
+    """BFS over crease edges from `base`: fills parent, parent_edge, order (faces not reached:
+    parent -2); returns faces reached."""
     n = parent.shape[0]
     for f in range(n):
         parent[f] = -2
     parent[base] = -1
     parent_edge[base] = -1
     order[0] = base
-    head = 0
-    tail = 1
+    reached = np.zeros(n, dtype=np.int64)
+    reached[base] = 1
+    return crease_bfs(crease, np.ones(n, dtype=np.bool_), reached, 1, adj_ptr, adj_face, adj_edge, parent,
+                      parent_edge, order, 0)
+
+
+@njit(cache=True)
+def crease_bfs(crease, inside, mark, stamp, adj_ptr, adj_face, adj_edge, parent, parent_edge, order, head):
+    """BFS over crease edges from order[head] (marked: mark[f] == stamp) through the faces with
+    `inside` not yet marked: each one's parent and parent_edge set, appended to order. Returns the
+    end of order."""
+    tail = head + 1
     while head < tail:
         f = order[head]
         head += 1
         for k in range(adj_ptr[f], adj_ptr[f + 1]):
-            e = adj_edge[k]
             g = adj_face[k]
-            if crease[e] and parent[g] == -2:
+            if crease[adj_edge[k]] and inside[g] and mark[g] != stamp:
+                mark[g] = stamp
                 parent[g] = f
-                parent_edge[g] = e
+                parent_edge[g] = adj_edge[k]
                 order[tail] = g
                 tail += 1
     return tail
@@ -291,9 +302,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, order)
     layout_tree(order, parent, parent_edge, faces, face_edges, local, tris)
     face_bounds(tris, order, xmin, xmax, ymin, ymax)
-    count, pairs = overlapping_pairs(tris, parent, tol, 0)
-    count, pairs = overlapping_pairs(tris, parent, tol, count)
-    score = _score(pairs, count, face_edges, edges, hyperbolic)
+    pairs = all_overlapping_pairs(tris, parent, tol)
+    score = _score(pairs, pairs.shape[0], face_edges, edges, hyperbolic)
     best = score
     it = 0
     path = np.empty(n, dtype=np.int64)
@@ -374,9 +384,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         new_score = (score - _score(gone, gone.shape[0], face_edges, edges, hyperbolic)
                      + _score(across, across.shape[0], face_edges, edges, hyperbolic))
         if new_score == 0:  # confirmed on every pair before the search stops on it
-            new_count, new_pairs = overlapping_pairs(tris, parent, tol, 0)
-            new_count, new_pairs = overlapping_pairs(tris, parent, tol, new_count)
-            new_score = _score(new_pairs, new_count, face_edges, edges, hyperbolic)
+            new_pairs = all_overlapping_pairs(tris, parent, tol)
+            new_score = _score(new_pairs, new_pairs.shape[0], face_edges, edges, hyperbolic)
         delta = new_score - score
         if delta <= 0 or (temperature > 0 and np.random.random() < np.exp(-delta / temperature)):
             score = new_score
@@ -414,19 +423,7 @@ def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_fa
     parent_edge[hang] = pick
     hung[hang] = stamp
     new_order[n_rest] = hang
-    head = n_rest
-    tail = n_rest + 1
-    while head < tail:
-        y = new_order[head]
-        head += 1
-        for k in range(adj_ptr[y], adj_ptr[y + 1]):
-            z = adj_face[k]
-            if crease[adj_edge[k]] and in_sub[z] and hung[z] != stamp:
-                hung[z] = stamp
-                parent[z] = y
-                parent_edge[z] = adj_edge[k]
-                new_order[tail] = z
-                tail += 1
+    crease_bfs(crease, in_sub, hung, stamp, adj_ptr, adj_face, adj_edge, parent, parent_edge, new_order, n_rest)
     return n_rest
 
 

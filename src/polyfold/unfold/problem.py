@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..collide.flat import overlapping_pairs
+from ..collide.flat import all_overlapping_pairs
 from ..mesh.geometry import merged_edges, row_dots, vector_norm
 from ..mesh.mesh import Mesh, face_components
 from . import kernels as K
@@ -127,10 +127,7 @@ class UnfoldProblem:
 
     def overlaps(self, coords: np.ndarray, parent: np.ndarray) -> np.ndarray:
         """All overlapping face pairs (k, 2) of a layout (crease pairs skipped)."""
-        count, pairs = overlapping_pairs(coords, parent, self.tol, 0)
-        if count:  # a second sweep to collect them (the first one counts)
-            _, pairs = overlapping_pairs(coords, parent, self.tol, int(count))
-        return pairs
+        return all_overlapping_pairs(coords, parent, self.tol)
 
 
 def local_frames(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
