@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import time
 
-from polyfold.deadline import Deadline
+from polyfold.deadline import CompileTally, Deadline, clock, compiled_seconds
 
 
 def test_left_expired_and_shares():
@@ -13,7 +13,7 @@ def test_left_expired_and_shares():
     assert 0.0 < d.left() <= 0.2 and not d.expired()
     assert d.within(0.05).at <= d.at and d.within(10).at == d.at
     assert abs(d.share(4).left() - d.left() / 4) < 0.01
-    past = Deadline(time.perf_counter() - 1.0)
+    past = Deadline(clock() - 1.0)
     assert past.expired() and past.left() == 0.0 and past.share(3).expired()
     never = Deadline.never()
     assert never.at == math.inf and not never.expired() and never.within(1.0).at < math.inf
@@ -27,7 +27,38 @@ def test_check_raises_out_of_time_only_when_expired():
     Deadline.never().check("anything")
     Deadline.after(10).check("anything")
     with pytest.raises(OutOfTime, match="while drawing") as err:
-        Deadline(time.perf_counter() - 1e-3).check("drawing")
+        Deadline(clock() - 1e-3).check("drawing")
     assert err.value.doing == "drawing" and err.value.exit_code == 1
     d = Deadline.after(5.0)
     assert abs((d.at - d.before(2.0).at) - 2.0) < 1e-9
+
+
+def test_clock_stops_while_numba_compiles():
+    """A time limit is the work's: the minute a first run spends compiling kernels must not run a
+    search out of its budget (a fresh install's first `make` of the bunny did, at 60 s)."""
+    import numpy as np
+    from numba import njit
+
+    d = Deadline.after(60.0)
+    tally = CompileTally()
+    tally.enter("before")
+    left0, compiled0, wall0 = d.left(), compiled_seconds(), time.perf_counter()
+    tally.enter("compiling")
+
+    @njit  # defined here: always compiled, never from a cache
+    def sum_sines(x):
+        s = 0.0
+        for i in range(x.shape[0]):
+            s += np.sin(x[i]) * np.cos(x[i])
+        return s
+
+    assert abs(sum_sines(np.ones(3)) - 3 * math.sin(1.0) * math.cos(1.0)) < 1e-12
+    wall = time.perf_counter() - wall0
+    compiled = compiled_seconds() - compiled0
+    assert 0.05 < compiled <= wall  # the call was mostly compiling...
+    assert left0 - d.left() <= wall - compiled + 1e-3  # ...and the deadline did not count it
+    assert clock() <= time.perf_counter() - compiled
+    by_stage = tally.by_stage()
+    assert "before" not in by_stage and abs(by_stage["compiling"] - compiled) < 1e-3
+    sum_sines(np.ones(4))  # compiled already: no more compile seconds
+    assert tally.by_stage() == by_stage

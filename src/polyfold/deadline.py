@@ -1,4 +1,5 @@
-"""The one way to say "time is up": a `Deadline` (a point on the `time.perf_counter` clock).
+"""The one way to say "time is up": a `Deadline` (a point on `clock()`, the
+`time.perf_counter` clock less numba's compiling).
 
 Every search that runs against a time budget (unfold, segment, fold's planners, make, batch)
 takes a Deadline, checks `expired()` between steps, and reports when it ran out rather than
@@ -6,6 +7,13 @@ hanging; a part of the work gets a share of what is left (`within`, `share`, `be
 must be done whatever the time (make's drawing and fitting) calls `check`, which raises OutOfTime
 past a hard deadline. The pattern of
 OMPL's PlannerTerminationCondition: callers decide when to stop, the work only asks.
+
+Deadlines run on `clock()`, a `time.perf_counter` that stops while numba compiles: a time limit
+is the work's budget, and a first run after `pip install` spends most of a minute compiling
+kernels (once; later runs load them from numba's cache). Counted, that minute ran a bunny's
+`make` out of its 60 s on a fresh install; now its work gets the same time as
+in every later run. `compiled_seconds()` says how long compiling took (the make report's
+"compile_seconds", by stage).
 """
 
 from __future__ import annotations
@@ -16,17 +24,77 @@ from dataclasses import dataclass
 
 from .errors import OutOfTime
 
+_compiling = {"depth": 0, "since": 0.0, "total": 0.0, "watching": False}
+
+
+def _watch_compiles() -> None:
+    """Listen to numba's compile events (once per process): nested compiles (a kernel's callees)
+    count once, in the outermost."""
+    from numba.core import event
+
+    class _Tally(event.Listener):
+        def on_start(self, ev: event.Event) -> None:
+            if _compiling["depth"] == 0:
+                _compiling["since"] = time.perf_counter()
+            _compiling["depth"] += 1
+
+        def on_end(self, ev: event.Event) -> None:
+            _compiling["depth"] -= 1
+            if _compiling["depth"] == 0:
+                _compiling["total"] += time.perf_counter() - _compiling["since"]
+
+    event.register("numba:compile", _Tally())
+    _compiling["watching"] = True
+
+
+def compiled_seconds() -> float:
+    """Seconds this process has spent compiling numba kernels so far (those under way included);
+    0 before the first Deadline."""
+    if _compiling["depth"]:
+        return _compiling["total"] + time.perf_counter() - _compiling["since"]
+    return _compiling["total"]
+
+
+def clock() -> float:
+    """`time.perf_counter()` less the seconds spent compiling: the clock every Deadline runs on.
+    (Process-wide: while one thread compiles, every thread's deadlines wait.)"""
+    if not _compiling["watching"]:
+        _watch_compiles()
+    return time.perf_counter() - compiled_seconds()
+
+
+class CompileTally:
+    """Seconds spent compiling, by stage of a run: call `enter(stage)` as each stage starts;
+    `seconds` {stage: s} holds the stages that compiled anything (nothing on a warm cache)."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+        self._stage: str | None = None
+        self._mark = compiled_seconds()
+
+    def enter(self, stage: str) -> None:
+        now = compiled_seconds()
+        if self._stage is not None and now > self._mark:
+            self.seconds[self._stage] = self.seconds.get(self._stage, 0.0) + now - self._mark
+        self._stage, self._mark = stage, now
+
+    def by_stage(self) -> dict[str, float]:
+        """`seconds` up to now, the stage under way included."""
+        if self._stage is not None:
+            self.enter(self._stage)
+        return dict(self.seconds)
+
 
 @dataclass(frozen=True)
 class Deadline:
-    """at: the `time.perf_counter()` value at which time is up (math.inf: never)."""
+    """at: the `clock()` value at which time is up (math.inf: never)."""
 
     at: float
 
     @classmethod
     def after(cls, seconds: float) -> Deadline:
         """The deadline `seconds` from now (math.inf: never)."""
-        return cls(time.perf_counter() + seconds)
+        return cls(clock() + seconds)
 
     @classmethod
     def never(cls) -> Deadline:
@@ -34,10 +102,10 @@ class Deadline:
 
     def left(self) -> float:
         """Seconds left, never negative."""
-        return max(0.0, self.at - time.perf_counter())
+        return max(0.0, self.at - clock())
 
     def expired(self) -> bool:
-        return time.perf_counter() >= self.at
+        return clock() >= self.at
 
     def check(self, doing: str) -> None:
         """Raise OutOfTime("... while <doing>") when time is up: the check between steps of work
@@ -52,7 +120,7 @@ class Deadline:
 
     def within(self, seconds: float) -> Deadline:
         """The earlier of this deadline and `seconds` from now."""
-        return Deadline(min(self.at, time.perf_counter() + seconds))
+        return Deadline(min(self.at, clock() + seconds))
 
     def share(self, parts: int) -> Deadline:
         """A deadline for one of `parts` equal shares of the time left (the first of them)."""

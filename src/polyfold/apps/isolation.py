@@ -41,7 +41,6 @@ from collections import deque
 from pathlib import Path
 from typing import Callable, Sequence
 
-from ..deadline import Deadline
 from ..errors import one_line
 from ..formats.files import atomic_write
 
@@ -266,15 +265,15 @@ def _run_local(specs: list[dict], workers: int, on_done: OnDone) -> None:
                                    name=f"polyfold-batch-{i}")
                 proc.start()
                 t0 = time.perf_counter()
-                running[proc.sentinel] = (i, proc, t0, Deadline(t0 + spec["hard_limit"]), res, log)
-            first = Deadline(min(hard.at for _, _, _, hard, _, _ in running.values()))
-            ready = set(wait(list(running), timeout=first.left()))
+                running[proc.sentinel] = (i, proc, t0, t0 + spec["hard_limit"], res, log)  # wall clock: kills hung children
+            first = min(hard for _, _, _, hard, _, _ in running.values())
+            ready = set(wait(list(running), timeout=max(0.0, first - time.perf_counter())))
             now = time.perf_counter()
             for sentinel, (i, proc, t0, hard, res, log) in list(running.items()):
                 if sentinel in ready:
                     proc.join()
                     outcome = process_outcome(proc.exitcode, res, log, now - t0)
-                elif now >= hard.at:
+                elif now >= hard:
                     _kill(proc)
                     outcome = timeout_outcome(specs[i]["hard_limit"], now - t0)
                 else:

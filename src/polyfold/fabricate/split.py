@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import bisect
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -34,6 +33,7 @@ import numpy as np
 import shapely
 from shapely import MultiPolygon, Polygon
 
+from ..deadline import clock
 from ..unfold.net import Net, subtree_areas
 from .pack import ANGLES, PageFiller, Spot, points_hull
 from .pieces import SheetPiece
@@ -212,7 +212,7 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
     margin, gap, angles and seed as `pack.pack_outlines`. A part split off goes onto the page with
     the most room that takes one (`emptiest_first`), else the first. A side split off, and the rest,
     cover at least `min_part` of a page's printable area. None when the plan finds no way, or at
-    `deadline` (`time.perf_counter()` seconds). A plan without cuts is pack_outlines' first fit in
+    `deadline` (a `deadline.clock()` time). A plan without cuts is pack_outlines' first fit in
     the plan's order: given that order as its hint, pack_outlines puts the pieces on `n_pages` pages.
     `rasters`: a dict kept across plans of these very pieces (same page, gap, angles, seed), so that
     a part tried by one is not rasterised again by the next. `cap`: the largest convex hull of a part
@@ -227,7 +227,7 @@ def plan_pages(pieces: Sequence[SheetPiece], nets: Sequence[Net], page_size: tup
     placed: list[tuple[int, int]] = []
     cuts: list[list[int]] = [[] for _ in trees]
     while queue:
-        if time.perf_counter() > deadline:
+        if clock() > deadline:
             return None
         _, _, t, mask = queue.pop(0)
         tree = trees[t]

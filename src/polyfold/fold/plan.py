@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..deadline import Deadline
+from ..deadline import Deadline, clock
 from ..errors import PolyfoldError
 from ..mesh.geometry import rho_to_fold_deg
 from .checker import ValidityChecker, first_blocked_segment
@@ -207,8 +207,8 @@ def plan_fold(
     """
     if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}")
-    t0 = time.perf_counter()
-    deadline = Deadline(t0 + time_limit) if deadline is None else deadline
+    t0, start = time.perf_counter(), clock()
+    deadline = Deadline(start + time_limit) if deadline is None else deadline
     check = ValidityChecker(tree, math.radians(resolution_deg))
     # at most two faces: their one pair is a crease pair or in two pieces, never tested, so every
     # configuration is free; single faces (no DOF): the flat net is the goal. Whatever the planner.
@@ -222,7 +222,7 @@ def plan_fold(
         steps = AUTO if planner == "auto" else ((planner, 1.0),)
         found = None
         for name, share in steps:
-            until = deadline if share >= 1.0 else Deadline(t0 + (deadline.at - t0) * share)
+            until = deadline if share >= 1.0 else Deadline(start + (deadline.at - start) * share)
             found = PLANNER_REGISTRY[name](tree, check, until, settings)
             if found is not None:
                 break

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ..deadline import Deadline
+from ..deadline import CompileTally, Deadline
 from ..errors import OutOfTime, PolyfoldError
 from ..fabricate.check import check_pages
 from ..fabricate.fit import model_scale, smallest_printed
@@ -30,7 +30,7 @@ from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ColorReport, ExportReport, GuideReport, InflateReport, InputReport, LayoutReport,
-                     LoadReport, MakeReport, PieceReport, SimplifyReport, StageReports)
+                     LoadReport, MakeReport, PieceReport, SimplifyReport, StageReports, StageSeconds)
 from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
 
 Progress = Callable[[str, str], None]  # (stage, message)
@@ -172,7 +172,13 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     in the report and on the sheets) and write the make folder into `out_dir` (see `export.py`).
     Raises PolyfoldError (nothing written) on bad input, a piece too large for the paper, or a
     failed sheet check. progress(stage, message) as the work goes."""
-    say = progress or _progress_noop
+    tell = progress or _progress_noop
+    compiling = CompileTally()
+
+    def say(stage: str, message: str) -> None:
+        compiling.enter(stage)
+        tell(stage, message)
+
     width, height = check_options(opts)
     inputs = (Path(source),) if isinstance(source, (str, os.PathLike)) else ()
     check_folder(out_dir, OUTPUTS, inputs)
@@ -181,7 +187,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     mesh, look, input_report, load_report, name = _load(source, name, say)
     try:
         return _make(mesh, look, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report,
-                     inputs)
+                     inputs, compiling)
     except OutOfTime as exc:
         raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
                         f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh first "
@@ -191,7 +197,7 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
 
 def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.PathLike, opts: MakeOptions,
           page: tuple[float, float], say: Progress, hard: Deadline, t0: float, input_report: InputReport,
-          load_report: LoadReport, inputs: tuple[Path, ...]) -> MakeResult:
+          load_report: LoadReport, inputs: tuple[Path, ...], compiling: CompileTally) -> MakeResult:
     """`make` after loading (page: width, height in mm): OutOfTime when `hard` passes in work that
     cannot be skipped."""
     width, height = page
@@ -231,7 +237,9 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
                                                   pdf_bytes=pdf_size),
                               simplify=simplify_report, color=_color_report(look, opts, printed), guide=guide)
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
-                          outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0)
+                          outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0,
+                          compile_seconds=tuple(StageSeconds(stage, round(s, 2))
+                                                for stage, s in compiling.by_stage().items()))
 
     if look is not None and opts.color != "none":
         say("export", f"printing the model's {'texture' if look.textured.any() and opts.color == 'texture' else 'colours'}")

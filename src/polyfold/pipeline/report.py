@@ -211,6 +211,12 @@ class ChecksReport:
 
 
 @dataclass(frozen=True)
+class StageSeconds:
+    stage: str
+    seconds: float
+
+
+@dataclass(frozen=True)
 class MakeReport:
     """report.json. polyfold_report: REPORT_VERSION."""
 
@@ -222,6 +228,9 @@ class MakeReport:
     outputs: tuple[str, ...]
     seconds: float
     polyfold_report: int = REPORT_VERSION
+    # numba compiling its kernels in this run (a first run after install; none once cached), by
+    # stage; not counted against --time-limit (`deadline.clock`)
+    compile_seconds: tuple[StageSeconds, ...] = ()
 
     def to_dict(self) -> dict:
         d = _plain(self)

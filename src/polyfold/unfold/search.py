@@ -445,7 +445,7 @@ def unfold(
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     t0 = time.perf_counter()
     if deadline is None:
-        deadline = Deadline(t0 + time_limit)
+        deadline = Deadline.after(time_limit)
     else:
         time_limit = deadline.left()
     rng = np.random.default_rng(seed)

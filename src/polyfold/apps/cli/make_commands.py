@@ -109,6 +109,10 @@ def make(
              f"{rep.checks.paths_verified}/{len(rep.pieces)} folding paths verified "
              f"(independent check, {opts.thickness:g} mm paper), "
              f"{time.perf_counter() - t0:.2f} s -> {output}")
+        if rep.compile_seconds:
+            say(f"of that, {sum(c.seconds for c in rep.compile_seconds):.1f} s compiling polyfold's kernels (once; "
+                f"{', '.join(f'{c.stage} {c.seconds:.1f} s' for c in rep.compile_seconds)}), not counted against "
+                "--time-limit")
 
 
 @app.command(name="view")

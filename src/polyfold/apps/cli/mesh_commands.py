@@ -108,7 +108,7 @@ def segment(
     check_segmentation_folder(output, (mesh,))
     check_faces_spec(faces)
     t0 = time.perf_counter()
-    deadline = Deadline(t0 + time_limit)
+    deadline = Deadline.after(time_limit)
     loaded = load(mesh, quiet, faces)
     seg = segment_mesh(loaded.mesh, tau=DEFAULT_TAU if tau is None else tau, parts=parts, seed=seed, deadline=deadline)
     seconds = time.perf_counter() - t0

@@ -69,7 +69,7 @@ def unfold(
     check_outputs([output, svg, png], [mesh])
     check_faces_spec(faces)
     t0 = time.perf_counter()
-    deadline = Deadline(t0 + time_limit)
+    deadline = Deadline.after(time_limit)
     loaded = load(mesh, quiet, faces, size)
     opts = NetsOptions(method=method.value, seed=seed, max_pieces=1 if max_pieces == "1" else None, fold=fold,
                        prefer_linear=prefer_linear, planner=planner.value, resolution_deg=resolution_deg,
