@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
@@ -205,7 +205,17 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
     searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
-    parts, segment_report, unfold_report = make_parts(mesh, opts, searches, say, hard=hard)
+    approximate_report = None
+    if opts.approximate == "hulls":
+        from .approximate import approximate_mesh
+
+        mesh, segment_report, approximate_report = approximate_mesh(mesh, opts, searches, say)
+        look = None  # the polyhedra's sides are not the model's faces: nothing to print on them
+        # every polyhedron is a component of its own, unfolded whole (convex: one piece)
+        parts, _, unfold_report = make_parts(mesh, replace(opts, tau=None, parts=None, segment="auto"), searches,
+                                             say, hard=hard)
+    else:
+        parts, segment_report, unfold_report = make_parts(mesh, opts, searches, say, hard=hard)
     try:
         scale = model_scale([mesh], opts.size)
     except PolyfoldError as exc:
@@ -235,7 +245,8 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
                               fold=fold_report, layout=layout_report,
                               export=ExportReport(seconds=time.perf_counter() - te, pages=sheets.packing.n_pages,
                                                   pdf_bytes=pdf_size),
-                              simplify=simplify_report, color=_color_report(look, opts, printed), guide=guide)
+                              simplify=simplify_report, color=_color_report(look, opts, printed), guide=guide,
+                              approximate=approximate_report)
         return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0,
                           compile_seconds=tuple(StageSeconds(stage, round(s, 2))

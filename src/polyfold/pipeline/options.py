@@ -15,6 +15,7 @@ from ..fabricate.paper import COLOR_MODES, DPI, DPI_RANGE, FOOTER_MM, MARK_CLEAR
 PAPERS = {"a4": (210.0, 297.0), "letter": (215.9, 279.4), "a3": (297.0, 420.0), "12x12in": (304.8, 304.8)}
 INFLATE_MODES = ("none", "constrained", "uniform")
 SEGMENT_MODES = ("auto", "none")
+APPROXIMATE_MODES = ("none", "hulls")
 
 
 @dataclass(frozen=True)
@@ -23,6 +24,7 @@ class MakeOptions:
 
     inflate: str = "none"  # none | constrained | uniform
     segment: str = "auto"  # auto | none (ignored when tau or parts is given)
+    approximate: str = "none"  # none | hulls: every part built as a convex polyhedron (pipeline/approximate.py)
     tau: float | None = None
     parts: int | None = None
     paper: str = "a4"
@@ -65,6 +67,8 @@ def check_options(opts: MakeOptions) -> tuple[float, float]:
         raise PolyfoldError(f"--inflate must be none, constrained or uniform, not {opts.inflate!r}")
     if opts.segment not in SEGMENT_MODES:
         raise PolyfoldError(f"--segment must be auto or none, not {opts.segment!r}")
+    if opts.approximate not in APPROXIMATE_MODES:
+        raise PolyfoldError(f"--approximate must be none or hulls, not {opts.approximate!r}")
     if not (opts.size > 0 and math.isfinite(opts.size)):
         raise PolyfoldError(f"--size must be a positive number of mm, not {opts.size}")
     if not (0.5 <= opts.min_label_mm <= 10):

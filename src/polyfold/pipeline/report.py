@@ -77,6 +77,33 @@ class SegmentReport:
 
 
 @dataclass(frozen=True)
+class ApproximateReport:
+    """`make --approximate hulls`: every part of the segmentation built as a convex polyhedron.
+
+    Per part: faces_before (triangles of its clipped hull), faces_after (of the piece built),
+    facets (its flat sides), hausdorff_out / hausdorff_in (approximation to the part's surface /
+    surface to approximation, over the mesh's bbox diagonal), volume_ratio (approximation over
+    the model's volume, all parts). clip_planes: planes that cut overlapping hulls apart;
+    overlapping_pairs: pairs of parts the independent check (an LP per pair) found overlapping
+    (0: interior-disjoint); contacts: (part i, part j, area in model units squared) of the sides
+    where two parts touch, to glue them together."""
+
+    mode: str
+    parts: int
+    faces_before: tuple[int, ...]
+    faces_after: tuple[int, ...]
+    facets: tuple[int, ...]
+    hausdorff_out: tuple[float, ...]
+    hausdorff_in: tuple[float, ...]
+    hausdorff_max: float
+    volume_ratio: float | None  # None for an open mesh (no volume)
+    clip_planes: int
+    overlapping_pairs: int
+    contacts: tuple[tuple[int, int, float], ...]
+    seconds: float
+
+
+@dataclass(frozen=True)
 class NetReport:
     faces: int
     pieces: int
@@ -180,6 +207,7 @@ class StageReports:
     simplify: SimplifyReport | None = None  # only when the mesh was simplified
     color: ColorReport | None = None  # the model's look on the sheets
     guide: GuideReport | None = None  # None with --no-guide
+    approximate: ApproximateReport | None = None  # --approximate hulls
 
 
 @dataclass(frozen=True)

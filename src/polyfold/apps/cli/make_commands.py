@@ -23,6 +23,7 @@ def make(
     segment_mode: str = options.SEGMENT,
     tau: Optional[float] = options.TAU,
     parts: Optional[int] = options.PARTS,
+    approximate: str = options.APPROXIMATE,
     paper: str = options.PAPER,
     size: float = options.SIZE,
     margin: float = options.MARGIN,
@@ -45,7 +46,7 @@ def make(
                                     paper=paper, size=size, margin=margin, tabs=tabs, seed=seed,
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
                                     marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces,
-                                    color=color, dpi=dpi, guide=guide)
+                                    color=color, dpi=dpi, guide=guide, approximate=approximate)
     from ...pipeline.make import make as run_make
     from ..warmup import kernels_cached
 

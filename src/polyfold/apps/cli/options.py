@@ -33,6 +33,8 @@ INFLATE = typer.Option(_D.inflate, "--inflate", help="none | constrained | unifo
 SEGMENT = typer.Option(_D.segment, "--segment", help="auto (one part per component unless no single net is found) | none.")
 TAU = typer.Option(None, "--tau", min=0.0, help="Segment into parts of concavity <= tau (fraction of the bbox diagonal).")
 PARTS = typer.Option(None, "--parts", min=1, help="Segment into this many parts.")
+APPROXIMATE = typer.Option(_D.approximate, "--approximate",
+                           help="none | hulls: build every part (--tau / --parts) as a convex polyhedron, the parts glued face to face (a low-poly model; errors in report.json).")
 PAPER = typer.Option(_D.paper, "--paper", help="a4 | letter | a3 | 12x12in | WxHmm.")
 SIZE = typer.Option(_D.size, "--size", min=1e-6, help="Longest dimension of the built model, mm.")
 MARGIN = typer.Option(_D.margin, "--margin", min=0.0, help="Page margin, mm.")
@@ -63,7 +65,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
                  time_limit: float, fold: bool, contact_tol: float, marks: bool,
                  min_label_mm: float = _D.min_label_mm, thickness: float = _D.thickness,
                  faces: str = _D.faces, color: str = _D.color, dpi: float = _D.dpi,
-                 guide: bool = _D.guide) -> MakeOptions:
+                 guide: bool = _D.guide, approximate: str = _D.approximate) -> MakeOptions:
     """The `MakeOptions` of the command line; fail(message, 2) on option conflicts."""
     if tau is not None and parts is not None:
         fail("give --tau or --parts, not both", 2)
@@ -72,7 +74,7 @@ def make_options(fail: Callable[[str, int], None], *, inflate: str, segment: str
     return MakeOptions(inflate=inflate, segment=segment, tau=tau, parts=parts, paper=paper, size=size,
                        margin=margin, tabs=tabs == "auto", seed=seed, time_limit=time_limit, fold=fold,
                        contact_tol=contact_tol, marks=marks, min_label_mm=min_label_mm, thickness=thickness,
-                       faces=faces, color=color, dpi=dpi, guide=guide)
+                       faces=faces, color=color, dpi=dpi, guide=guide, approximate=approximate)
 
 
 @contextlib.contextmanager

@@ -1,0 +1,109 @@
+"""make's `--approximate hulls` stage: the mesh segmented into nearly convex parts, every part
+replaced by a closed convex polyhedron (`approximate.hulls`), the polyhedra interior-disjoint.
+
+In: the (simplified, inflated) Mesh and make's options. Out: the approximated model as one Mesh
+whose connected components are the parts' polyhedra (part order = component order; make unfolds
+every component whole, as for any mesh of several closed solids), with the segmentation's and
+the approximation's reports. Every pair of polyhedra is checked apart by an LP of its own
+(`approximate.error.lp_overlap_depths`, not the clipping that made them) and the sides where two
+parts touch are measured (`contacts`): those are glued face to face when the model is assembled.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable
+
+import numpy as np
+
+from ..approximate.error import lp_overlap_depths
+from ..approximate.hulls import approximate_hulls
+from ..deadline import Deadline
+from ..errors import PolyfoldError
+from ..mesh.mesh import Mesh
+from ..segment.segment import DEFAULT_TAU, segment
+from .options import MakeOptions
+from .report import ApproximateReport, SegmentReport
+
+# over the bbox diagonal: a ball this deep inside two parts' polyhedra is an overlap (the LP's
+# tolerances are far below; a touching pair has depth 0 up to rounding)
+OVERLAP_DEPTH = 1e-7
+# a side within this angle (cosine) and distance (x diagonal) of another part's side lies on it
+CONTACT_COS = math.cos(1e-4)
+CONTACT_DIST = 1e-7
+
+
+def joined(meshes: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
+    """The meshes as one Mesh (vertices and faces one after another; face_source continued so that
+    facet ids stay apart between meshes)."""
+    offsets = np.cumsum([0] + [m.n_vertices for m in meshes])
+    src_offsets = np.cumsum([0] + [int(m.face_source.max()) + 1 for m in meshes])
+    return Mesh(np.concatenate([m.vertices for m in meshes]),
+                np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]),
+                np.concatenate([m.face_source + o for m, o in zip(meshes, src_offsets)]))
+
+
+def contact_areas(meshes: tuple[Mesh, ...] | list[Mesh], diag: float) -> list[tuple[int, int, float]]:
+    """(i, j, area) for every pair of meshes with flat sides on one plane, facing each other, that
+    overlap with positive area (model units squared): where part i is glued onto part j."""
+    from shapely import Polygon, unary_union
+
+    sides = []  # per mesh: (normal, offset, triangles) of every facet
+    for m in meshes:
+        n = m.face_normals
+        for s in np.unique(m.face_source):
+            tri = m.vertices[m.faces[m.face_source == s]]
+            normal = n[m.face_source == s][0]
+            sides.append((len(sides), normal, float(normal @ tri[0, 0]), tri))
+    owner = np.repeat(np.arange(len(meshes)), [len(np.unique(m.face_source)) for m in meshes])
+    found: dict[tuple[int, int], float] = {}
+    for a, na, da, ta in sides:
+        for b, nb, db, tb in sides:
+            i, j = int(owner[a]), int(owner[b])
+            if i >= j or na @ nb > -CONTACT_COS or abs(da + db) > CONTACT_DIST * diag:
+                continue
+            u = np.cross(na, [1.0, 0.0, 0.0] if abs(na[0]) < 0.9 else [0.0, 1.0, 0.0])
+            u /= np.linalg.norm(u)
+            v = np.cross(na, u)
+            flat = [unary_union([Polygon(t @ np.stack([u, v], axis=1)) for t in tris]) for tris in (ta, tb)]
+            area = float(flat[0].intersection(flat[1]).area)
+            if area > 0.0:
+                found[(i, j)] = found.get((i, j), 0.0) + area
+    return [(i, j, a) for (i, j), a in sorted(found.items())]
+
+
+def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None]
+                     ) -> tuple[Mesh, SegmentReport, ApproximateReport]:
+    """(the approximated model, the segmentation's report, the approximation's) of `mesh` under
+    `--approximate hulls` (`--tau` / `--parts` as for make's segmentation; default tau)."""
+    ts = time.perf_counter()
+    mode = "parts" if opts.parts is not None else "tau"
+    say("segment", f"segmenting into nearly convex parts ({mode})")
+    seg = segment(mesh, tau=DEFAULT_TAU if opts.tau is None else opts.tau, parts=opts.parts, seed=0,
+                  deadline=deadline)
+    seg_report = SegmentReport(mode=mode, tau=seg.tau, parts=seg.n_parts,
+                               concavity=tuple(float(c) for c in seg.concavity),
+                               seconds=time.perf_counter() - ts, segmented_components=())
+    ta = time.perf_counter()
+    say("approximate", f"{seg.n_parts} part(s): convex hulls, cut apart where they overlap")
+    approx = approximate_hulls(mesh, seg, seed=opts.seed)
+    diag = mesh.bbox_diagonal
+    depth = lp_overlap_depths(approx.parts)
+    pairs = np.argwhere(np.triu(depth > OVERLAP_DEPTH * diag, 1))
+    if len(pairs):  # the clipping's own guarantee failed: never build parts that cannot be assembled
+        i, j = (int(x) + 1 for x in pairs[0])
+        raise PolyfoldError(f"the convex parts {i} and {j} overlap (by {depth[i - 1, j - 1] / diag:.2g} of the "
+                            f"diagonal, independent check): try another --tau or --parts")
+    overlapping = len(pairs)
+    contacts = contact_areas(approx.parts, diag)
+    report = ApproximateReport(
+        mode="hulls", parts=approx.n_parts, faces_before=tuple(int(x) for x in approx.faces_before),
+        faces_after=tuple(int(x) for x in approx.faces_after), facets=tuple(int(x) for x in approx.facets),
+        hausdorff_out=tuple(round(float(x), 6) for x in approx.hausdorff_out),
+        hausdorff_in=tuple(round(float(x), 6) for x in approx.hausdorff_in),
+        hausdorff_max=round(float(approx.hausdorff_max), 6),
+        volume_ratio=None if math.isnan(approx.volume_ratio) else round(float(approx.volume_ratio), 6),
+        clip_planes=len(approx.planes), overlapping_pairs=overlapping,
+        contacts=tuple((i, j, round(a, 9)) for i, j, a in contacts), seconds=time.perf_counter() - ta)
+    return joined(approx.parts), seg_report, report
