@@ -85,6 +85,7 @@ MIN_KEEP = 0.05  # a cut leaves each hull at least this fraction of its unclippe
 FLAT_WIDTH = 1e-5
 FLAT_THICKNESS = 0.01
 PLANE_METHODS = ("shared", "centroids", "overlap", "refine")
+DEFAULT_OBJECTIVE = "volume"
 # In the unit frame (diagonal 1): a vertex this close to a plane lies on it; two hulls overlap when a
 # ball of radius above OVERLAP_EPS fits in both (HiGHS runs at 1e-10 feasibility tolerance)
 ON_PLANE = 1e-9
@@ -312,7 +313,7 @@ def _boxes_apart(a: _Polytope, b: _Polytope) -> bool:
 
 
 def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: float, keep_j: float,
-                 normal: np.ndarray) -> tuple[float, float] | None:
+                 wi: float, wj: float, normal: np.ndarray) -> tuple[float, float, float] | None:
     """(offset s, removed volume) of the plane n . x = s with hull i (triangles ti, volume vi)
     kept on n . x <= s and hull j on n . x >= s, minimising vol(cut off i) + vol(cut off j) with
     at least keep_i, keep_j left; None when no offset leaves both that much."""
@@ -321,7 +322,7 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
     pi, pj = ti.reshape(-1, 3) @ normal, tj.reshape(-1, 3) @ normal
     lo, hi = float(pj.min()), float(pi.max())  # beyond [lo, hi] the plane cuts only one hull, deeper
     if lo >= hi:
-        return 0.5 * (lo + hi), 0.0
+        return 0.5 * (lo + hi), 0.0, 0.0
 
     def off_i(s):
         return volume_beyond(ti, normal, s)
@@ -330,13 +331,23 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
         return volume_beyond(tj, -normal, -s)
 
     # kept volume of i grows with s, of j shrinks: the offsets leaving both enough are [a, b]
-    a = lo if vi - off_i(lo) >= keep_i else brentq(lambda s: vi - off_i(s) - keep_i, lo, hi, xtol=1e-12)
-    b = hi if vj - off_j(hi) >= keep_j else brentq(lambda s: vj - off_j(s) - keep_j, lo, hi, xtol=1e-12)
+    def spare_i(s):
+        return vi - off_i(s) - keep_i
+
+    def spare_j(s):
+        return vj - off_j(s) - keep_j
+
+    # a hull already cut down to its floor may still be cut where it loses nothing (rounding: tol)
+    tol_i, tol_j = 1e-9 * vi, 1e-9 * vj
+    if spare_i(hi) < -tol_i or spare_j(lo) < -tol_j:
+        return None
+    a = lo if spare_i(lo) >= -tol_i else brentq(spare_i, lo, hi, xtol=1e-12) if spare_i(hi) > 0 else hi
+    b = hi if spare_j(hi) >= -tol_j else brentq(spare_j, lo, hi, xtol=1e-12) if spare_j(lo) > 0 else lo
     if a > b:
         return None
 
     def cost(s):
-        return off_i(s) + off_j(s)
+        return wi * off_i(s) + wj * off_j(s)
 
     grid = np.linspace(a, b, GRID)
     costs = np.array([cost(s) for s in grid])
@@ -347,7 +358,7 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
         res = minimize_scalar(cost, bounds=(lo_k, hi_k), method="bounded", options={"xatol": 1e-10})
         if res.fun < best_c:
             best_s, best_c = float(res.x), float(res.fun)
-    return best_s, best_c
+    return best_s, best_c, off_i(best_s) + off_j(best_s)
 
 
 def _unit(v: np.ndarray) -> np.ndarray | None:
@@ -384,41 +395,44 @@ def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarr
     return out
 
 
-def _cut(a: _Polytope, b: _Polytope, keep_a: float, keep_b: float, overlap: _Polytope, shared: np.ndarray,
-         methods: tuple[str, ...]) -> tuple[np.ndarray, float, float, str] | None:
+def _cut(a: _Polytope, b: _Polytope, keep: tuple[float, float], weight: tuple[float, float], overlap: _Polytope,
+         shared: np.ndarray, methods: tuple[str, ...]) -> tuple[np.ndarray, float, float, str] | None:
     """(normal, offset, removed volume, method) of the best plane keeping a on n . x <= s and b on
-    n . x >= s; None when no candidate leaves both hulls enough volume."""
+    n . x >= s (cost: weight-ed volumes cut off a and b), each hull keeping at least `keep`; None
+    when no candidate leaves both hulls that much."""
     from scipy.optimize import minimize
 
     ta, tb = a.corners, b.corners
-    best = None
+
+    def offset(n):
+        return _best_offset(ta, tb, a.volume, b.volume, keep[0], keep[1], weight[0], weight[1], n)
+
+    best = None  # (normal, offset, cost, removed, method)
     for method, n in _candidates(a, b, overlap, shared, methods):
         for sign in (1.0, -1.0):
-            got = _best_offset(ta, tb, a.volume, b.volume, keep_a, keep_b, sign * n)
+            got = offset(sign * n)
             if got is not None and (best is None or got[1] < best[2]):
-                best = (sign * n, got[0], got[1], method)
-    if best is None or "refine" not in methods or best[2] == 0.0:
-        return best
-    n0 = best[0]
-    u = _unit(np.cross(n0, [1.0, 0.0, 0.0] if abs(n0[0]) < 0.9 else [0.0, 1.0, 0.0]))
-    w = np.cross(n0, u)
+                best = (sign * n, got[0], got[1], got[2], method)
+    if best is not None and "refine" in methods and best[2] > 0.0:
+        n0 = best[0]
+        u = _unit(np.cross(n0, [1.0, 0.0, 0.0] if abs(n0[0]) < 0.9 else [0.0, 1.0, 0.0]))
+        w = np.cross(n0, u)
 
-    def normal(x):
-        return _unit(n0 + x[0] * u + x[1] * w)
+        def normal(x):
+            return _unit(n0 + x[0] * u + x[1] * w)
 
-    def removed(x):
-        got = _best_offset(ta, tb, a.volume, b.volume, keep_a, keep_b, normal(x))
-        return np.inf if got is None else got[1]
+        def cost(x):
+            got = offset(normal(x))
+            return np.inf if got is None else got[1]
 
-    res = minimize(removed, np.zeros(2), method="Nelder-Mead",
-                   options={"initial_simplex": [[0, 0], [0.1, 0], [0, 0.1]], "xatol": 1e-4, "fatol": 1e-9 * a.volume,
-                            "maxfev": 80})
-    if res.fun < best[2]:
-        n = normal(res.x)
-        got = _best_offset(ta, tb, a.volume, b.volume, keep_a, keep_b, n)
-        if got is not None and got[1] < best[2]:
-            return n, got[0], got[1], "refine"
-    return best
+        res = minimize(cost, np.zeros(2), method="Nelder-Mead",
+                       options={"initial_simplex": [[0, 0], [0.1, 0], [0, 0.1]], "xatol": 1e-4,
+                                "fatol": 1e-6 * best[2], "maxfev": 80})
+        if res.fun < best[2]:
+            got = offset(normal(res.x))
+            if got is not None and got[1] < best[2]:
+                best = (normal(res.x), got[0], got[1], got[2], "refine")
+    return None if best is None else (best[0], best[1], best[3], best[4])
 
 
 def _clip(poly: _Polytope, plane: np.ndarray, cut: int) -> _Polytope | None:
@@ -426,13 +440,17 @@ def _clip(poly: _Polytope, plane: np.ndarray, cut: int) -> _Polytope | None:
     return _polytope(planes, clip)
 
 
-def separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tuple[str, ...] = PLANE_METHODS
-             ) -> tuple[list[_Polytope], list[tuple[int, int, np.ndarray, float, float, str]]]:
+def separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tuple[str, ...] = PLANE_METHODS,
+             objective: str = DEFAULT_OBJECTIVE) -> tuple[list[_Polytope], list[tuple[int, int, np.ndarray, float, float, str]]]:
     """Cut every overlapping pair of hulls (unit frame), largest overlap first: (the hulls, the
-    cuts as (i, j, normal, offset, removed volume, method), i kept on n . x <= offset)."""
+    cuts as (i, j, normal, offset, removed volume, method), i kept on n . x <= offset).
+    objective: "fraction" (each hull's cut-off volume over its unclipped volume) or "volume"."""
     frame = _frame(mesh)
     n = len(hulls)
     floor = [MIN_KEEP * h.volume for h in hulls]
+    if objective not in ("fraction", "volume"):
+        raise ValueError(f"objective must be 'fraction' or 'volume', not {objective!r}")
+    weight = [1.0 / h.volume if objective == "fraction" else 1.0 for h in hulls]
     shared_of = {}
     overlap: dict[tuple[int, int], _Polytope | None] = {}
     for i in range(n):
@@ -448,7 +466,7 @@ def separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tup
         if (i, j) not in shared_of:
             ids = np.intersect1d(seg.vertex_ids[i], seg.vertex_ids[j])
             shared_of[(i, j)] = (mesh.vertices[ids] - frame[0]) / frame[1]
-        got = _cut(hulls[i], hulls[j], floor[i], floor[j], region, shared_of[(i, j)], methods)
+        got = _cut(hulls[i], hulls[j], (floor[i], floor[j]), (weight[i], weight[j]), region, shared_of[(i, j)], methods)
         if got is None:
             raise PolyfoldError(f"parts {i} and {j}: every plane separating their hulls leaves one of them with less "
                                 f"than {MIN_KEEP:.0%} of its volume (a part nested in another's hull)")
@@ -551,14 +569,15 @@ def _frame(mesh: Mesh) -> tuple[np.ndarray, float]:
 
 
 def hull_meshes(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAULT_MIN_FACET,
-                max_growth: float = DEFAULT_MAX_GROWTH, methods: tuple[str, ...] = PLANE_METHODS
+                max_growth: float = DEFAULT_MAX_GROWTH, methods: tuple[str, ...] = PLANE_METHODS,
+                objective: str = DEFAULT_OBJECTIVE
                 ) -> tuple[list[Mesh], np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]:
     """The geometry of `approximate_hulls` without the error measures: (meshes (model units),
     faces_before (P,), facets (P,), simplify_error (P,), cuts (unit frame, `separate`),
     unsimplified volumes (P,), unit frame)."""
     centre, scale = _frame(mesh)
     hulls = [_part_hull(mesh, seg, p, (centre, scale)) for p in range(seg.n_parts)]
-    hulls, cuts = separate(mesh, seg, hulls, methods)
+    hulls, cuts = separate(mesh, seg, hulls, methods, objective)
     before = np.array([len(h.tri) for h in hulls])
     growth = np.zeros(len(hulls))
     cut_apart = {(c[0], c[1]) for c in cuts} | {(c[1], c[0]) for c in cuts}  # clipping planes are never dropped
@@ -575,6 +594,7 @@ def hull_meshes(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAULT_MIN
 
 def approximate_hulls(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAULT_MIN_FACET,
                       max_growth: float = DEFAULT_MAX_GROWTH, methods: tuple[str, ...] = PLANE_METHODS,
+                      objective: str = DEFAULT_OBJECTIVE,
                       samples: int = SAMPLES, seed: int = 0) -> HullApproximation:
     """Every part of `seg` (a segmentation of `mesh`) as a closed convex polyhedron, pairwise
     interior-disjoint, with errors (module docstring, `HullApproximation`).
@@ -586,7 +606,7 @@ def approximate_hulls(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAU
     hull cannot be made or separated (a part on a line, a hull clipped to nothing)."""
     t0 = time.perf_counter()
     meshes, before, facets, growth, cuts, (centre, scale) = hull_meshes(
-        mesh, seg, min_facet=min_facet, max_growth=max_growth, methods=methods)
+        mesh, seg, min_facet=min_facet, max_growth=max_growth, methods=methods, objective=objective)
     diag = mesh.bbox_diagonal
     out, inn, vol = part_errors(seg.parts, meshes, diag, samples, seed)
     closed = not mesh.topology.boundary.any()
