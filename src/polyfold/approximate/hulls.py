@@ -200,7 +200,8 @@ def _polytope(planes: np.ndarray, clip: np.ndarray, inside: np.ndarray | None = 
         if radius <= OVERLAP_EPS or radius >= 1.0:
             return None
     try:
-        pts = HalfspaceIntersection(planes, inside).intersections
+        with np.errstate(divide="ignore", invalid="ignore"):  # unbounded: points at infinity, refused below
+            pts = HalfspaceIntersection(planes, inside).intersections
         if not np.isfinite(pts).all() or np.abs(pts).max() > 10.0:  # unbounded (the unit frame is 1 across)
             return None
         verts, tri, _ = _hull_of(pts)
