@@ -87,11 +87,12 @@ def hausdorff(a: Mesh, b: Mesh, samples: int = HAUSDORFF_SAMPLES, seed: int = 0)
     """Symmetric Hausdorff distance between the surfaces of a and b (model units), over `samples`
     area-weighted points on each and its vertices, each point's distance to the other surface
     exact (`closest.surface_distances`). Never below the distance at those points."""
-    return max(_farthest(_points(a, samples, seed), b), _farthest(_points(b, samples, seed + 1), a))
+    return max(farthest(surface_points(a, samples, seed), b), farthest(surface_points(b, samples, seed + 1), a))
 
 
-def _points(m: Mesh, samples: int, seed: int) -> np.ndarray:
-    """Area-weighted random points on the surface of m, and its vertices."""
+def surface_points(m: Mesh, samples: int, seed: int) -> np.ndarray:
+    """(samples + used vertices, 3) area-weighted random points on the surface of m (seeded), then
+    its vertices (a distance measured at them is never below the one at the corners)."""
     rng = np.random.default_rng(seed)
     area = face_areas(m.vertices, m.faces)
     f = rng.choice(len(m.faces), size=samples, p=area / area.sum())
@@ -103,7 +104,7 @@ def _points(m: Mesh, samples: int, seed: int) -> np.ndarray:
     return np.concatenate([on, m.vertices[np.unique(m.faces)]])
 
 
-def _farthest(points: np.ndarray, m: Mesh) -> float:
+def farthest(points: np.ndarray, m: Mesh) -> float:
     """The largest distance from the points to the surface of m (exact: `closest.surface_distances`)."""
     from .closest import surface_distances
 
