@@ -50,6 +50,7 @@ LINE_COLORS = {"M": (214, 39, 40), "V": (31, 119, 180)}  # mountain red, valley 
 CUT_COLOR = (40, 40, 40)
 HV_COLOR = (230, 20, 20)
 INFLATED_COLOR = (150, 175, 215)
+ORIGINAL_COLOR = (205, 200, 190)  # the mesh a convex approximation stands for, left of it
 ALL_PARTS = "all parts"
 NET_GAP = 0.8  # view units (the model is 2 long): model to nets, on the right
 INFLATED_GAP = 1.4  # model to the inflated copy, on the left
@@ -183,6 +184,7 @@ class Viewer:
         self._set_camera()
         self._add_panels()
         self._add_inflated_nodes()
+        self._original_node = None
         self._connect()
         self._inflater = _Debounced(self._inflate, DEBOUNCE_S)
         self.load(folder)
@@ -228,6 +230,9 @@ class Viewer:
                                                   hint="The part whose pieces fold; the others are ghosted.")
             self.fold_slider = gui.add_slider("Fold", 0.0, 1.0, 0.01, 1.0, hint="0 = flat net, 1 = folded onto the model.")
             self.play_button = gui.add_button("Play", hint="Play the folding path from flat to folded.")
+            self.original_checkbox = gui.add_checkbox(
+                "Show original", True, disabled=self.folder.original is None,
+                hint="A convex approximation (make --approximate hulls): the mesh it stands for, on its left.")
             self.look_checkbox = gui.add_checkbox(
                 "Model's colours", True, hint="Folded, show the model in its texture / colours (model.glb) "
                 "instead of the part colours.")
@@ -273,6 +278,7 @@ class Viewer:
         for h in (self.mode_dropdown, self.pressure_slider, self.stiffness_slider, self.steps_slider):
             h.on_update(lambda _: self._inflater.request())
         self.show_inflated.on_update(lambda _: self._show_inflated_visibility())
+        self.original_checkbox.on_update(lambda _: self._show_original())
         self.make_button.on_click(lambda _: self._start(self._run_make))
         self.export_button.on_click(lambda _: self._start(self._export))
 
@@ -281,8 +287,13 @@ class Viewer:
     def _to_view(self, x: np.ndarray) -> np.ndarray:
         return (((np.asarray(x, dtype=np.float64) - self._center) @ self._rot.T) * self._k).astype(np.float32)
 
-    def _inflated_offset(self) -> tuple[float, float, float]:
+    def _original_offset(self) -> tuple[float, float, float]:
         return (-2.0 * float(self._half[0]) - INFLATED_GAP, 0.0, 0.0)  # left of the model
+
+    def _inflated_offset(self) -> tuple[float, float, float]:
+        """Left of the model; left of the original when the folder is a convex approximation."""
+        steps = 2 if self.folder.original is not None else 1
+        return (steps * (-2.0 * float(self._half[0]) - INFLATED_GAP), 0.0, 0.0)
 
     def _net_row_width(self) -> float:
         return max(2.5, 2.5 * float(self._half[0]))
@@ -315,9 +326,30 @@ class Viewer:
             options = [ALL_PARTS] + [self._part_label(k) for k in range(len(folder.parts))]
             self.part_dropdown.options = options
             verified = sum(p.verified for p in folder.pieces)
-            self._title.content = (f"**{folder.model}**: {len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
+            self._load_original(folder.original)
+            self._title.content = (f"**{folder.model}**"
+                                   + (" (convex approximation; the original on its left)" if folder.original is not None
+                                      else "")
+                                   + f": {len(folder.parts)} part(s), {len(folder.pieces)} piece(s), "
                                    f"{verified}/{len(folder.pieces)} folding paths verified")
             self._show_part()
+
+    def _load_original(self, original: Mesh | None) -> None:
+        """The mesh a convex approximation stands for (the folder's original.obj), left of the
+        model; none for other folders."""
+        if self._original_node is not None:
+            self._original_node.remove()
+            self._original_node = None
+        self.original_checkbox.disabled = original is None
+        if original is not None:
+            self._original_node = self.server.scene.add_mesh_simple(
+                "/original", self._to_view(original.vertices), original.faces.astype(np.uint32), color=ORIGINAL_COLOR,
+                flat_shading=True, side="double", position=self._original_offset(),
+                visible=bool(self.original_checkbox.value))
+
+    def _show_original(self) -> None:
+        if self._original_node is not None:
+            self._original_node.visible = bool(self.original_checkbox.value)
 
     def _add_build_nodes(self) -> None:
         """Every piece folded in place (hidden until a build step is picked), in the guide's piece
@@ -689,7 +721,10 @@ def serve(folder: MakeFolder | str | Path, host: str = DEFAULT_HOST, port: int =
     with _quiet_stdout(), guarded_start(gate):
         server = viser.ViserServer(host=host, port=int(port), label="polyfold", verbose=False)
     try:
-        return Viewer(server, folder, source if source is not None else folder.whole,
+        # the inflation panel and "Run make" work on the mesh the folder was made from: a convex
+        # approximation's original.obj, else the parts welded back together
+        whole = folder.original if folder.original is not None else folder.whole
+        return Viewer(server, folder, source if source is not None else whole,
                       Path(source_path) if source_path is not None else None, folder.path, gate)
     except BaseException:
         with _quiet_stdout():

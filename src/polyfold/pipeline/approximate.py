@@ -73,6 +73,16 @@ def contact_areas(meshes: tuple[Mesh, ...] | list[Mesh], diag: float) -> list[tu
     return [(i, j, a) for (i, j), a in sorted(found.items())]
 
 
+def contacts_of_parts(report: ApproximateReport, part_faces: list[np.ndarray]) -> tuple[tuple[int, int], ...]:
+    """The report's contacts as pairs of make's parts (part_faces: each part's faces in the joined
+    mesh; a polyhedron whose net needed cutting into several parts is named by its first)."""
+    owner = np.repeat(np.arange(report.parts), report.faces_after)
+    part_of = {}
+    for k, faces in enumerate(part_faces):
+        part_of.setdefault(int(owner[faces[0]]), k)
+    return tuple((part_of[i], part_of[j]) for i, j, _ in report.contacts if i in part_of and j in part_of)
+
+
 def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None]
                      ) -> tuple[Mesh, SegmentReport, ApproximateReport]:
     """(the approximated model, the segmentation's report, the approximation's) of `mesh` under

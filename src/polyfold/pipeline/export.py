@@ -44,7 +44,7 @@ from .sheets import Sheets, pack_box
 
 # every name make may write into its folder (`files.check_folder` before the run)
 OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "model.glb", "piece-*.fold",
-           "assembly.json", "instructions.html", "guide.pdf", "report.json")
+           "assembly.json", "instructions.html", "guide.pdf", "report.json", "original.obj")
 
 
 @dataclass(frozen=True)
@@ -127,11 +127,14 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                       folded: list[FoldedPiece], sheets: Sheets,
                       finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int, GuideReport | None],
                                        MakeReport],
-                      inputs: tuple[Path, ...] = (), look: Appearance | None = None) -> tuple[tuple[str, ...], MakeReport]:
+                      inputs: tuple[Path, ...] = (), look: Appearance | None = None, original: Mesh | None = None,
+                      contacts: tuple[tuple[int, int], ...] = ()) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
     written, and the report. finish(piece rows, outputs so far, what the sheets print of the
     model's `look`, sheets.pdf's size in bytes, the guide's report or None) gives the report,
-    written last. inputs: the files make read (never replaced)."""
+    written last. inputs: the files make read (never replaced). original: the mesh a convex
+    approximation (`--approximate hulls`) stands for, written as original.obj (the viewer shows
+    it beside the parts); contacts: the pairs of parts glued face to face (the guide says which)."""
     pages, printed = sheet_pages(sheets, model, opts, look)
     guide = None
     if opts.guide:
@@ -150,6 +153,9 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         for k, part in enumerate(parts):
             sub = mesh.submesh(part.faces)
             stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
+        if original is not None:
+            stage.write("original.obj", obj_text(original.vertices, original.faces,
+                                                 f"{model} as approximated by the parts (polyfold make)"))
         if look is not None and opts.color != "none":  # the model as made, in the look printed (the viewer shows it)
             shown = look if opts.color == "texture" else flat_look(look)
             stage.write("model.glb", look_glb(mesh.vertices, mesh.faces, shown))
@@ -164,13 +170,13 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         stage.write("assembly.json", assembly(model, opts, parts, sheets, rows, guide).to_json())
         stage.write("instructions.html", instructions_html(
             model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue, sheets.page_of_piece(),
-            sheets.packing.n_pages, opts, svgs, guide))
+            sheets.packing.n_pages, opts, svgs, guide, contacts))
         guide_report = None
         if guide is not None:
             from ..formats.guide_pdf import guide_pdf_bytes
 
             intro = guide_intro(opts, sheets.packing.n_pages, len(parts), sheets.pieces,
-                                any(g.printed != g.label for g in sheets.glue))
+                                any(g.printed != g.label for g in sheets.glue), contacts)
             guide_pdf, guide_pages = guide_pdf_bytes(guide, f"Building {model}", (sheets.width, sheets.height), intro)
             stage.write("guide.pdf", guide_pdf)
             closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)

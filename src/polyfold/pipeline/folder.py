@@ -122,6 +122,7 @@ class MakeFolder:
     options: MakeOptions | None
     look: ModelLook | None = None
     steps: tuple[AssemblyStep, ...] = ()  # the guide's build steps (none: made with --no-guide)
+    original: Mesh | None = None  # original.obj: what a convex approximation (--approximate hulls) stands for
 
     def placed_after(self, step: int) -> list[int]:
         """The pieces (indices into `pieces`) in the model after build step `step` (1-based), in
@@ -332,7 +333,8 @@ def load_folder(path: str | Path) -> MakeFolder:
             raise PolyfoldError(f"{row.fold}: malformed FOLD data ({type(exc).__name__}: {exc})") from None
     return MakeFolder(path=root, model=assembly.model or root.name, parts=tuple(parts), pieces=tuple(pieces),
                       whole=weld_parts(parts), options=_read_options(root), look=_read_look(root, parts),
-                      steps=assembly.steps)
+                      steps=assembly.steps,
+                      original=read_mesh_as_is(root / "original.obj") if (root / "original.obj").is_file() else None)
 
 
 def make_folder(source: str | Path | Mesh | LoadedMesh, out_dir: str | Path, opts: MakeOptions | None = None,

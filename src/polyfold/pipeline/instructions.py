@@ -32,9 +32,11 @@ def _edge(g) -> str:
     return g.label if g.printed == g.label else f"{g.label} (run {g.printed})"
 
 
-def guide_intro(opts: MakeOptions, n_pages: int, n_parts: int, pieces, seam_runs: bool) -> list[str]:
+def guide_intro(opts: MakeOptions, n_pages: int, n_parts: int, pieces, seam_runs: bool,
+                contacts: tuple[tuple[int, int], ...] = ()) -> list[str]:
     """The paragraphs (plain text) before the guide's pictures, in instructions.html and guide.pdf
-    (pieces: the sheets' pieces, glue strips included)."""
+    (pieces: the sheets' pieces, glue strips included; contacts: parts glued face to face, a
+    convex approximation's)."""
     strips = sum(1 for p in pieces if len(p.face_ids) == 0)
     counted = f"{len(pieces) - strips} piece(s)" + (f" and {strips} glue strip(s)" if strips else "")
     out = [f"{n_parts} part(s), {counted} on {n_pages} {opts.paper} page(s); model {opts.size:g} mm long. "
@@ -51,11 +53,32 @@ def guide_intro(opts: MakeOptions, n_pages: int, n_parts: int, pieces, seam_runs
                "the other copy. A label that has no room in its face is printed on its tab or beside its edge "
                "(with a thin leader line); a seam with no room for a tab has a glue strip (piece S and the "
                "label): glue it behind both copies.")
+    if opts.approximate == "hulls":
+        out.append(_approximation_intro(n_parts, pieces, contacts))
     if seam_runs:
         out.append("Some seams are too dense for a label per edge: there, one label names a whole seam run, "
                    "several edges in a row between two short ticks drawn into the faces. Glue the run between the "
                    "ticks to the run with the same label between its ticks, edge by edge.")
     return out
+
+
+def _approximation_intro(n_parts: int, pieces, contacts: tuple[tuple[int, int], ...]) -> str:
+    """What a convex approximation's builder does last: which closed parts glue onto which."""
+    names: dict[int, list[str]] = {}
+    for p in pieces:
+        if len(p.face_ids):
+            names.setdefault(p.part, []).append(p.name)
+
+    def part(k: int) -> str:
+        return f"part {k + 1} (piece{'s' if len(names.get(k, ())) > 1 else ''} {', '.join(names.get(k, ['?']))})"
+
+    text = (f"The model is approximated by {n_parts} convex solids, each a closed part of its own: build every part "
+            "(its steps below), then glue the parts together where they touch, flat side on flat side (the "
+            "largest sides of a part are usually where it meets another; the pictures of where each piece goes "
+            "show the model assembled).")
+    if contacts:
+        text += " Glue " + "; ".join(f"{part(i)} to {part(j)}" for i, j in contacts) + "."
+    return text
 
 
 def _img(pic, css: str = "") -> str:
@@ -90,7 +113,8 @@ def _guide_html(guide) -> list[str]:
 
 
 def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], pieces, glue, page_of_piece: list[int],
-                      n_pages: int, opts: MakeOptions, sheet_files: list[str], guide=None) -> str:
+                      n_pages: int, opts: MakeOptions, sheet_files: list[str], guide=None,
+                      contacts: tuple[tuple[int, int], ...] = ()) -> str:
     """instructions.html: the assembly guide (`guide.guide.Guide`: where each piece goes, the
     build steps with their pictures; without one, the model with its parts in colour), the
     sheets, and per part its pieces and what glues to what (pieces: `SheetPiece`s, glue:
@@ -111,7 +135,7 @@ def instructions_html(name: str, mesh: Mesh, part_faces: list[np.ndarray], piece
          f"<h1>Building {escape(name)}</h1>"]
     if guide is None:
         h.append(f"<p><img src='data:image/png;base64,{_png_b64(mesh, part_faces, None)}' alt='the model, parts in colour'></p>")
-    h += [f"<p>{escape(p)}</p>" for p in guide_intro(opts, n_pages, len(part_faces), pieces, seam_runs)]
+    h += [f"<p>{escape(p)}</p>" for p in guide_intro(opts, n_pages, len(part_faces), pieces, seam_runs, contacts)]
     if guide is not None:
         h.append("<p>Contents: <a href='#where'>where each piece goes</a>, <a href='#steps'>build steps</a>, "
                  "<a href='#sheets'>sheets</a>, <a href='#seams'>every seam by part</a>. The same steps are in "

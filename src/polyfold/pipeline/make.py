@@ -205,15 +205,17 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
     searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
-    approximate_report = None
+    approximate_report, original, contacts = None, None, ()
     if opts.approximate == "hulls":
-        from .approximate import approximate_mesh
+        from .approximate import approximate_mesh, contacts_of_parts
 
+        original = mesh
         mesh, segment_report, approximate_report = approximate_mesh(mesh, opts, searches, say)
         look = None  # the polyhedra's sides are not the model's faces: nothing to print on them
         # every polyhedron is a component of its own, unfolded whole (convex: one piece)
         parts, _, unfold_report = make_parts(mesh, replace(opts, tau=None, parts=None, segment="auto"), searches,
                                              say, hard=hard)
+        contacts = contacts_of_parts(approximate_report, [p.faces for p in parts])
     else:
         parts, segment_report, unfold_report = make_parts(mesh, opts, searches, say, hard=hard)
     try:
@@ -255,5 +257,5 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     if look is not None and opts.color != "none":
         say("export", f"printing the model's {'texture' if look.textured.any() and opts.color == 'texture' else 'colours'}")
     files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs,
-                                      look=look)
+                                      look=look, original=original, contacts=contacts)
     return MakeResult(out_dir=Path(out_dir), files=files, report=report)

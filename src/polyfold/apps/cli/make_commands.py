@@ -104,6 +104,15 @@ def make(
             say(f"assembly guide: {guide.steps} steps in instructions.html and guide.pdf ({guide.pdf_pages} pages)"
                 + (f"; seam(s) {', '.join(guide.closing_seams)} close the model from outside" if guide.closing_seams
                    else ""))
+        approx = rep.stages.approximate
+        if approx is not None:
+            glue = "; glue them face to face where they touch: " + ", ".join(
+                f"{i + 1}-{j + 1}" for i, j, _ in approx.contacts) if approx.contacts else ""
+            say(f"convex approximation: {approx.parts} polyhedra of {min(approx.facets)}-{max(approx.facets)} sides, "
+                f"none overlapping (independent check), {approx.clip_planes} cut apart; error (Hausdorff) up to "
+                f"{approx.hausdorff_max:.1%} of the model's diagonal"
+                + (f", volume {approx.volume_ratio:.0%} of the model's" if approx.volume_ratio is not None else "")
+                + glue)
         say(f"{mesh.name}: {rep.stages.segment.parts} part(s), {len(rep.pieces)} piece(s), {lay.pages} "
              f"page(s) ({lay.utilisation:.0%} of their printable area){printed}, {lay.glue_edges} glue edges, "
              f"smallest edge {lay.smallest_edge_mm:.3g} mm, narrowest face {lay.smallest_face_mm:.3g} mm, "

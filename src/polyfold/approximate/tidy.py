@@ -1,0 +1,65 @@
+"""Corners a builder can fold: a convex polyhedron without corners that crowd each other.
+
+Clipping hulls apart and dropping facets leaves corners a hair apart (a cut passing just beside a
+hull vertex makes an edge of 0.08 mm at 150 mm) and slivers of facets (a corner almost on the line
+of two others: a face 0.001 mm across), which no one can cut, score or glue. Both are corners
+that lie within `min_dist` of the hull of the other corners (a short edge's end is that close to
+the other end; the middle corner of a sliver is that close to the segment between its
+neighbours), so one rule removes them: drop the corner nearest to the hull of the others, while
+that is nearer than `min_dist`. Corners on a cutting plane (`pinned`) go last: the face where
+two parts are glued together is cut from both sides' corners on that plane, and dropping them
+independently on the two sides leaves faces that no longer match (the horse's body and neck kept
+a sixth of their contact); a pinned corner goes only when no free corner is crowded.
+
+Dropping a corner only shrinks the polyhedron (the hull of fewer points lies inside the hull of
+more), so polyhedra that were apart stay apart, and corners on a cutting plane stay on it (the
+faces two parts glue together stay in one plane). The surface moves by at most `min_dist` per
+corner dropped, inwards; the errors of the result are measured afterwards (`error.part_errors`).
+
+In: points (N, 3) whose hull is the polyhedron. Out: the corners kept (K, 3), K >= 4, and the
+largest distance of a dropped corner to the hull of the ones kept after it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh.closest import closest_points
+
+
+def distance_to_hull_surface(point: np.ndarray, corners: np.ndarray) -> float:
+    """Distance from point (3,) to the surface of the convex hull of corners (M, 3): the nearest of
+    its qhull triangles (the one point-triangle primitive, `closest.closest_points`)."""
+    from scipy.spatial import ConvexHull
+
+    tri = np.ascontiguousarray(corners[ConvexHull(corners).simplices])
+    face, bary = np.zeros(1, dtype=np.int64), np.zeros((1, 3))
+    cand = np.arange(len(tri), dtype=np.int64)[None, :]
+    closest_points(np.ascontiguousarray(point[None, :], dtype=np.float64), np.zeros((1, 3)), cand, tri,
+                   np.zeros((len(tri), 3)), 0.0, face, bary)
+    return float(np.linalg.norm(bary[0] @ tri[face[0]] - point))
+
+
+def drop_crowded_corners(points: np.ndarray, min_dist: float, pinned: np.ndarray | None = None
+                         ) -> tuple[np.ndarray, float]:
+    """(corners kept (K, 3), the largest distance a dropped corner had): the hull's corners, the
+    one nearest to the hull of the others dropped while that is under min_dist, free corners
+    before pinned ones (pinned (N,) bool per point; module docstring). A tetrahedron is never
+    reduced further."""
+    from scipy.spatial import ConvexHull
+
+    keep = ConvexHull(points).vertices
+    corners = points[keep]
+    pin = np.zeros(len(corners), dtype=bool) if pinned is None else np.asarray(pinned, dtype=bool)[keep]
+    lost = 0.0
+    while len(corners) > 4:
+        near = np.array([distance_to_hull_surface(corners[i], np.delete(corners, i, axis=0))
+                         for i in range(len(corners))])
+        crowded = near < min_dist
+        if not crowded.any():
+            break
+        pick = crowded & ~pin if (crowded & ~pin).any() else crowded
+        i = int(np.flatnonzero(pick)[np.argmin(near[pick])])
+        lost = max(lost, float(near[i]))
+        corners, pin = np.delete(corners, i, axis=0), np.delete(pin, i)
+    return corners, lost
