@@ -76,7 +76,7 @@ from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
 from .error import SAMPLES, part_errors, signed_volume
 from .kernels import volume_beyond
-from .tidy import drop_crowded_corners
+from .tidy import drop_crowded_corners, thin_polygon
 
 DEFAULT_MIN_FACET = 0.01  # x the hull's surface area: smaller facets are dropped (when allowed)
 DEFAULT_MAX_GROWTH = 0.005  # x the bbox diagonal: how far dropping facets may grow a hull
@@ -568,20 +568,57 @@ def simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, ma
 # The whole stage
 
 
+def _from_corners(corners: np.ndarray, like: _Polytope) -> _Polytope:
+    """The hull of corners (a subset of `like`, or points on its surface): its planes are the
+    hull's facets; one on a plane of `like` keeps that plane's clip index."""
+    verts, tri, eq = _hull_of(corners)
+    same = np.abs(eq[:, None, :] - like.planes[None, :, :]).max(axis=2) <= PLANE_MATCH  # (T, K)
+    clip = np.where(same.any(axis=1), like.clip[np.argmax(same, axis=1)], -1)
+    planes, clip = _dedupe(eq, clip)
+    return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri))
+
+
 def _uncrowded(poly: _Polytope, min_corner: float) -> tuple[_Polytope, float]:
     """(poly without corners within min_corner of the hull of the others (`tidy`), how far that
-    moved its surface). Its planes are the new hull's facets; one on a plane of poly keeps that
-    plane's clip index (corners on a cutting plane stay on it)."""
+    moved its surface); corners on cutting planes stay."""
     cutting = poly.planes[poly.clip >= 0]
     pinned = (np.abs(poly.vertices @ cutting[:, :3].T + cutting[:, 3]) <= ON_PLANE).any(axis=1)
     corners, lost = drop_crowded_corners(poly.vertices, min_corner, pinned)
     if len(corners) == len(poly.vertices):
         return poly, 0.0
-    verts, tri, eq = _hull_of(corners)
-    same = np.abs(eq[:, None, :] - poly.planes[None, :, :]).max(axis=2) <= PLANE_MATCH  # (T, K)
-    clip = np.where(same.any(axis=1), poly.clip[np.argmax(same, axis=1)], -1)
-    planes, clip = _dedupe(eq, clip)
-    return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri)), lost
+    return _from_corners(corners, poly), lost
+
+
+def _plane_basis(normal: np.ndarray) -> np.ndarray:
+    """(2, 3): two unit vectors spanning the plane of `normal`."""
+    u = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    return np.stack([u, np.cross(normal, u)])
+
+
+def match_glued_faces(hulls: list[_Polytope], cuts: list, min_corner: float) -> list[_Polytope]:
+    """Every pair cut apart glued on one face: both hulls' faces on the cut's plane replaced by
+    their common part (the intersection of the two faces, its crowded corners dropped in the
+    plane, `tidy.thin_polygon`), so the two faces a builder glues together are the same polygon.
+    Each hull becomes the hull of its corners off the plane and that polygon's: a subset of what
+    it was (the polygon lies in both faces), so the parts stay apart. Pairs whose faces do not
+    overlap (one hull only touches the plane), or share less than a square of 4 min_corner, get
+    their own faces thinned, each side alone."""
+    from shapely import Polygon
+
+    for i, j, normal, offset, _, _ in cuts:
+        on = [np.abs(hulls[p].vertices @ normal - offset) <= ON_PLANE for p in (i, j)]
+        if min(o.sum() for o in on) < 3:
+            continue
+        basis = _plane_basis(normal)
+        flat = [Polygon(hulls[p].vertices[o] @ basis.T).convex_hull for p, o in zip((i, j), on)]
+        common = flat[0].intersection(flat[1])
+        glued = isinstance(common, Polygon) and common.area > (4 * min_corner) ** 2
+        for p, o, own in zip((i, j), on, flat):
+            ring = thin_polygon(np.asarray((common if glued else own).exterior.coords)[:-1], min_corner)
+            face = offset * normal + ring @ basis
+            hulls[p] = _from_corners(np.concatenate([hulls[p].vertices[~o], face]), hulls[p])
+    return hulls
 
 
 def _frame(mesh: Mesh) -> tuple[np.ndarray, float]:
@@ -606,7 +643,12 @@ def hull_meshes(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAULT_MIN
     for p in range(len(hulls)):
         others = [hulls[q] for q in range(len(hulls)) if q != p and (p, q) not in cut_apart]
         hulls[p], growth[p] = simplify_hull(hulls[p], others, min_facet, max_growth)
-        if min_corner > 0:
+    if min_corner > 0:  # free corners first (fewer crowd the glued faces), the glued faces, free corners again
+        for p in range(len(hulls)):
+            hulls[p], shrunk = _uncrowded(hulls[p], min_corner)
+            growth[p] = max(growth[p], shrunk)
+        hulls = match_glued_faces(hulls, cuts, min_corner)
+        for p in range(len(hulls)):
             hulls[p], shrunk = _uncrowded(hulls[p], min_corner)
             growth[p] = max(growth[p], shrunk)
     meshes, facets = [], []

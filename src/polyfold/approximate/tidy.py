@@ -6,10 +6,11 @@ of two others: a face 0.001 mm across), which no one can cut, score or glue. Bot
 that lie within `min_dist` of the hull of the other corners (a short edge's end is that close to
 the other end; the middle corner of a sliver is that close to the segment between its
 neighbours), so one rule removes them: drop the corner nearest to the hull of the others, while
-that is nearer than `min_dist`. Corners on a cutting plane (`pinned`) go last: the face where
-two parts are glued together is cut from both sides' corners on that plane, and dropping them
-independently on the two sides leaves faces that no longer match (the horse's body and neck kept
-a sixth of their contact); a pinned corner goes only when no free corner is crowded.
+that is nearer than `min_dist`. Corners on a cutting plane (`pinned`) are never dropped here:
+the face where two parts are glued together is cut from both sides' corners on that plane, and
+dropping them independently on the two sides leaves faces that no longer match (the horse lost 5
+of its 6 glued faces); those faces are thinned in their plane, both sides alike (`thin_polygon`,
+`hulls.match_glued_faces`).
 
 Dropping a corner only shrinks the polyhedron (the hull of fewer points lies inside the hull of
 more), so polyhedra that were apart stay apart, and corners on a cutting plane stay on it (the
@@ -40,26 +41,46 @@ def distance_to_hull_surface(point: np.ndarray, corners: np.ndarray) -> float:
     return float(np.linalg.norm(bary[0] @ tri[face[0]] - point))
 
 
+def thin_polygon(ring: np.ndarray, min_dist: float) -> np.ndarray:
+    """A convex polygon (K, 2, in order) without corners within min_dist of the segment between
+    their two neighbours (the 2-D case of `drop_crowded_corners`, which the plane of a glued face
+    needs: its corners are coplanar): the nearest dropped first, never below a triangle."""
+    ring = np.asarray(ring, dtype=np.float64)
+    while len(ring) > 3:
+        a, b = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        ab = b - a
+        t = np.clip(np.einsum("ij,ij->i", ring - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0, 1)
+        near = np.linalg.norm(a + t[:, None] * ab - ring, axis=1)
+        i = int(np.argmin(near))
+        if near[i] >= min_dist:
+            break
+        ring = np.delete(ring, i, axis=0)
+    return ring
+
+
 def drop_crowded_corners(points: np.ndarray, min_dist: float, pinned: np.ndarray | None = None
                          ) -> tuple[np.ndarray, float]:
     """(corners kept (K, 3), the largest distance a dropped corner had): the hull's corners, the
-    one nearest to the hull of the others dropped while that is under min_dist, free corners
-    before pinned ones (pinned (N,) bool per point; module docstring). A tetrahedron is never
-    reduced further."""
+    one nearest to the hull of the others dropped while that is under min_dist; pinned (N,) bool
+    per point: never dropped (module docstring). A tetrahedron is never reduced further."""
     from scipy.spatial import ConvexHull
 
     keep = ConvexHull(points).vertices
     corners = points[keep]
     pin = np.zeros(len(corners), dtype=bool) if pinned is None else np.asarray(pinned, dtype=bool)[keep]
     lost = 0.0
+    near = np.array([np.inf if pin[i] else distance_to_hull_surface(corners[i], np.delete(corners, i, axis=0))
+                     for i in range(len(corners))])
+    # a corner's distance only grows as others go (the hull of fewer points lies inside), so the
+    # distances found so far are lower bounds: the smallest is measured again before it is dropped
     while len(corners) > 4:
-        near = np.array([distance_to_hull_surface(corners[i], np.delete(corners, i, axis=0))
-                         for i in range(len(corners))])
-        crowded = near < min_dist
-        if not crowded.any():
+        i = int(np.argmin(near))
+        if near[i] >= min_dist:
             break
-        pick = crowded & ~pin if (crowded & ~pin).any() else crowded
-        i = int(np.flatnonzero(pick)[np.argmin(near[pick])])
-        lost = max(lost, float(near[i]))
-        corners, pin = np.delete(corners, i, axis=0), np.delete(pin, i)
+        now = distance_to_hull_surface(corners[i], np.delete(corners, i, axis=0))
+        if now > near[i]:
+            near[i] = now
+            continue
+        lost = max(lost, now)
+        corners, near = np.delete(corners, i, axis=0), np.delete(near, i)
     return corners, lost
