@@ -75,7 +75,7 @@ from ..mesh.geometry import FLAT_REGION_RAD, face_areas
 from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
 from .error import SAMPLES, part_errors, signed_volume
-from .kernels import volume_beyond
+from .kernels import volume_beyond, volumes_beyond
 
 DEFAULT_MIN_FACET = 0.01  # x the hull's surface area: smaller facets are dropped (when allowed)
 DEFAULT_MAX_GROWTH = 0.005  # x the bbox diagonal: how far dropping facets may grow a hull
@@ -298,8 +298,24 @@ def _part_hull(mesh: Mesh, seg: Segmentation, p: int, frame: tuple[np.ndarray, f
     return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri))
 
 
+def _plane_apart(a: _Polytope, b: _Polytope) -> bool:
+    """True when a facet plane of one polytope has the other's vertices all on or beyond it (a
+    sufficient test of separation that spares most disjoint pairs their LP)."""
+    return bool(((b.vertices @ a.planes[:, :3].T + a.planes[:, 3]).min(axis=0) >= -OVERLAP_EPS).any()
+                or ((a.vertices @ b.planes[:, :3].T + b.planes[:, 3]).min(axis=0) >= -OVERLAP_EPS).any())
+
+
+def _apart(a: _Polytope, b: _Polytope) -> bool:
+    """True when no ball of radius OVERLAP_EPS fits in both polytopes (box and facet-plane tests
+    first, then the Chebyshev LP of both sets of planes)."""
+    return (_boxes_apart(a, b) or _plane_apart(a, b)
+            or chebyshev_centre(np.concatenate([a.planes, b.planes]))[1] <= OVERLAP_EPS)
+
+
 def _intersection(a: _Polytope, b: _Polytope) -> _Polytope | None:
     """The overlap of two polytopes, None when no ball of radius OVERLAP_EPS fits in both."""
+    if _boxes_apart(a, b) or _plane_apart(a, b):
+        return None
     planes = np.concatenate([a.planes, b.planes])
     return _polytope(planes, np.full(len(planes), -1))
 
@@ -351,7 +367,7 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
         return wi * off_i(s) + wj * off_j(s)
 
     grid = np.linspace(a, b, GRID)
-    costs = np.array([cost(s) for s in grid])
+    costs = wi * volumes_beyond(ti, normal, grid) + wj * volumes_beyond(tj, -normal, -grid)
     k = int(np.argmin(costs))
     best_s, best_c = float(grid[k]), float(costs[k])
     lo_k, hi_k = grid[max(k - 1, 0)], grid[min(k + 1, GRID - 1)]
@@ -549,9 +565,7 @@ def simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, ma
         if ok:
             n_corners = len(facet_mesh(grown.vertices, grown.tri, grown.planes)[0])
             growth = _growth(grown.vertices, poly) if n_corners < corners else np.inf
-            ok = growth <= max_growth and all(
-                _boxes_apart(grown, o) or chebyshev_centre(np.concatenate([grown.planes, o.planes]))[1] <= OVERLAP_EPS
-                for o in others)
+            ok = growth <= max_growth and all(_apart(grown, o) for o in others)
         if ok:
             best, corners = (grown, growth), n_corners
         else:
