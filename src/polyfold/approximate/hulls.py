@@ -102,8 +102,13 @@ from ..segment.segment import Segmentation
 from .error import SAMPLES, part_errors, signed_volume
 from .kernels import volume_beyond, volumes_beyond
 
-DEFAULT_MIN_FACET = 0.01  # x the hull's surface area: smaller facets are dropped (when allowed)
-DEFAULT_MAX_GROWTH = 0.005  # x the bbox diagonal: how far dropping facets may grow a hull
+# Dropping facets: x the hull's surface area, smaller facets go (when allowed); x the bbox diagonal, how
+# far that may grow a hull. Over seven shared models (bunny-128/348, horse, fish, sphere-deformed,
+# moneybox at tau 0.05, bumpy at 0.02; 4,210 triangles before): 0.01 / 0.005 take 10.5 % of the
+# triangles off, 0.03 / 0.01 19.7 % (growth up to 1 %), 0.005 / 0.002 5.9 %; a tenth of the
+# segmentation's default tau is the growth allowed by default
+DEFAULT_MIN_FACET = 0.01
+DEFAULT_MAX_GROWTH = 0.005
 MIN_KEEP = 0.05  # a cut leaves each hull at least this fraction of its unclipped volume
 # x the bbox diagonal: a part thinner than FLAT_WIDTH (flat up to the rounding of coplanar faces in
 # files, see mesh/flat.FLAT_DIST) is thickened to FLAT_THICKNESS, inwards
