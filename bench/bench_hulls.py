@@ -8,8 +8,9 @@ Hausdorff distances approx -> part patch / patch -> approx / symmetric (max over
 bbox diagonal), the largest growth from dropping facets (%), the volume ratio (sum of
 approximations / model), the largest pairwise intersection volume by manifold3d over the model
 volume, the number of cuts, seconds (approximate_hulls only, after one warm-up run).
---planes, table 2: the volume removed by all cuts (% of the model volume) at the default tau with
-each set of plane candidates (the comparison in hulls.py's docstring).
+--planes, table 2: the volume removed by all cuts (% of the model volume) at tau 0.02 and the
+default with each set of plane candidates (the comparison in hulls.py's docstring); "error" where a
+restricted set cannot separate a pair without cutting a hull below MIN_KEEP.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 
 from polyfold.approximate.error import overlap_volumes, signed_volume
 from polyfold.approximate.hulls import approximate_hulls, hull_meshes
+from polyfold.errors import PolyfoldError
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
 from polyfold.segment.segment import DEFAULT_TAU, segment
@@ -57,22 +59,27 @@ def table(taus: list[float]) -> None:
                   f"| {r.volume_ratio:.3f} | {off:.1e} | {len(r.planes)} | {r.seconds:.2f} |")
 
 
-def planes_table() -> None:
-    print("| model | " + " | ".join("+".join(s) for s in PLANE_SETS) + " |")
-    print("|---|" + "---|" * len(PLANE_SETS))
+def planes_table(taus: list[float]) -> None:
+    print("| model | tau | parts | " + " | ".join("+".join(s) for s in PLANE_SETS) + " |")
+    print("|---|---|---|" + "---|" * len(PLANE_SETS))
     for name in CLOSED:
         mesh = load(name)
-        seg = segment(mesh, tau=DEFAULT_TAU)
-        if seg.n_parts < 2:
-            continue
         model_vol = signed_volume(mesh.vertices, mesh.faces)
-        row = []
-        for methods in PLANE_SETS:
-            t0 = time.perf_counter()
-            _, _, _, _, cuts, (_, scale) = hull_meshes(mesh, seg, methods=methods)
-            removed = sum(c[4] for c in cuts) * scale ** 3
-            row.append(f"{100 * removed / model_vol:.2f} ({time.perf_counter() - t0:.1f} s)")
-        print(f"| {name} | " + " | ".join(row) + " |")
+        for tau in taus:
+            seg = segment(mesh, tau=tau)
+            if seg.n_parts < 2:
+                continue
+            row = []
+            for methods in PLANE_SETS:
+                t0 = time.perf_counter()
+                try:
+                    _, _, _, _, cuts, (_, scale) = hull_meshes(mesh, seg, methods=methods)
+                except PolyfoldError as exc:  # a hull cut down to MIN_KEEP
+                    row.append(f"error ({exc})"[:40])
+                    continue
+                removed = sum(c[4] for c in cuts) * scale ** 3
+                row.append(f"{100 * removed / model_vol:.2f} ({time.perf_counter() - t0:.1f} s)")
+            print(f"| {name} | {tau:g} | {seg.n_parts} | " + " | ".join(row) + " |")
 
 
 def main() -> None:
@@ -83,7 +90,7 @@ def main() -> None:
     table(args.tau)
     if args.planes:
         print()
-        planes_table()
+        planes_table([0.02, DEFAULT_TAU])
 
 
 if __name__ == "__main__":

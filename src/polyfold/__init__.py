@@ -5,6 +5,7 @@ The pipeline, one package per stage, data flowing one way (Xi & Lien 2017; ALGOR
     mesh/       load & check: the `Mesh` record, topology, geometry, repairs
     inflate/    pop local dents (mass-spring inflation)
     segment/    nearly convex parts
+    approximate/ each part as a closed convex polyhedron, none overlapping (not in make yet)
     unfold/     overlap-free nets (`Net`): heuristics, GA, multi-piece fallback
     fold/       a collision-free folding path per net (`FoldTree`, one validity checker, planners)
     fabricate/  pieces on paper: tabs, labels, splitting, packing, page checks
@@ -28,6 +29,7 @@ _API = {
     "load_mesh": "formats.meshes",
     "inflate": "inflate.inflate", "InflateResult": "inflate.inflate",
     "segment": "segment.segment", "Segmentation": "segment.segment",
+    "approximate_hulls": "approximate.hulls", "HullApproximation": "approximate.hulls",
     "unfold": "unfold.search", "Net": "unfold.net", "UnfoldStats": "unfold.search",
     "FoldTree": "fold.tree", "plan_fold": "fold.plan", "FoldPath": "fold.plan", "sample_ratio": "fold.cspace",
     "make": "pipeline.make", "MakeOptions": "pipeline.options", "MakeResult": "pipeline.make", "MakeReport": "pipeline.report",

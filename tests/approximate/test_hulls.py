@@ -16,7 +16,7 @@ from scipy.spatial import ConvexHull
 
 from conftest import assert_valid_component, signed_volume
 from polyfold.approximate.error import LP_TOL, SAMPLES, lp_overlap_depth, lp_overlap_depths, overlap_volumes
-from polyfold.approximate.hulls import FLAT_THICKNESS, HullApproximation, approximate_hulls
+from polyfold.approximate.hulls import DEFAULT_MIN_CORNER, FLAT_THICKNESS, HullApproximation, approximate_hulls
 from polyfold.errors import PolyfoldError
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
@@ -171,7 +171,7 @@ def test_convex_input_is_its_own_approximation():
     mesh = convex_hull_mesh(pts)
     seg = segment(mesh)
     assert seg.n_parts == 1
-    r = approximate_hulls(mesh, seg)
+    r = approximate_hulls(mesh, seg, min_corner=0.0)  # every corner kept: exactly the input
     check_approximation(mesh, seg, r)
     assert r.hausdorff_max <= 1e-9 and len(r.planes) == 0
     assert r.volume_ratio == pytest.approx(1.0, abs=1e-9)
@@ -186,10 +186,13 @@ def test_convex_input_in_two_parts():
     mesh = convex_hull_mesh(pts)
     x = mesh.vertices[mesh.faces].mean(axis=1)[:, 0]
     seg = segmentation_of(mesh, (x > np.median(x)).astype(np.int64))
-    r = approximate_hulls(mesh, seg)
+    r = approximate_hulls(mesh, seg, min_corner=0.0)
     check_approximation(mesh, seg, r)
     assert len(r.planes) == 1
     assert 0.99 < r.volume_ratio <= 1 + 1e-9
+    tidy = approximate_hulls(mesh, seg)  # crowded corners dropped: inside the exact pieces, a little smaller
+    check_approximation(mesh, seg, tidy)
+    assert 0.9 < tidy.volume_ratio <= r.volume_ratio + 1e-9
 
 
 def test_flat_parts_become_slabs(models_dir):
@@ -213,6 +216,68 @@ def test_line_part_is_an_error():
     seg = segmentation_of(mesh, np.array([0, 1]))
     with pytest.raises(PolyfoldError, match="part 0"):
         approximate_hulls(mesh, seg)
+
+
+# ----------------------------------------------------------------------------------------------
+# Buildable corners (tidy.py) and glued faces
+
+
+def polytope_edges(m: Mesh) -> np.ndarray:
+    """(E, 2) the true edges of a fanned convex mesh: triangle edges between two facets."""
+    e = np.sort(np.concatenate([m.faces[:, [0, 1]], m.faces[:, [1, 2]], m.faces[:, [2, 0]]]), axis=1)
+    facet = np.tile(m.face_source, 3)
+    order = np.lexsort((e[:, 1], e[:, 0]))
+    e, facet = e[order], facet[order]
+    assert (e[0::2] == e[1::2]).all()  # closed: every edge twice
+    return e[0::2][facet[0::2] != facet[1::2]]
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_no_edge_too_short_to_fold_and_glued_faces_match(approximated, name):
+    """No corner crowds another (the shortest edge of every part at least DEFAULT_MIN_CORNER of the
+    diagonal: 2 mm at make's 150 mm; a cut beside a hull vertex left 0.08 mm edges before), and
+    the two faces of every glued pair are one polygon: same area, same corners."""
+    from shapely import Polygon
+
+    mesh, seg, r = approximated[name]
+    diag = mesh.bbox_diagonal
+    for p, m in enumerate(r.parts):
+        e = polytope_edges(m)
+        shortest = np.linalg.norm(m.vertices[e[:, 0]] - m.vertices[e[:, 1]], axis=1).min()
+        assert shortest >= DEFAULT_MIN_CORNER * diag, f"part {p}: an edge of {shortest / diag:.4f} of the diagonal"
+    glued = 0
+    for (n_d, (i, j)) in zip(r.planes, r.plane_pairs):
+        faces = []
+        for k, sign in ((i, 1.0), (j, -1.0)):
+            m = r.parts[k]
+            on_plane = [f for f in np.unique(m.face_source)
+                        if np.abs(m.vertices[m.faces[m.face_source == f]] @ n_d[:3] + n_d[3]).max() <= PLANE_TOL * diag
+                        and m.face_normals[m.face_source == f][0] @ n_d[:3] * sign > 0.999]
+            faces.append([m.vertices[np.unique(m.faces[m.face_source == f])] for f in on_plane])
+        if not (faces[0] and faces[1]):
+            continue
+        (a,), (b,) = faces  # one face each side
+        u = np.linalg.svd(a - a.mean(axis=0))[2][:2]
+        pa, pb = (Polygon((x @ u.T)[ConvexHull(x @ u.T).vertices]) for x in (a, b))
+        if pa.intersection(pb).area > 0.5 * min(pa.area, pb.area):  # glued (else two faces that barely touch)
+            glued += 1
+            assert pa.symmetric_difference(pb).area <= 1e-9 * pa.area
+    assert glued >= 1
+
+
+def test_crowded_corners_go_and_pinned_ones_stay():
+    from polyfold.approximate.tidy import drop_crowded_corners, thin_polygon
+
+    cube = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+    near = np.array([[1.004, 1.003, 0.5], [0.5, 0.5, 1.002]])  # a sliver beside an edge, a face barely raised
+    kept, lost = drop_crowded_corners(np.concatenate([cube, near]), 0.01)
+    assert len(kept) == 8 and {tuple(x) for x in kept} == {tuple(x) for x in cube}
+    assert 0.002 <= lost < 0.01
+    kept, _ = drop_crowded_corners(np.concatenate([cube, near]), 0.01, pinned=np.r_[np.zeros(8, bool), True, True])
+    assert len(kept) == 10  # pinned corners (on a glued face) are never dropped here
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.5], [1.0005, 1.0], [0.0, 1.0]])
+    assert len(thin_polygon(square, 0.01)) == 4  # the corner almost on the right side's line
+    assert len(thin_polygon(square[[0, 1, 4]], 10.0)) == 3  # never below a triangle
 
 
 # ----------------------------------------------------------------------------------------------

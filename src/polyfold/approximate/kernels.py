@@ -51,3 +51,12 @@ def volume_beyond(tri, normal, offset):
         for k in range(1, m - 1):
             total += _cone(p0, poly[0], poly[k], poly[k + 1])
     return total
+
+
+@njit(cache=True)
+def volumes_beyond(tri, normal, offsets):
+    """`volume_beyond` at every offset (n,) (one call for a grid of offsets)."""
+    out = np.empty(offsets.shape[0])
+    for k in range(offsets.shape[0]):
+        out[k] = volume_beyond(tri, normal, offsets[k])
+    return out
