@@ -245,6 +245,10 @@ def test_no_edge_too_short_to_fold_and_glued_faces_match(approximated, name):
         e = polytope_edges(m)
         shortest = np.linalg.norm(m.vertices[e[:, 0]] - m.vertices[e[:, 1]], axis=1).min()
         assert shortest >= DEFAULT_MIN_CORNER * diag, f"part {p}: an edge of {shortest / diag:.4f} of the diagonal"
+        t = m.vertices[m.faces]  # no sliver in a facet's fan either (it starts at the widest corner)
+        height = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1) / np.max(
+            [np.linalg.norm(t[:, k] - t[:, (k + 1) % 3], axis=1) for k in range(3)], axis=0)
+        assert height.min() >= 0.25 * DEFAULT_MIN_CORNER * diag, f"part {p}: a face {height.min() / diag:.5f} across"
     glued = 0
     for (n_d, (i, j)) in zip(r.planes, r.plane_pairs):
         faces = []

@@ -312,6 +312,18 @@ def facet_mesh(poly_vertices: np.ndarray, tri: np.ndarray, planes: np.ndarray
     v, f = v[order], f[order]
     start = np.concatenate([[0], np.cumsum(count)[:-1]])
     pos = np.arange(len(v)) - start[f]
+    # fan from the widest corner: a corner almost on the line of its neighbours (the corners of a
+    # facet are true corners of the polyhedron, but two neighbouring facets may meet it at
+    # nearly 180 degrees) would otherwise make the fan's sliver (prev, corner, next)
+    here = poly_vertices[v]
+    prev = poly_vertices[v[start[f] + (pos - 1) % count[f]]] - here
+    after = poly_vertices[v[start[f] + (pos + 1) % count[f]]] - here
+    cos = np.einsum("ij,ij->i", prev, after) / np.maximum(np.linalg.norm(prev, axis=1) * np.linalg.norm(after, axis=1),
+                                                           1e-300)
+    first = np.lexsort((cos, f))[start]  # per facet, the corner of smallest cosine (widest angle)
+    turned = (pos - pos[first][f]) % count[f]
+    order = np.lexsort((turned, f))
+    v, f = v[order], f[order]
     mid = np.flatnonzero((pos >= 1) & (pos <= count[f] - 2))  # fan triangles (first, k, k + 1)
     faces = np.stack([v[start[f[mid]]], v[mid], v[mid + 1]], axis=1)
     used, inverse = np.unique(faces, return_inverse=True)
@@ -674,6 +686,7 @@ def match_glued_faces(hulls: list[_Polytope], cuts: list, min_corner: float) -> 
 def _match_once(hulls: list[_Polytope], cuts: list, min_corner: float) -> tuple[list[_Polytope], bool]:
     """One round of `match_glued_faces`: (the hulls, whether every glued pair's faces were equal
     already)."""
+    from scipy.spatial import QhullError
     from shapely import Polygon
 
     matched = True
@@ -691,7 +704,10 @@ def _match_once(hulls: list[_Polytope], cuts: list, min_corner: float) -> tuple[
         for p, o, own in zip((i, j), on, flat):
             ring = thin_polygon(np.asarray((common if glued else own).exterior.coords)[:-1], min_corner)
             face = offset * normal + ring @ basis
-            hulls[p] = _from_corners(np.concatenate([hulls[p].vertices[~o], face]), hulls[p])
+            try:
+                hulls[p] = _from_corners(np.concatenate([hulls[p].vertices[~o], face]), hulls[p])
+            except (QhullError, ValueError):  # no volume left off the plane: keep the hull as it is
+                pass
     return hulls, matched
 
 

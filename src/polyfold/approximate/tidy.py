@@ -30,10 +30,14 @@ from ..mesh.closest import closest_points
 
 def distance_to_hull_surface(point: np.ndarray, corners: np.ndarray) -> float:
     """Distance from point (3,) to the surface of the convex hull of corners (M, 3): the nearest of
-    its qhull triangles (the one point-triangle primitive, `closest.closest_points`)."""
-    from scipy.spatial import ConvexHull
+    its qhull triangles (the one point-triangle primitive, `closest.closest_points`); inf when the
+    corners span no volume (without `point` there would be no polyhedron left)."""
+    from scipy.spatial import ConvexHull, QhullError
 
-    tri = np.ascontiguousarray(corners[ConvexHull(corners).simplices])
+    try:
+        tri = np.ascontiguousarray(corners[ConvexHull(corners).simplices])
+    except (QhullError, ValueError):
+        return np.inf
     face, bary = np.zeros(1, dtype=np.int64), np.zeros((1, 3))
     cand = np.arange(len(tri), dtype=np.int64)[None, :]
     closest_points(np.ascontiguousarray(point[None, :], dtype=np.float64), np.zeros((1, 3)), cand, tri,
@@ -82,5 +86,5 @@ def drop_crowded_corners(points: np.ndarray, min_dist: float, pinned: np.ndarray
             near[i] = now
             continue
         lost = max(lost, now)
-        corners, near = np.delete(corners, i, axis=0), np.delete(near, i)
+        corners, near, pin = np.delete(corners, i, axis=0), np.delete(near, i), np.delete(pin, i)
     return corners, lost
