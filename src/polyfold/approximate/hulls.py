@@ -65,8 +65,8 @@ candidate allows that, PolyfoldError names the two parts. (A volume floor does n
 part's area: periscope-28's flat sides lose most of theirs, see `hausdorff_in` in the benchmark.)
 
 Flat parts (all vertices within FLAT_WIDTH of a plane, x the bounding-box diagonal) get a
-thickness instead of an error: their vertices are copied FLAT_THICKNESS inwards (against the
-part's area-weighted outward normal) before the hull, so a flat side becomes a slab that can be
+thickness instead of an error: their vertices, moved onto the plane through the outermost one,
+are copied FLAT_THICKNESS inwards (against the part's area-weighted outward normal) before the hull, so a flat side becomes a slab that can be
 built and cut like any hull; the slab's back is FLAT_THICKNESS from the surface, which
 `hausdorff_out` reports.
 
@@ -99,7 +99,7 @@ from ..mesh.closest import closest_points
 from ..mesh.geometry import FLAT_REGION_RAD, face_areas
 from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
-from .error import SAMPLES, part_errors, signed_volume
+from .error import SAMPLES, chebyshev_centre, part_errors, signed_volume
 from .kernels import volume_beyond, volumes_beyond
 
 # Dropping facets: x the hull's surface area, smaller facets go (when allowed); x the bbox diagonal, how
@@ -120,8 +120,10 @@ DEFAULT_OBJECTIVE = "volume"
 # ball of radius above OVERLAP_EPS fits in both (HiGHS runs at 1e-10 feasibility tolerance)
 ON_PLANE = 1e-9
 OVERLAP_EPS = 1e-9
+WELD = 1e-6  # hull points closer than this are one (`_hull_of`)
+ON_FACET = 1e-6  # a qhull facet whose equation is within this of a halfspace's lies on it
 GRID = 25  # offsets tried per candidate normal before the bounded 1-D search
-_LP_OPTIONS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
+SNAP = 1e-6  # unit frame: a cut's offset this close to a vertex goes through it
 
 
 @dataclass(frozen=True, eq=False)
@@ -173,12 +175,14 @@ class HullApproximation:
 class _Polytope:
     """A convex polytope in the unit frame: planes (K, 4) (n, d), inside n . x + d <= 0; clip (K,)
     the index of the cut that added each plane, -1 for the part's own hull facets; vertices (V, 3)
-    and triangles tri (T, 3), CCW outward (qhull's triangulation); volume."""
+    and triangles tri (T, 3), CCW outward (qhull's triangulation), equations (T, 4) the plane of
+    each triangle's qhull facet (the triangles of one facet share the row); volume."""
 
     planes: np.ndarray
     clip: np.ndarray
     vertices: np.ndarray
     tri: np.ndarray
+    equations: np.ndarray
     volume: float
 
     @property
@@ -193,24 +197,21 @@ class _Polytope:
         return (w[:, None] * t.sum(axis=1)).sum(axis=0) / (4.0 * w.sum())
 
 
-def chebyshev_centre(planes: np.ndarray, cap: float = 1.0) -> tuple[np.ndarray, float]:
-    """(centre (3,), radius) of the largest ball inside n . x + d <= 0 for all rows (n, d) of
-    planes (K, 4), n unit: one LP (HiGHS). radius <= 0: no interior; radius == cap: unbounded
-    (or at least that large)."""
-    from scipy.optimize import linprog
-
-    a = np.concatenate([planes[:, :3], np.ones((len(planes), 1))], axis=1)
-    res = linprog(c=[0, 0, 0, -1], A_ub=a, b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(None, cap)],
-                  method="highs", options=_LP_OPTIONS)
-    if res.status != 0:
-        raise PolyfoldError(f"Chebyshev centre LP failed: {res.message}")
-    return res.x[:3], float(res.x[3])
-
-
 def _hull_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices, triangles CCW outward, facet equations) of the convex hull of points (qhull)."""
-    from scipy.spatial import ConvexHull
+    """(vertices, triangles CCW outward, each triangle's facet equation) of the convex hull of
+    points (qhull), points closer than WELD first replaced by one of them (a cut through a vertex
+    leaves several intersection points within 1e-8 of it, and edges that short make slivers whose
+    normals are noise; keeping one of the points, not their mean, keeps the hull inside every
+    halfspace the points satisfy)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import ConvexHull, cKDTree
 
+    pairs = cKDTree(points).query_pairs(WELD, output_type="ndarray")
+    if len(pairs):
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(points), len(points)))
+        _, label = connected_components(graph, directed=False)
+        points = points[np.unique(label, return_index=True)[1]]
     h = ConvexHull(points)
     tri = h.simplices.copy()
     t = points[tri]
@@ -234,11 +235,11 @@ def _polytope(planes: np.ndarray, clip: np.ndarray, inside: np.ndarray | None = 
             pts = HalfspaceIntersection(planes, inside).intersections
         if not np.isfinite(pts).all() or np.abs(pts).max() > 10.0:  # unbounded (the unit frame is 1 across)
             return None
-        verts, tri, _ = _hull_of(pts)
+        verts, tri, eq = _hull_of(pts)
     except (QhullError, ValueError):
         return None
     vol = signed_volume(verts, tri)
-    return _Polytope(planes, clip, verts, tri, vol) if vol > 0 else None
+    return _Polytope(planes, clip, verts, tri, eq, vol) if vol > 0 else None
 
 
 def _dedupe(planes: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -255,29 +256,25 @@ def _dedupe(planes: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return planes[keep], clip[keep]
 
 
-def facet_mesh(poly_vertices: np.ndarray, tri: np.ndarray, planes: np.ndarray
+def facet_mesh(poly_vertices: np.ndarray, tri: np.ndarray, equations: np.ndarray, planes: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Flat facets of a convex polytope made whole: (vertices (V', 3), faces (F', 3) CCW outward,
     facet (F',) the facet of each face, plane (n_facets,) the row of `planes` each facet lies on,
     -1 for a facet on none of them).
 
-    Every qhull triangle goes to the plane it lies on (all corners within ON_PLANE, normal the
-    same way; the most parallel); only vertices on three or more facets stay (the others are
-    inside a facet or on a straight edge); a facet's corners, sorted by angle around their mean
-    in its plane (a convex polygon), are fanned from the first (n - 2 triangles)."""
-    t = poly_vertices[tri]
-    tn = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    tn /= np.maximum(np.linalg.norm(tn, axis=1, keepdims=True), 1e-300)
-    dist = np.abs(poly_vertices @ planes[:, :3].T + planes[:, 3])  # (V, K)
-    on = (dist[tri] <= ON_PLANE).all(axis=1)  # (T, K)
-    score = np.where(on, tn @ planes[:, :3].T, -np.inf)
-    best = np.argmax(score, axis=1)
-    plane_of = np.where(score[np.arange(len(tri)), best] > 0, best, -1)
-    # triangles on no plane (qhull dropped a nearly coplanar vertex) are facets of their own
-    key = np.where(plane_of >= 0, plane_of, len(planes) + np.arange(len(tri)))
-    groups, first, facet_of_tri = np.unique(key, return_index=True, return_inverse=True)
-    facet_plane = np.where(groups < len(planes), groups, -1)
-    normal = np.where(facet_plane[:, None] >= 0, planes[np.maximum(facet_plane, 0), :3], tn[first])
+    In: qhull's triangles tri (T, 3) of the hull of poly_vertices, CCW outward, and the equation of
+    each one's facet (T, 4) (qhull's facets: the triangles of one share the row); planes (K, 4) the
+    halfspaces. A facet lies on the most parallel plane within ON_FACET; only vertices on three or
+    more facets stay (the others are inside a facet or on a straight edge); a facet's corners,
+    sorted by angle around their mean in its plane (a convex polygon), are fanned from the first
+    (n - 2 triangles)."""
+    groups, facet_of_tri = np.unique(equations, axis=0, return_inverse=True)
+    facet_of_tri = facet_of_tri.reshape(-1)
+    fit = groups[:, :3] @ planes[:, :3].T  # (n_facets, K)
+    fit[(fit < 1.0 - ON_FACET) | (np.abs(groups[:, 3:] - planes[:, 3]) > ON_FACET)] = -np.inf
+    best = np.argmax(fit, axis=1)
+    facet_plane = np.where(np.isfinite(fit[np.arange(len(groups)), best]), best, -1)
+    normal = groups[:, :3]
     pairs = np.unique(np.stack([facet_of_tri.repeat(3), tri.reshape(-1)], axis=1), axis=0)  # (facet, vertex)
     corner = np.bincount(pairs[:, 1], minlength=len(poly_vertices)) >= 3
     pairs = pairs[corner[pairs[:, 1]]]
@@ -322,10 +319,14 @@ def _part_hull(mesh: Mesh, seg: Segmentation, p: int, frame: tuple[np.ndarray, f
         normals = mesh.face_normals[seg.face_ids[p]] * face_areas(mesh.vertices, mesh.faces[seg.face_ids[p]])[:, None]
         if float(normals.sum(axis=0) @ thin) < 0:
             thin = -thin  # outwards
-        pts = np.concatenate([pts, pts - (FLAT_THICKNESS - width) * thin])
+        # onto the plane through the outermost point (a move below FLAT_WIDTH): a rounded "flat"
+        # set would leave facets and edges of its own width on the slab
+        h = pts @ thin
+        pts = pts + np.outer(h.max() - h, thin)
+        pts = np.concatenate([pts, pts - FLAT_THICKNESS * thin])
     verts, tri, eq = _hull_of(pts)
     planes, clip = _dedupe(eq, np.full(len(eq), -1))
-    return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri))
+    return _Polytope(planes, clip, verts, tri, eq, signed_volume(verts, tri))
 
 
 def _plane_apart(a: _Polytope, b: _Polytope) -> bool:
@@ -342,12 +343,28 @@ def _apart(a: _Polytope, b: _Polytope) -> bool:
             or chebyshev_centre(np.concatenate([a.planes, b.planes]))[1] <= OVERLAP_EPS)
 
 
-def _intersection(a: _Polytope, b: _Polytope) -> _Polytope | None:
+@dataclass(frozen=True, eq=False)
+class _Overlap:
+    """Two hulls overlap: a ball of `radius` (> OVERLAP_EPS) fits in both; region: their common
+    polytope, None when it is too thin for qhull (it must be cut all the same)."""
+
+    radius: float
+    region: _Polytope | None
+
+    @property
+    def volume(self) -> float:
+        return self.region.volume if self.region is not None else 0.0
+
+
+def _intersection(a: _Polytope, b: _Polytope) -> _Overlap | None:
     """The overlap of two polytopes, None when no ball of radius OVERLAP_EPS fits in both."""
     if _boxes_apart(a, b) or _plane_apart(a, b):
         return None
     planes = np.concatenate([a.planes, b.planes])
-    return _polytope(planes, np.full(len(planes), -1))
+    centre, radius = chebyshev_centre(planes)
+    if radius <= OVERLAP_EPS:
+        return None
+    return _Overlap(radius, _polytope(planes, np.full(len(planes), -1), centre))
 
 
 def _boxes_apart(a: _Polytope, b: _Polytope) -> bool:
@@ -405,7 +422,13 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
         res = minimize_scalar(cost, bounds=(lo_k, hi_k), method="bounded", options={"xatol": 1e-10})
         if res.fun < best_c:
             best_s, best_c = float(res.x), float(res.fun)
-    return best_s, best_c, off_i(best_s) + off_j(best_s)
+    # The optimum often sits at a kink of the cost, where the plane passes a vertex: through it
+    # exactly, or the cut leaves edges of 1e-8 and slivers whose normals are noise
+    proj = np.concatenate([pi, pj])
+    near = proj[np.argmin(np.abs(proj - best_s))]
+    if abs(near - best_s) <= SNAP and a <= near <= b:
+        best_s = float(near)
+    return best_s, wi * off_i(best_s) + wj * off_j(best_s), off_i(best_s) + off_j(best_s)
 
 
 def _unit(v: np.ndarray) -> np.ndarray | None:
@@ -413,7 +436,7 @@ def _unit(v: np.ndarray) -> np.ndarray | None:
     return v / n if n > 1e-12 else None
 
 
-def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarray,
+def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope | None, shared: np.ndarray,
                 methods: tuple[str, ...]) -> list[tuple[str, np.ndarray]]:
     """Candidate normals (method, unit normal) for cutting a from b (module docstring)."""
     axis = _unit(b.centroid - a.centroid)
@@ -431,7 +454,7 @@ def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarr
             out.append(("shared", n))
     if ("centroids" in methods or not out) and axis is not None:
         out.append(("centroids", axis))
-    if "overlap" in methods or not out:
+    if overlap is not None and ("overlap" in methods or not out):
         v = overlap.vertices
         q = v - v.mean(axis=0)
         out.append(("overlap", np.linalg.svd(q, full_matrices=False)[2][2]))
@@ -442,7 +465,7 @@ def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarr
     return out
 
 
-def _cut(a: _Polytope, b: _Polytope, keep: tuple[float, float], weight: tuple[float, float], overlap: _Polytope,
+def _cut(a: _Polytope, b: _Polytope, keep: tuple[float, float], weight: tuple[float, float], overlap: _Polytope | None,
          shared: np.ndarray, methods: tuple[str, ...]) -> tuple[np.ndarray, float, float, str] | None:
     """(normal, offset, removed volume, method) of the best plane keeping a on n . x <= s and b on
     n . x >= s (cost: weight-ed volumes cut off a and b), each hull keeping at least `keep`; None
@@ -499,7 +522,7 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
         raise ValueError(f"objective must be 'fraction' or 'volume', not {objective!r}")
     weight = [1.0 / h.volume if objective == "fraction" else 1.0 for h in hulls]
     shared_of = {}
-    overlap: dict[tuple[int, int], _Polytope | None] = {}
+    overlap: dict[tuple[int, int], _Overlap | None] = {}
     for i in range(n):
         for j in range(i + 1, n):
             if not _boxes_apart(hulls[i], hulls[j]):
@@ -509,11 +532,12 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
         live = {k: v for k, v in overlap.items() if v is not None}
         if not live:
             return hulls, cuts
-        (i, j), region = max(live.items(), key=lambda kv: kv[1].volume)
+        (i, j), over = max(live.items(), key=lambda kv: (kv[1].volume, kv[1].radius))
         if (i, j) not in shared_of:
             ids = np.intersect1d(seg.vertex_ids[i], seg.vertex_ids[j])
             shared_of[(i, j)] = (mesh.vertices[ids] - frame[0]) / frame[1]
-        got = _cut(hulls[i], hulls[j], (floor[i], floor[j]), (weight[i], weight[j]), region, shared_of[(i, j)], methods)
+        got = _cut(hulls[i], hulls[j], (floor[i], floor[j]), (weight[i], weight[j]), over.region, shared_of[(i, j)],
+                   methods)
         if got is None:
             raise PolyfoldError(f"parts {i} and {j}: every plane separating their hulls leaves one of them with less "
                                 f"than {MIN_KEEP:.0%} of its volume (a part nested in another's hull)")
@@ -538,7 +562,7 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
 
 def _facets(poly: _Polytope) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """`facet_mesh` of a polytope plus the area on each of its planes (K,)."""
-    verts, faces, facet, plane = facet_mesh(poly.vertices, poly.tri, poly.planes)
+    verts, faces, facet, plane = facet_mesh(poly.vertices, poly.tri, poly.equations, poly.planes)
     area = np.zeros(len(poly.planes))
     fa = face_areas(verts, faces)
     np.add.at(area, np.where(plane[facet] >= 0, plane[facet], 0), np.where(plane[facet] >= 0, fa, 0.0))
@@ -585,7 +609,7 @@ def _simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, m
     if not len(cand):
         return poly, 0.0
     inside = chebyshev_centre(poly.planes)[0]  # inside every superset: no LP per attempt
-    corners = len(facet_mesh(poly.vertices, poly.tri, poly.planes)[0])
+    corners = len(facet_mesh(poly.vertices, poly.tri, poly.equations, poly.planes)[0])
     keep = np.ones(len(poly.planes), dtype=bool)
     best = (poly, 0.0)
     for k in cand:
@@ -593,7 +617,7 @@ def _simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, m
         grown = _polytope(poly.planes[keep], poly.clip[keep], inside)
         ok = grown is not None
         if ok:
-            n_corners = len(facet_mesh(grown.vertices, grown.tri, grown.planes)[0])
+            n_corners = len(facet_mesh(grown.vertices, grown.tri, grown.equations, grown.planes)[0])
             growth = _growth(grown.vertices, poly) if n_corners < corners else np.inf
             ok = growth <= max_growth and all(_apart(grown, o) for o in others)
         if ok:
