@@ -149,6 +149,16 @@ def test_shared_models(approximated, name):
     assert 0.9 < r.volume_ratio < 1.5
 
 
+@pytest.mark.parametrize("name,tau", [("torus-50", 0.0), ("periscope2-44", 0.02), ("star-4split-96", 0.05),
+                                      ("periscope-28", 0.0)])
+def test_cases_that_broke_early_versions(models_dir, name, tau):
+    """Many flat parts (thickened), cuts through vertices, an overlap too thin for qhull, an LP
+    HiGHS gave up on at its tightest tolerance."""
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    seg = segment(mesh, tau=tau)
+    check_approximation(mesh, seg, approximate_hulls(mesh, seg, samples=500))
+
+
 def test_generated_noisy_icosphere():
     mesh = noisy_icosphere()
     seg = segment(mesh)
