@@ -41,8 +41,9 @@ def part_errors(parts: Sequence[Mesh], approx: Sequence[Mesh], diag: float, samp
     """(out, in, volume), each (P,): out[p] = one-sided Hausdorff distance from approximation p to
     the open surface patch parts[p], in[p] = from the patch to the approximation's surface, both
     over `diag`; volume[p] = the enclosed volume of approx[p] (model units cubed)."""
-    out = np.array([hausdorff_one_sided(a, s, samples, seed + 2 * p) for p, (s, a) in enumerate(zip(parts, approx))]) / diag
-    inn = np.array([hausdorff_one_sided(s, a, samples, seed + 2 * p + 1) for p, (s, a) in enumerate(zip(parts, approx))]) / diag
+    pairs = list(enumerate(zip(parts, approx)))
+    out = np.array([hausdorff_one_sided(a, s, samples, seed + 2 * p) for p, (s, a) in pairs]) / diag
+    inn = np.array([hausdorff_one_sided(s, a, samples, seed + 2 * p + 1) for p, (s, a) in pairs]) / diag
     vol = np.array([signed_volume(a.vertices, a.faces) for a in approx])
     return out, inn, vol
 

@@ -67,9 +67,9 @@ part's area: periscope-28's flat sides lose most of theirs, see `hausdorff_in` i
 
 Flat parts (all vertices within FLAT_WIDTH of a plane, x the bounding-box diagonal) get a
 thickness instead of an error: their vertices, moved onto the plane through the outermost one,
-are copied FLAT_THICKNESS inwards (against the part's area-weighted outward normal) before the hull, so a flat side becomes a slab that can be
-built and cut like any hull; the slab's back is FLAT_THICKNESS from the surface, which
-`hausdorff_out` reports.
+are copied FLAT_THICKNESS inwards (against the part's area-weighted outward normal) before the
+hull, so a flat side becomes a slab that can be built and cut like any hull; the slab's back is
+FLAT_THICKNESS from the surface, which `hausdorff_out` reports.
 
 Facets: a facet smaller than `min_facet` of its hull's surface area, or within FLAT_REGION_RAD of a
 larger facet's normal, loses its halfspace (the hull grows over it) unless it is a clipping plane
@@ -512,7 +512,7 @@ def _clip(poly: _Polytope, plane: np.ndarray, cut: int) -> _Polytope | None:
 
 
 def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tuple[str, ...] = PLANE_METHODS,
-             objective: str = DEFAULT_OBJECTIVE) -> tuple[list[_Polytope], list[tuple[int, int, np.ndarray, float, float, str]]]:
+              objective: str = DEFAULT_OBJECTIVE) -> tuple[list[_Polytope], list[tuple]]:
     """Cut every overlapping pair of hulls (unit frame), largest overlap first: (the hulls, the
     cuts as (i, j, normal, offset, removed volume, method), i kept on n . x <= offset).
     objective: "fraction" (each hull's cut-off volume over its unclipped volume) or "volume"."""
