@@ -244,16 +244,12 @@ def _polytope(planes: np.ndarray, clip: np.ndarray, inside: np.ndarray | None = 
 
 
 def _dedupe(planes: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The planes without repeats (normals and offsets within ON_PLANE: the tighter one stays, a
-    clipping plane before a hull facet)."""
-    keep = np.ones(len(planes), dtype=bool)
-    order = np.lexsort((-planes[:, 3], clip < 0))  # clipping planes first, then the tighter
-    for a_i, a in enumerate(order):
-        if not keep[a]:
-            continue
-        rest = order[a_i + 1:]
-        same = (np.abs(planes[rest] - planes[a]).max(axis=1) <= ON_PLANE) & keep[rest]
-        keep[rest[same]] = False
+    """The planes without repeats (normals and offsets within ON_PLANE of an earlier one, in the
+    order: clipping planes first, then the tighter; a plane and its repeat bound the same side)."""
+    order = np.lexsort((-planes[:, 3], clip < 0))
+    p = planes[order]
+    same = (np.abs(p[:, None] - p[None]).max(axis=2) <= ON_PLANE) & np.tri(len(p), k=-1, dtype=bool)
+    keep = order[~same.any(axis=1)]
     return planes[keep], clip[keep]
 
 
