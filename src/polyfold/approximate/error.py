@@ -41,8 +41,9 @@ def part_errors(parts: Sequence[Mesh], approx: Sequence[Mesh], diag: float, samp
     """(out, in, volume), each (P,): out[p] = one-sided Hausdorff distance from approximation p to
     the open surface patch parts[p], in[p] = from the patch to the approximation's surface, both
     over `diag`; volume[p] = the enclosed volume of approx[p] (model units cubed)."""
-    out = np.array([hausdorff_one_sided(a, s, samples, seed + 2 * p) for p, (s, a) in enumerate(zip(parts, approx))]) / diag
-    inn = np.array([hausdorff_one_sided(s, a, samples, seed + 2 * p + 1) for p, (s, a) in enumerate(zip(parts, approx))]) / diag
+    pairs = list(enumerate(zip(parts, approx)))
+    out = np.array([hausdorff_one_sided(a, s, samples, seed + 2 * p) for p, (s, a) in pairs]) / diag
+    inn = np.array([hausdorff_one_sided(s, a, samples, seed + 2 * p + 1) for p, (s, a) in pairs]) / diag
     vol = np.array([signed_volume(a.vertices, a.faces) for a in approx])
     return out, inn, vol
 
@@ -51,13 +52,32 @@ def part_errors(parts: Sequence[Mesh], approx: Sequence[Mesh], diag: float, samp
 # Disjointness
 
 
+def chebyshev_centre(planes: np.ndarray, cap: float = 1.0) -> tuple[np.ndarray, float]:
+    """(centre (3,), radius) of the largest ball inside n . x + d <= 0 for all rows (n, d) of
+    planes (K, 4), n unit: one LP, max t s.t. n . x + d + t <= 0 (HiGHS). radius <= 0: no
+    interior (minus the distance the planes would have to move); radius == cap: unbounded (or at
+    least that large). Coordinates should be of order 1 (HiGHS's tolerances are absolute).
+
+    HiGHS at feasibility tolerance 1e-10 now and then ends in an unknown status (a torus's
+    planes); then 1e-9, then its interior-point method."""
+    from scipy.optimize import linprog
+
+    a = np.concatenate([planes[:, :3], np.ones((len(planes), 1))], axis=1)
+    res = None
+    for method, tol in (("highs", 1e-10), ("highs", 1e-9), ("highs-ipm", 1e-9)):
+        res = linprog(c=[0, 0, 0, -1], A_ub=a, b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(None, cap)],
+                      method=method, options={"primal_feasibility_tolerance": tol, "dual_feasibility_tolerance": tol})
+        if res.status == 0:
+            return res.x[:3], float(res.x[3])
+    raise PolyfoldError(f"Chebyshev centre LP failed: {res.message}")
+
+
 def lp_overlap_depth(a: Mesh, b: Mesh) -> float:
     """The radius (model units) of the largest ball inside both closed convex meshes a and b (their
     face planes, CCW outward): > 0 when their interiors overlap, <= 0 when a plane separates them
-    (then minus half the gap along the best separating direction, roughly). One LP (HiGHS): max t
-    s.t. n_f . x + d_f + t <= 0 for every face f of both, n_f unit."""
-    from scipy.optimize import linprog
-
+    (then minus half the gap along the best separating direction, roughly): `chebyshev_centre` of
+    the face planes of both, in a frame of their size. The planes come from the meshes' faces, not
+    from the halfspaces the clipping kept, so the check does not trust the clipping's bookkeeping."""
     verts = np.concatenate([a.vertices, b.vertices])
     centre = 0.5 * (verts.min(axis=0) + verts.max(axis=0))
     scale = float(np.linalg.norm(np.ptp(verts, axis=0))) or 1.0
@@ -67,13 +87,7 @@ def lp_overlap_depth(a: Mesh, b: Mesh) -> float:
         n = face_normals(v, m.faces)
         ok = np.linalg.norm(n, axis=1) > 0.5  # degenerate faces have no plane
         rows.append(np.concatenate([n[ok], -np.einsum("ij,ij->i", n[ok], v[m.faces[ok, 0]])[:, None]], axis=1))
-    planes = np.concatenate(rows)
-    res = linprog(c=[0, 0, 0, -1], A_ub=np.concatenate([planes[:, :3], np.ones((len(planes), 1))], axis=1),
-                  b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(None, 1.0)], method="highs",
-                  options={"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10})
-    if res.status != 0:
-        raise PolyfoldError(f"overlap LP failed: {res.message}")
-    return float(res.x[3]) * scale
+    return chebyshev_centre(np.concatenate(rows))[1] * scale
 
 
 def lp_overlap_depths(parts: Sequence[Mesh]) -> np.ndarray:

@@ -43,8 +43,8 @@ bench/bench_hulls.py --planes on the shared closed models with more than one par
     fish-472             0.05    5     0.34      0.89      0.18      0.18       0.17
     sphere-deformed-320  0.02    6     7.42      7.42      7.33      7.33       7.30
     bumpy-528            0.02   29    36.06     12.99      6.92      6.92       6.22
-    periscope-28         0.02    6    38.43     34.02     32.22     32.31      30.48
-    periscope-28         0.05    5    error     57.81     56.57     56.55      49.83
+    periscope-28         0.02    6    38.43     34.02     33.58     33.58      33.17
+    periscope-28         0.05    5    error     57.81     54.41     54.41      51.18
     star-24              0.05    2    73.42     50.00     50.00     50.00      48.24
     moneybox-128         0.05    6     5.86      5.45      4.78      4.78       4.66
 
@@ -53,22 +53,23 @@ some pair could not be cut without leaving a hull below MIN_KEEP.) The shared bo
 the issue's first idea, is the worst candidate on most models: a boundary loop is rarely flat, and
 its plane may slice a hull lengthwise (horse 0.05: twice the volume of the best). The overlap
 region's thin directions alone come closest to the best, and refining the normal takes another
-0-12 % off, for milliseconds per pair (the whole stage stays under 3.5 s on these models), so all candidates are
-tried and the refined best is taken. The cuts are greedy (largest overlap first), so a better
-plane for one pair can cost another pair later (periscope 0.02: all three 32.31 vs overlap alone
-32.22). objective="fraction" (each hull's cut-off volume over its unclipped volume) spares small
-parts at the cost of more volume (bunny-128 0.05: 17.0 % removed against 11.1 %); the issue asks
-for the least volume, so that is the default.
+0-10 % off, for milliseconds per pair (the whole stage stays under 3.5 s on these models), so all
+candidates are tried and the refined best is taken (the cuts are greedy, largest overlap first, so
+a better plane for one pair may still cost another pair later). objective="fraction" (each hull's
+cut-off volume over its unclipped volume) spares small parts at the cost of more volume, and does
+not fit the patches better (tau 0.05, removed % / hausdorff_in %: bunny-128 17.0 / 12.8 against
+11.1 / 11.9, horse-302 12.6 / 7.5 against 8.5 / 6.2); the issue asks for the least volume, so that
+is the default.
 
 A cut may not leave either hull with less than MIN_KEEP of its unclipped volume; when no
 candidate allows that, PolyfoldError names the two parts. (A volume floor does not keep a thin
 part's area: periscope-28's flat sides lose most of theirs, see `hausdorff_in` in the benchmark.)
 
 Flat parts (all vertices within FLAT_WIDTH of a plane, x the bounding-box diagonal) get a
-thickness instead of an error: their vertices are copied FLAT_THICKNESS inwards (against the
-part's area-weighted outward normal) before the hull, so a flat side becomes a slab that can be
-built and cut like any hull; the slab's back is FLAT_THICKNESS from the surface, which
-`hausdorff_out` reports.
+thickness instead of an error: their vertices, moved onto the plane through the outermost one,
+are copied FLAT_THICKNESS inwards (against the part's area-weighted outward normal) before the
+hull, so a flat side becomes a slab that can be built and cut like any hull; the slab's back is
+FLAT_THICKNESS from the surface, which `hausdorff_out` reports.
 
 Facets: a facet smaller than `min_facet` of its hull's surface area, or within FLAT_REGION_RAD of a
 larger facet's normal, loses its halfspace (the hull grows over it) unless it is a clipping plane
@@ -108,7 +109,7 @@ from ..mesh.closest import closest_points
 from ..mesh.geometry import FLAT_REGION_RAD, face_areas
 from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
-from .error import SAMPLES, part_errors, signed_volume
+from .error import SAMPLES, chebyshev_centre, part_errors, signed_volume
 from .kernels import volume_beyond, volumes_beyond
 from .tidy import drop_crowded_corners, thin_polygon
 
@@ -135,8 +136,10 @@ DEFAULT_OBJECTIVE = "volume"
 # ball of radius above OVERLAP_EPS fits in both (HiGHS runs at 1e-10 feasibility tolerance)
 ON_PLANE = 1e-9
 OVERLAP_EPS = 1e-9
+WELD = 1e-6  # hull points closer than this are one (`_hull_of`)
+ON_FACET = 1e-6  # a qhull facet whose equation is within this of a halfspace's lies on it
 GRID = 25  # offsets tried per candidate normal before the bounded 1-D search
-_LP_OPTIONS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
+SNAP = 1e-6  # unit frame: a cut's offset this close to a vertex goes through it
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,12 +191,14 @@ class HullApproximation:
 class _Polytope:
     """A convex polytope in the unit frame: planes (K, 4) (n, d), inside n . x + d <= 0; clip (K,)
     the index of the cut that added each plane, -1 for the part's own hull facets; vertices (V, 3)
-    and triangles tri (T, 3), CCW outward (qhull's triangulation); volume."""
+    and triangles tri (T, 3), CCW outward (qhull's triangulation), equations (T, 4) the plane of
+    each triangle's qhull facet (the triangles of one facet share the row); volume."""
 
     planes: np.ndarray
     clip: np.ndarray
     vertices: np.ndarray
     tri: np.ndarray
+    equations: np.ndarray
     volume: float
 
     @property
@@ -208,24 +213,21 @@ class _Polytope:
         return (w[:, None] * t.sum(axis=1)).sum(axis=0) / (4.0 * w.sum())
 
 
-def chebyshev_centre(planes: np.ndarray, cap: float = 1.0) -> tuple[np.ndarray, float]:
-    """(centre (3,), radius) of the largest ball inside n . x + d <= 0 for all rows (n, d) of
-    planes (K, 4), n unit: one LP (HiGHS). radius <= 0: no interior; radius == cap: unbounded
-    (or at least that large)."""
-    from scipy.optimize import linprog
-
-    a = np.concatenate([planes[:, :3], np.ones((len(planes), 1))], axis=1)
-    res = linprog(c=[0, 0, 0, -1], A_ub=a, b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(None, cap)],
-                  method="highs", options=_LP_OPTIONS)
-    if res.status != 0:
-        raise PolyfoldError(f"Chebyshev centre LP failed: {res.message}")
-    return res.x[:3], float(res.x[3])
-
-
 def _hull_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices, triangles CCW outward, facet equations) of the convex hull of points (qhull)."""
-    from scipy.spatial import ConvexHull
+    """(vertices, triangles CCW outward, each triangle's facet equation) of the convex hull of
+    points (qhull), points closer than WELD first replaced by one of them (a cut through a vertex
+    leaves several intersection points within 1e-8 of it, and edges that short make slivers whose
+    normals are noise; keeping one of the points, not their mean, keeps the hull inside every
+    halfspace the points satisfy)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import ConvexHull, cKDTree
 
+    pairs = cKDTree(points).query_pairs(WELD, output_type="ndarray")
+    if len(pairs):
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(points), len(points)))
+        _, label = connected_components(graph, directed=False)
+        points = points[np.unique(label, return_index=True)[1]]
     h = ConvexHull(points)
     tri = h.simplices.copy()
     t = points[tri]
@@ -249,50 +251,42 @@ def _polytope(planes: np.ndarray, clip: np.ndarray, inside: np.ndarray | None = 
             pts = HalfspaceIntersection(planes, inside).intersections
         if not np.isfinite(pts).all() or np.abs(pts).max() > 10.0:  # unbounded (the unit frame is 1 across)
             return None
-        verts, tri, _ = _hull_of(pts)
+        verts, tri, eq = _hull_of(pts)
     except (QhullError, ValueError):
         return None
     vol = signed_volume(verts, tri)
-    return _Polytope(planes, clip, verts, tri, vol) if vol > 0 else None
+    return _Polytope(planes, clip, verts, tri, eq, vol) if vol > 0 else None
 
 
 def _dedupe(planes: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The planes without repeats (normals and offsets within ON_PLANE: the tighter one stays, a
-    clipping plane before a hull facet)."""
-    keep = np.ones(len(planes), dtype=bool)
-    order = np.lexsort((-planes[:, 3], clip < 0))  # clipping planes first, then the tighter
-    for a_i, a in enumerate(order):
-        if not keep[a]:
-            continue
-        rest = order[a_i + 1:]
-        same = (np.abs(planes[rest] - planes[a]).max(axis=1) <= ON_PLANE) & keep[rest]
-        keep[rest[same]] = False
+    """The planes without repeats (normals and offsets within ON_PLANE of an earlier one, in the
+    order: clipping planes first, then the tighter; a plane and its repeat bound the same side)."""
+    order = np.lexsort((-planes[:, 3], clip < 0))
+    p = planes[order]
+    same = (np.abs(p[:, None] - p[None]).max(axis=2) <= ON_PLANE) & np.tri(len(p), k=-1, dtype=bool)
+    keep = order[~same.any(axis=1)]
     return planes[keep], clip[keep]
 
 
-def facet_mesh(poly_vertices: np.ndarray, tri: np.ndarray, planes: np.ndarray
+def facet_mesh(poly_vertices: np.ndarray, tri: np.ndarray, equations: np.ndarray, planes: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Flat facets of a convex polytope made whole: (vertices (V', 3), faces (F', 3) CCW outward,
     facet (F',) the facet of each face, plane (n_facets,) the row of `planes` each facet lies on,
     -1 for a facet on none of them).
 
-    Every qhull triangle goes to the plane it lies on (all corners within ON_PLANE, normal the
-    same way; the most parallel); only vertices on three or more facets stay (the others are
-    inside a facet or on a straight edge); a facet's corners, sorted by angle around their mean
-    in its plane (a convex polygon), are fanned from the first (n - 2 triangles)."""
-    t = poly_vertices[tri]
-    tn = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    tn /= np.maximum(np.linalg.norm(tn, axis=1, keepdims=True), 1e-300)
-    dist = np.abs(poly_vertices @ planes[:, :3].T + planes[:, 3])  # (V, K)
-    on = (dist[tri] <= ON_PLANE).all(axis=1)  # (T, K)
-    score = np.where(on, tn @ planes[:, :3].T, -np.inf)
-    best = np.argmax(score, axis=1)
-    plane_of = np.where(score[np.arange(len(tri)), best] > 0, best, -1)
-    # triangles on no plane (qhull dropped a nearly coplanar vertex) are facets of their own
-    key = np.where(plane_of >= 0, plane_of, len(planes) + np.arange(len(tri)))
-    groups, first, facet_of_tri = np.unique(key, return_index=True, return_inverse=True)
-    facet_plane = np.where(groups < len(planes), groups, -1)
-    normal = np.where(facet_plane[:, None] >= 0, planes[np.maximum(facet_plane, 0), :3], tn[first])
+    In: qhull's triangles tri (T, 3) of the hull of poly_vertices, CCW outward, and the equation of
+    each one's facet (T, 4) (qhull's facets: the triangles of one share the row); planes (K, 4) the
+    halfspaces. A facet lies on the most parallel plane within ON_FACET; only vertices on three or
+    more facets stay (the others are inside a facet or on a straight edge); a facet's corners,
+    sorted by angle around their mean in its plane (a convex polygon), are fanned from the first
+    (n - 2 triangles)."""
+    groups, facet_of_tri = np.unique(equations, axis=0, return_inverse=True)
+    facet_of_tri = facet_of_tri.reshape(-1)
+    fit = groups[:, :3] @ planes[:, :3].T  # (n_facets, K)
+    fit[(fit < 1.0 - ON_FACET) | (np.abs(groups[:, 3:] - planes[:, 3]) > ON_FACET)] = -np.inf
+    best = np.argmax(fit, axis=1)
+    facet_plane = np.where(np.isfinite(fit[np.arange(len(groups)), best]), best, -1)
+    normal = groups[:, :3]
     pairs = np.unique(np.stack([facet_of_tri.repeat(3), tri.reshape(-1)], axis=1), axis=0)  # (facet, vertex)
     corner = np.bincount(pairs[:, 1], minlength=len(poly_vertices)) >= 3
     pairs = pairs[corner[pairs[:, 1]]]
@@ -349,10 +343,14 @@ def _part_hull(mesh: Mesh, seg: Segmentation, p: int, frame: tuple[np.ndarray, f
         normals = mesh.face_normals[seg.face_ids[p]] * face_areas(mesh.vertices, mesh.faces[seg.face_ids[p]])[:, None]
         if float(normals.sum(axis=0) @ thin) < 0:
             thin = -thin  # outwards
-        pts = np.concatenate([pts, pts - (FLAT_THICKNESS - width) * thin])
+        # onto the plane through the outermost point (a move below FLAT_WIDTH): a rounded "flat"
+        # set would leave facets and edges of its own width on the slab
+        h = pts @ thin
+        pts = pts + np.outer(h.max() - h, thin)
+        pts = np.concatenate([pts, pts - FLAT_THICKNESS * thin])
     verts, tri, eq = _hull_of(pts)
     planes, clip = _dedupe(eq, np.full(len(eq), -1))
-    return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri))
+    return _Polytope(planes, clip, verts, tri, eq, signed_volume(verts, tri))
 
 
 def _plane_apart(a: _Polytope, b: _Polytope) -> bool:
@@ -369,12 +367,28 @@ def _apart(a: _Polytope, b: _Polytope) -> bool:
             or chebyshev_centre(np.concatenate([a.planes, b.planes]))[1] <= OVERLAP_EPS)
 
 
-def _intersection(a: _Polytope, b: _Polytope) -> _Polytope | None:
+@dataclass(frozen=True, eq=False)
+class _Overlap:
+    """Two hulls overlap: a ball of `radius` (> OVERLAP_EPS) fits in both; region: their common
+    polytope, None when it is too thin for qhull (it must be cut all the same)."""
+
+    radius: float
+    region: _Polytope | None
+
+    @property
+    def volume(self) -> float:
+        return self.region.volume if self.region is not None else 0.0
+
+
+def _intersection(a: _Polytope, b: _Polytope) -> _Overlap | None:
     """The overlap of two polytopes, None when no ball of radius OVERLAP_EPS fits in both."""
     if _boxes_apart(a, b) or _plane_apart(a, b):
         return None
     planes = np.concatenate([a.planes, b.planes])
-    return _polytope(planes, np.full(len(planes), -1))
+    centre, radius = chebyshev_centre(planes)
+    if radius <= OVERLAP_EPS:
+        return None
+    return _Overlap(radius, _polytope(planes, np.full(len(planes), -1), centre))
 
 
 def _boxes_apart(a: _Polytope, b: _Polytope) -> bool:
@@ -432,7 +446,13 @@ def _best_offset(ti: np.ndarray, tj: np.ndarray, vi: float, vj: float, keep_i: f
         res = minimize_scalar(cost, bounds=(lo_k, hi_k), method="bounded", options={"xatol": 1e-10})
         if res.fun < best_c:
             best_s, best_c = float(res.x), float(res.fun)
-    return best_s, best_c, off_i(best_s) + off_j(best_s)
+    # The optimum often sits at a kink of the cost, where the plane passes a vertex: through it
+    # exactly, or the cut leaves edges of 1e-8 and slivers whose normals are noise
+    proj = np.concatenate([pi, pj])
+    near = proj[np.argmin(np.abs(proj - best_s))]
+    if abs(near - best_s) <= SNAP and a <= near <= b:
+        best_s = float(near)
+    return best_s, wi * off_i(best_s) + wj * off_j(best_s), off_i(best_s) + off_j(best_s)
 
 
 def _unit(v: np.ndarray) -> np.ndarray | None:
@@ -440,7 +460,7 @@ def _unit(v: np.ndarray) -> np.ndarray | None:
     return v / n if n > 1e-12 else None
 
 
-def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarray,
+def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope | None, shared: np.ndarray,
                 methods: tuple[str, ...]) -> list[tuple[str, np.ndarray]]:
     """Candidate normals (method, unit normal) for cutting a from b (module docstring)."""
     axis = _unit(b.centroid - a.centroid)
@@ -458,7 +478,7 @@ def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarr
             out.append(("shared", n))
     if ("centroids" in methods or not out) and axis is not None:
         out.append(("centroids", axis))
-    if "overlap" in methods or not out:
+    if overlap is not None and ("overlap" in methods or not out):
         v = overlap.vertices
         q = v - v.mean(axis=0)
         out.append(("overlap", np.linalg.svd(q, full_matrices=False)[2][2]))
@@ -469,7 +489,7 @@ def _candidates(a: _Polytope, b: _Polytope, overlap: _Polytope, shared: np.ndarr
     return out
 
 
-def _cut(a: _Polytope, b: _Polytope, keep: tuple[float, float], weight: tuple[float, float], overlap: _Polytope,
+def _cut(a: _Polytope, b: _Polytope, keep: tuple[float, float], weight: tuple[float, float], overlap: _Polytope | None,
          shared: np.ndarray, methods: tuple[str, ...]) -> tuple[np.ndarray, float, float, str] | None:
     """(normal, offset, removed volume, method) of the best plane keeping a on n . x <= s and b on
     n . x >= s (cost: weight-ed volumes cut off a and b), each hull keeping at least `keep`; None
@@ -515,7 +535,7 @@ def _clip(poly: _Polytope, plane: np.ndarray, cut: int) -> _Polytope | None:
 
 
 def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tuple[str, ...] = PLANE_METHODS,
-             objective: str = DEFAULT_OBJECTIVE) -> tuple[list[_Polytope], list[tuple[int, int, np.ndarray, float, float, str]]]:
+              objective: str = DEFAULT_OBJECTIVE) -> tuple[list[_Polytope], list[tuple]]:
     """Cut every overlapping pair of hulls (unit frame), largest overlap first: (the hulls, the
     cuts as (i, j, normal, offset, removed volume, method), i kept on n . x <= offset).
     objective: "fraction" (each hull's cut-off volume over its unclipped volume) or "volume"."""
@@ -526,7 +546,7 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
         raise ValueError(f"objective must be 'fraction' or 'volume', not {objective!r}")
     weight = [1.0 / h.volume if objective == "fraction" else 1.0 for h in hulls]
     shared_of = {}
-    overlap: dict[tuple[int, int], _Polytope | None] = {}
+    overlap: dict[tuple[int, int], _Overlap | None] = {}
     for i in range(n):
         for j in range(i + 1, n):
             if not _boxes_apart(hulls[i], hulls[j]):
@@ -536,11 +556,12 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
         live = {k: v for k, v in overlap.items() if v is not None}
         if not live:
             return hulls, cuts
-        (i, j), region = max(live.items(), key=lambda kv: kv[1].volume)
+        (i, j), over = max(live.items(), key=lambda kv: (kv[1].volume, kv[1].radius))
         if (i, j) not in shared_of:
             ids = np.intersect1d(seg.vertex_ids[i], seg.vertex_ids[j])
             shared_of[(i, j)] = (mesh.vertices[ids] - frame[0]) / frame[1]
-        got = _cut(hulls[i], hulls[j], (floor[i], floor[j]), (weight[i], weight[j]), region, shared_of[(i, j)], methods)
+        got = _cut(hulls[i], hulls[j], (floor[i], floor[j]), (weight[i], weight[j]), over.region, shared_of[(i, j)],
+                   methods)
         if got is None:
             raise PolyfoldError(f"parts {i} and {j}: every plane separating their hulls leaves one of them with less "
                                 f"than {MIN_KEEP:.0%} of its volume (a part nested in another's hull)")
@@ -565,7 +586,7 @@ def _separate(mesh: Mesh, seg: Segmentation, hulls: list[_Polytope], methods: tu
 
 def _facets(poly: _Polytope) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """`facet_mesh` of a polytope plus the area on each of its planes (K,)."""
-    verts, faces, facet, plane = facet_mesh(poly.vertices, poly.tri, poly.planes)
+    verts, faces, facet, plane = facet_mesh(poly.vertices, poly.tri, poly.equations, poly.planes)
     area = np.zeros(len(poly.planes))
     fa = face_areas(verts, faces)
     np.add.at(area, np.where(plane[facet] >= 0, plane[facet], 0), np.where(plane[facet] >= 0, fa, 0.0))
@@ -612,7 +633,7 @@ def _simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, m
     if not len(cand):
         return poly, 0.0
     inside = chebyshev_centre(poly.planes)[0]  # inside every superset: no LP per attempt
-    corners = len(facet_mesh(poly.vertices, poly.tri, poly.planes)[0])
+    corners = len(facet_mesh(poly.vertices, poly.tri, poly.equations, poly.planes)[0])
     keep = np.ones(len(poly.planes), dtype=bool)
     best = (poly, 0.0)
     for k in cand:
@@ -620,7 +641,7 @@ def _simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, m
         grown = _polytope(poly.planes[keep], poly.clip[keep], inside)
         ok = grown is not None
         if ok:
-            n_corners = len(facet_mesh(grown.vertices, grown.tri, grown.planes)[0])
+            n_corners = len(facet_mesh(grown.vertices, grown.tri, grown.equations, grown.planes)[0])
             growth = _growth(grown.vertices, poly) if n_corners < corners else np.inf
             ok = growth <= max_growth and all(_apart(grown, o) for o in others)
         if ok:
