@@ -662,7 +662,7 @@ def _from_corners(corners: np.ndarray, like: _Polytope) -> _Polytope:
     same = np.abs(eq[:, None, :] - like.planes[None, :, :]).max(axis=2) <= PLANE_MATCH  # (T, K)
     clip = np.where(same.any(axis=1), like.clip[np.argmax(same, axis=1)], -1)
     planes, clip = _dedupe(eq, clip)
-    return _Polytope(planes, clip, verts, tri, signed_volume(verts, tri))
+    return _Polytope(planes, clip, verts, tri, eq, signed_volume(verts, tri))
 
 
 def _uncrowded(poly: _Polytope, min_corner: float) -> tuple[_Polytope, float]:
