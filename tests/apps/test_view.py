@@ -602,3 +602,72 @@ def test_a_foreign_page_in_the_browser_gets_nothing(make_dir: Path, tmp_path: Pa
         foreign.shutdown()
         viewer.stop()
     assert sorted(p.name for p in make_dir.rglob("*")) == before  # nothing written
+
+
+# ----------------------------------------------------------------------------------------------
+# A convex approximation beside its original (issue 24)
+
+
+@pytest.fixture(scope="module")
+def hull_dir(models_dir: Path, tmp_path_factory) -> Path:
+    from polyfold.pipeline.make import make
+    from polyfold.pipeline.options import MakeOptions
+
+    out = tmp_path_factory.mktemp("view-hulls") / "bunny-128"
+    make(models_dir / "bunny-128.obj", out, MakeOptions(approximate="hulls", time_limit=30))
+    return out
+
+
+def test_the_viewer_shows_the_original_beside_the_approximation(hull_dir: Path, make_dir: Path) -> None:
+    viewer = serve(hull_dir, port=0)
+    try:
+        original = viewer.folder.original
+        assert original is not None and viewer._original_node is not None and viewer._original_node.visible
+        assert not viewer.original_checkbox.disabled and "convex approximation" in viewer._title.content
+        assert viewer.source is original  # inflation and "Run make" work on the original, not the parts
+        # left of the model, clear of it; the inflated copy further left, clear of the original
+        width = 2.0 * float(viewer._half[0])
+        left = viewer._original_offset()[0]
+        assert left <= -width and viewer._inflated_offset()[0] <= left - width
+        np.testing.assert_allclose(viewer._original_node.vertices, viewer._to_view(original.vertices), atol=1e-6)
+        viewer.original_checkbox.value = False
+        _until(lambda: not viewer._original_node.visible, 5, "the original hidden")
+    finally:
+        viewer.stop()
+    viewer = serve(make_dir, port=0)  # an ordinary folder: no original, the box greyed out
+    try:
+        assert viewer.folder.original is None and viewer._original_node is None and viewer.original_checkbox.disabled
+    finally:
+        viewer.stop()
+
+
+@needs_chromium
+def test_the_approximation_in_the_browser(hull_dir: Path) -> None:
+    """The page draws the original: hiding it changes the left of the picture. Set
+    POLYFOLD_HULLS_SCREENSHOT=path to save the page (docs/approximate/viewer.png)."""
+    from playwright.sync_api import sync_playwright
+
+    viewer = serve(hull_dir, port=0)
+    try:
+        viewer.show_inflated.value = False
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+            try:
+                page = browser.new_page(viewport={"width": 1280, "height": 800})
+                page.goto(viewer.url)
+                page.wait_for_selector("canvas", timeout=30000)
+                page.get_by_text(re.compile(r"convex approximation")).wait_for(timeout=30000)
+                canvas = page.locator("canvas").first
+                shown = _stable_shot(canvas)
+                shot = os.environ.get("POLYFOLD_HULLS_SCREENSHOT")
+                if shot:
+                    page.screenshot(path=shot)
+                page.get_by_text("Show original").click()
+                _until(lambda: not viewer._original_node.visible, 10, "the original hidden")
+                hidden = _stable_shot(canvas)
+                changed = (np.abs(shown - hidden).max(axis=2) > 30).mean()
+                assert changed > 0.005, f"only {changed:.2%} of the canvas changed hiding the original"
+            finally:
+                browser.close()
+    finally:
+        viewer.stop()
