@@ -661,6 +661,10 @@ def test_the_approximation_in_the_browser(hull_dir: Path) -> None:
                 shown = _stable_shot(canvas)
                 shot = os.environ.get("POLYFOLD_HULLS_SCREENSHOT")
                 if shot:
+                    close = page.locator("button.mantine-Notification-closeButton, .mantine-Notification-root button")
+                    if close.count():
+                        close.first.click()
+                    _stable_shot(canvas)
                     page.screenshot(path=shot)
                 page.get_by_text("Show original").click()
                 _until(lambda: not viewer._original_node.visible, 10, "the original hidden")
