@@ -86,7 +86,11 @@ vertices leave edges of a twentieth of a millimetre and slivers of faces; every 
 `min_corner` (x the diagonal) of the hull of the others is dropped, nearest first, which only
 shrinks a hull (parts stay apart). Corners on a cutting plane are not dropped that way: the two
 faces of a glued pair are first made one polygon, the common part of both sides' faces thinned in
-its plane (`match_glued_faces`), so the faces a builder glues together match exactly. fish-472's
+its plane (`match_glued_faces`), so the faces a builder glues together match exactly. Last, a
+side that comes to a needle point (a corner under NEEDLE_DEG) loses one of its other corners
+where that moves the surface little (`_without_needles`): the two sides beside a needle meet only
+at its point and come within a paper's thickness along it (star-24 found no folding path at
+0.2 mm). fish-472's
 body then has 122 triangles instead of 400, its shortest edge 2.4 % of the diagonal; `faces_after`
 and the errors are those of this result.
 
@@ -111,7 +115,7 @@ from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
 from .error import SAMPLES, chebyshev_centre, part_errors, signed_volume
 from .kernels import volume_beyond, volumes_beyond
-from .tidy import drop_crowded_corners, thin_polygon
+from .tidy import distance_to_hull_surface, drop_crowded_corners, thin_polygon
 
 # Dropping facets: x the hull's surface area, smaller facets go (when allowed); x the bbox diagonal, how
 # far that may grow a hull. Over seven shared models (bunny-128/348, horse, fish, sphere-deformed,
@@ -124,6 +128,8 @@ DEFAULT_MAX_GROWTH = 0.005
 # (no shorter edge, no narrower face; `tidy`): 2 mm at make's 150 mm
 DEFAULT_MIN_CORNER = 0.012
 MATCH_ROUNDS = 6  # rounds of matching glued faces (`match_glued_faces`)
+NEEDLE_DEG = 8.0  # a side with a corner this narrow is a needle (`_without_needles`)
+NEEDLE_MOVE = 4.0  # x min_corner: the most a corner dropped to remove a needle may move the surface
 PLANE_MATCH = 1e-6  # a facet of a tidied hull whose (n, d) is this close to a plane's lies on it
 MIN_KEEP = 0.05  # a cut leaves each hull at least this fraction of its unclipped volume
 # x the bbox diagonal: a part thinner than FLAT_WIDTH (flat up to the rounding of coplanar faces in
@@ -676,6 +682,41 @@ def _uncrowded(poly: _Polytope, min_corner: float) -> tuple[_Polytope, float]:
     return _from_corners(corners, poly), lost
 
 
+def _without_needles(poly: _Polytope, min_corner: float) -> tuple[_Polytope, float]:
+    """(poly without sides that come to a needle point, how far that moved its surface): a side
+    whose corner is narrower than NEEDLE_DEG lets the two sides beside it, which meet only at that
+    corner, come within a paper's thickness of each other along it (star-24's part of 22 faces:
+    a 4-degree side, no folding path at 0.2 mm). One of the needle side's other corners goes,
+    the one nearest the hull of the rest, when that is within NEEDLE_MOVE x min_corner and it is
+    on no cutting plane (a glued face stays as it is); dropping corners only shrinks the hull."""
+    from ..mesh.geometry import corner_angles
+
+    moved = 0.0
+    while True:
+        verts, faces, facet, _ = _facets(poly)
+        angle = corner_angles(verts, faces)  # (F, 3), summed per facet and corner below
+        key = facet[:, None] * len(verts) + faces
+        keys, inverse = np.unique(key.ravel(), return_inverse=True)
+        total = np.zeros(len(keys))
+        np.add.at(total, inverse, angle.ravel())
+        needle = keys[total < math.radians(NEEDLE_DEG)]
+        cutting = poly.planes[poly.clip >= 0]
+        pinned = (np.abs(verts @ cutting[:, :3].T + cutting[:, 3]) <= ON_PLANE).any(axis=1)
+        best = None
+        for k in needle:
+            side, apex = divmod(int(k), len(verts))
+            for c in np.unique(faces[facet == side]):
+                if c == apex or pinned[c]:
+                    continue
+                d = distance_to_hull_surface(verts[c], np.delete(verts, c, axis=0))
+                if d <= NEEDLE_MOVE * min_corner and (best is None or d < best[0]):
+                    best = (d, c)
+        if best is None:
+            return poly, moved
+        moved = max(moved, best[0])
+        poly = _from_corners(np.delete(verts, best[1], axis=0), poly)
+
+
 def _plane_basis(normal: np.ndarray) -> np.ndarray:
     """(2, 3): two unit vectors spanning the plane of `normal`."""
     u = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
@@ -762,7 +803,8 @@ def hull_meshes(mesh: Mesh, seg: Segmentation, *, min_facet: float = DEFAULT_MIN
         hulls = match_glued_faces(hulls, cuts, min_corner)
         for p in range(len(hulls)):
             hulls[p], shrunk = _uncrowded(hulls[p], min_corner)
-            growth[p] = max(growth[p], shrunk)
+            hulls[p], sharp = _without_needles(hulls[p], min_corner)
+            growth[p] = max(growth[p], shrunk, sharp)
     meshes, facets = [], []
     for h in hulls:
         verts, faces, facet, _ = _facets(h)
