@@ -130,3 +130,14 @@ def test_joined_keeps_the_parts_apart():
         from polyfold.pipeline.options import check_options
 
         check_options(MakeOptions(approximate="spheres"))
+
+
+def test_a_star_of_needle_points_folds(models_dir, tmp_path):
+    """star-24's convex parts had sides coming to a 4-degree point: the sides beside it met only
+    at the point and came within the 0.2 mm paper's thickness along it, so two pieces found no
+    folding path. Needle points go (`hulls._without_needles`): every piece folds."""
+    rep = make(models_dir / "star-24.obj", tmp_path / "star", MakeOptions(approximate="hulls", time_limit=60.0)).report
+    assert rep.checks.paths_verified == len(rep.pieces) and all(p.path_verified for p in rep.pieces)
+    for row in rep.pieces:
+        if row.faces > 1:
+            assert check_path(tmp_path / "star" / row.fold_file).ok
