@@ -160,6 +160,16 @@ def _stable_shot(locator, timeout: float = 15.0) -> np.ndarray:
     return prev
 
 
+def _changed_by_click(page, canvas, text: str, done, what: str) -> float:
+    """The fraction of the canvas that changes when the control showing `text` is clicked (once
+    done() says the viewer took it, and the rendering settled)."""
+    before = _stable_shot(canvas)
+    page.get_by_text(text).click()
+    _until(done, 10, what)
+    after = _stable_shot(canvas)
+    return float((np.abs(before - after).max(axis=2) > 30).mean())
+
+
 def _slider(page, label: str):
     """The thumb of the viser slider labelled `label` (the element a user drags / keys)."""
     target = page.locator("label", has_text=re.compile(rf"^{re.escape(label)}$")).get_attribute("for")
@@ -492,11 +502,8 @@ def test_the_texture_in_the_browser(look_dirs: dict[str, Path]) -> None:
                 page.goto(viewer.url)
                 page.wait_for_selector("canvas", timeout=30000)
                 canvas = page.locator("canvas").first
-                textured = _stable_shot(canvas)
-                page.get_by_text("Model's colours").click()
-                _until(lambda: viewer.look_checkbox.value is False, 10, "the box to be unticked")
-                plain = _stable_shot(canvas)
-                changed = (np.abs(textured - plain).max(axis=2) > 30).mean()
+                changed = _changed_by_click(page, canvas, "Model's colours", lambda: viewer.look_checkbox.value is False,
+                                            "the box to be unticked")
                 assert changed > 0.002, f"only {changed:.2%} of the canvas changed with the model's colours"
             finally:
                 browser.close()
@@ -658,7 +665,6 @@ def test_the_approximation_in_the_browser(hull_dir: Path) -> None:
                 page.wait_for_selector("canvas", timeout=30000)
                 page.get_by_text(re.compile(r"convex approximation")).wait_for(timeout=30000)
                 canvas = page.locator("canvas").first
-                shown = _stable_shot(canvas)
                 shot = os.environ.get("POLYFOLD_HULLS_SCREENSHOT")
                 if shot:
                     close = page.locator("button.mantine-Notification-closeButton, .mantine-Notification-root button")
@@ -666,10 +672,8 @@ def test_the_approximation_in_the_browser(hull_dir: Path) -> None:
                         close.first.click()
                     _stable_shot(canvas)
                     page.screenshot(path=shot)
-                page.get_by_text("Show original").click()
-                _until(lambda: not viewer._original_node.visible, 10, "the original hidden")
-                hidden = _stable_shot(canvas)
-                changed = (np.abs(shown - hidden).max(axis=2) > 30).mean()
+                changed = _changed_by_click(page, canvas, "Show original", lambda: not viewer._original_node.visible,
+                                            "the original hidden")
                 assert changed > 0.005, f"only {changed:.2%} of the canvas changed hiding the original"
             finally:
                 browser.close()

@@ -717,7 +717,7 @@ def _without_needles(poly: _Polytope, min_corner: float) -> tuple[_Polytope, flo
         poly = _from_corners(np.delete(verts, best[1], axis=0), poly)
 
 
-def _plane_basis(normal: np.ndarray) -> np.ndarray:
+def plane_basis(normal: np.ndarray) -> np.ndarray:
     """(2, 3): two unit vectors spanning the plane of `normal`."""
     u = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
     u /= np.linalg.norm(u)
@@ -756,7 +756,7 @@ def _match_once(hulls: list[_Polytope], cuts: list, min_corner: float) -> tuple[
         on = [np.abs(hulls[p].vertices @ normal - offset) <= ON_PLANE for p in (i, j)]
         if min(o.sum() for o in on) < 3:
             continue
-        basis = _plane_basis(normal)
+        basis = plane_basis(normal)
         flat = [Polygon(hulls[p].vertices[o] @ basis.T).convex_hull for p, o in zip((i, j), on)]
         common = flat[0].intersection(flat[1])
         glued = isinstance(common, Polygon) and common.area > min_corner ** 2

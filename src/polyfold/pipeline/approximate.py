@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 
 from ..approximate.error import lp_overlap_depths
-from ..approximate.hulls import approximate_hulls
+from ..approximate.hulls import approximate_hulls, plane_basis
 from ..deadline import Deadline
 from ..errors import PolyfoldError
 from ..mesh.mesh import Mesh
@@ -45,31 +45,29 @@ def joined(meshes: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
 
 
 def contact_areas(meshes: tuple[Mesh, ...] | list[Mesh], diag: float) -> list[tuple[int, int, float]]:
-    """(i, j, area) for every pair of meshes with flat sides on one plane, facing each other, that
-    overlap with positive area (model units squared): where part i is glued onto part j."""
+    """(i, j, area) for every pair of meshes with flat sides (faces of one face_source) on one
+    plane, facing each other, that overlap with positive area (model units squared): where part i
+    is glued onto part j. Candidate pairs of sides by their planes (numpy), areas by shapely."""
     from shapely import Polygon, unary_union
 
-    sides = []  # per mesh: (normal, offset, triangles) of every facet
-    for m in meshes:
-        n = m.face_normals
-        for s in np.unique(m.face_source):
-            tri = m.vertices[m.faces[m.face_source == s]]
-            normal = n[m.face_source == s][0]
-            sides.append((len(sides), normal, float(normal @ tri[0, 0]), tri))
-    owner = np.repeat(np.arange(len(meshes)), [len(np.unique(m.face_source)) for m in meshes])
+    owner, normal, offset, tris = [], [], [], []
+    for k, m in enumerate(meshes):
+        src, first = np.unique(m.face_source, return_index=True)
+        n = m.face_normals[first]
+        owner.append(np.full(len(src), k))
+        normal.append(n)
+        offset.append(np.einsum("ij,ij->i", n, m.vertices[m.faces[first, 0]]))
+        tris += [m.vertices[m.faces[m.face_source == s]] for s in src]
+    owner, normal, offset = np.concatenate(owner), np.concatenate(normal), np.concatenate(offset)
+    facing = (normal @ normal.T < -CONTACT_COS) & (np.abs(offset[:, None] + offset[None, :]) <= CONTACT_DIST * diag)
     found: dict[tuple[int, int], float] = {}
-    for a, na, da, ta in sides:
-        for b, nb, db, tb in sides:
-            i, j = int(owner[a]), int(owner[b])
-            if i >= j or na @ nb > -CONTACT_COS or abs(da + db) > CONTACT_DIST * diag:
-                continue
-            u = np.cross(na, [1.0, 0.0, 0.0] if abs(na[0]) < 0.9 else [0.0, 1.0, 0.0])
-            u /= np.linalg.norm(u)
-            v = np.cross(na, u)
-            flat = [unary_union([Polygon(t @ np.stack([u, v], axis=1)) for t in tris]) for tris in (ta, tb)]
-            area = float(flat[0].intersection(flat[1]).area)
-            if area > 0.0:
-                found[(i, j)] = found.get((i, j), 0.0) + area
+    for a, b in np.argwhere(facing & (owner[:, None] < owner[None, :])):
+        basis = plane_basis(normal[a])
+        flat = [unary_union([Polygon(t @ basis.T) for t in tris[x]]) for x in (a, b)]
+        area = float(flat[0].intersection(flat[1]).area)
+        if area > 0.0:
+            key = (int(owner[a]), int(owner[b]))
+            found[key] = found.get(key, 0.0) + area
     return [(i, j, a) for (i, j), a in sorted(found.items())]
 
 
