@@ -9,6 +9,7 @@ faces from the part files' geometry."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -83,6 +84,19 @@ def test_every_part_unfolds_whole_folds_and_glues(hull_folders, name):
     intro = (folder / "instructions.html").read_text()
     i, j, _ = contacts[0]
     assert f"Glue part {i + 1} (piece" in intro and f"to part {j + 1} (piece" in intro
+    # every glued side is marked with the piece it goes onto, both ways (but those too small)
+    notes = {}
+    for svg in folder.glob("sheet-*.svg"):
+        for kind, text in read_sheet(svg)["labels"]:
+            note = re.fullmatch(r"(?:glue )?to ([A-Z]+)", text or "")  # ("to X" where the long one has no room)
+            if note:
+                notes[note.group(1)] = notes.get(note.group(1), 0) + 1
+    part_of = {row["piece"]: row["part"] for row in report["pieces"]}
+    assert notes and all(name in part_of for name in notes)
+    assert sum(notes.values()) == 2 * len(contacts) - report["stages"]["approximate"]["unmarked_sides"]
+    scale = report["stages"]["layout"]["scale_mm_per_unit"]
+    big = sum(area * scale ** 2 >= 100.0 for _, _, area in contacts)  # 1 cm2 or more on paper
+    assert big >= 1 and sum(notes.values()) >= 2 * big
 
 
 def test_glued_faces_are_measured_from_the_part_files(hull_folders, models_dir):

@@ -89,7 +89,7 @@ def text_box(center: np.ndarray, u: np.ndarray, text: str, size: float) -> np.nd
                      center - hw * u + hh * n])
 
 
-def _inside_triangle(tri: np.ndarray, pts: np.ndarray, pad: float) -> bool:
+def inside_triangle(tri: np.ndarray, pts: np.ndarray, pad: float) -> bool:
     """All points inside triangle `tri` (either orientation), at least `pad` from its sides."""
     a, b, c = tri
     area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
@@ -497,7 +497,7 @@ class PieceLabels:
             size = min(PIECE_FONT_MAX_MM, max(self.size, 1.2 * r[f] / max(text_width(text, 1.0), CAP_HEIGHT)))
             while size >= self.size - 1e-9:
                 box = text_box(center, u, text, size)
-                if _inside_triangle(faces_xy[f], box, LABEL_PAD_MM):
+                if inside_triangle(faces_xy[f], box, LABEL_PAD_MM):
                     self._put(text, center, u, size, "piece-label", box)
                     return
                 size *= 0.9
@@ -573,7 +573,7 @@ class PieceLabels:
         inside = [side.p0 + t * d - n_out * (1.2 * LABEL_PAD_MM + h / 2) for t in ts] + [_incentre(side.tri)]
         for center in inside:  # 1. inside the face
             box = text_box(center, u, text, s)
-            if _inside_triangle(side.tri, box, LABEL_PAD_MM) and not self._hits(box):
+            if inside_triangle(side.tri, box, LABEL_PAD_MM) and not self._hits(box):
                 self._put(text, center, u, s, "edge-label", box)
                 return True
         if self._on_tab(text, u, tab_parts, tab_folds, n_out, h):
@@ -685,7 +685,7 @@ class PieceLabels:
         if self._hits(box):
             return False
         poly = Polygon(box)
-        in_face = any(_inside_triangle(np.asarray(self.room.faces[f].exterior.coords)[:3], box, LABEL_PAD_MM)
+        in_face = any(inside_triangle(np.asarray(self.room.faces[f].exterior.coords)[:3], box, LABEL_PAD_MM)
                       for f in self.room.tree.query(poly))
         if not in_face and (not self.allowed.contains(poly) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
             return False

@@ -18,8 +18,8 @@ from ..deadline import Deadline
 from ..mesh.geometry import FLAT_EPS, merged_edges  # flat creases are not scored, as in the FOLD files
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
-from .labels import LabelStats, PieceLabels, label_font, piece_name, text_width
-from .page import TextItem
+from .labels import LABEL_PAD_MM, LabelStats, PieceLabels, label_font, piece_name, text_box, text_width
+from .page import TextItem, upright
 from .paper import MIN_LABEL_MM
 from .tabs import CutSide, Room, Tab, choose_tab, full_depth
 
@@ -378,6 +378,66 @@ def glue_strip(label: str, length: float, rho: float, part: int, size: float) ->
                       body=body, outline=body, mountain=line if rho < 0 else none, valley=line if rho >= 0 else none,
                       slits=none, tabs=(), tab_folds=none, texts=texts, tab_mountain=np.zeros(0, dtype=bool),
                       footprint=body, leaders=none)
+
+
+def with_side_notes(pieces: list[SheetPiece], glued_to: np.ndarray, min_label_mm: float = MIN_LABEL_MM
+                    ) -> tuple[list[SheetPiece], int]:
+    """(the pieces with "glue to X" printed on every face that is glued flat onto another piece's
+    face, how many sides found no place for it): glued_to (F,) whole-mesh face -> a face of the side
+    it is glued onto, -1 for none (`make --approximate hulls`: the sides where two convex parts
+    touch). A note goes at the point of its side farthest from the side's edges (shapely's
+    polylabel), along the side's long axis or across the page, as "glue to X" or "to X", at 1.5 x the
+    glue labels' size down to their size, clear of the piece's other texts."""
+    from shapely import Polygon, union_all
+
+    piece_of = {int(f): k for k, p in enumerate(pieces) for f in p.face_ids}
+    size = 1.5 * label_font(min_label_mm)
+    out, missed = [], 0
+    for p in pieces:
+        sides: dict[str, list[int]] = {}
+        for local, f in enumerate(p.face_ids):
+            other = int(glued_to[f]) if 0 <= f < len(glued_to) else -1
+            if other >= 0 and other in piece_of:
+                sides.setdefault(pieces[piece_of[other]].name, []).append(local)
+        texts = list(p.texts)
+        for name, local in sides.items():
+            taken = [Polygon(text_box(np.array([t.x, t.y]), np.array([math.cos(math.radians(t.angle)),
+                                                                       -math.sin(math.radians(t.angle))]),
+                                      t.text, t.size)) for t in texts]
+            side = union_all([Polygon(t) for t in p.faces_xy[local]], grid_size=1e-6)
+            spot = _note_spot(side, name, size, label_font(min_label_mm), taken)
+            if spot is None:
+                missed += 1
+                continue
+            texts.append(spot)
+        out.append(replace(p, texts=tuple(texts)) if len(texts) > len(p.texts) else p)
+    return out, missed
+
+
+def _note_spot(side, name: str, size: float, smallest: float, taken: list) -> TextItem | None:
+    """The note of a glued side (a shapely polygon, mm) naming piece `name`: see `with_side_notes`;
+    None when it fits nowhere."""
+    from shapely import Polygon
+    from shapely.ops import polylabel
+
+    if side.geom_type != "Polygon" or side.area <= 0:
+        return None
+    inner = side.buffer(-LABEL_PAD_MM)
+    centre = np.asarray(polylabel(side, tolerance=0.05).coords[0])
+    box = np.asarray(side.minimum_rotated_rectangle.exterior.coords)[:4]
+    edges = np.diff(np.vstack([box, box[:1]]), axis=0)
+    long = edges[np.argmax(np.linalg.norm(edges, axis=1))]
+    along = long / max(float(np.linalg.norm(long)), 1e-12)
+    for text in (f"glue to {name}", f"to {name}"):
+        for u in (along, np.array([1.0, 0.0])):
+            s = size
+            while s >= smallest - 1e-9:
+                glyphs = Polygon(text_box(centre, u, text, s))
+                if inner.contains(glyphs) and not any(glyphs.intersects(t) for t in taken):
+                    angle = upright(math.degrees(math.atan2(-u[1], u[0])))  # (the box is the same either way)
+                    return TextItem(text, float(centre[0]), float(centre[1]), angle, s, "edge-label")
+                s *= 0.9
+    return None
 
 
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,

@@ -44,31 +44,55 @@ def joined(meshes: tuple[Mesh, ...] | list[Mesh]) -> Mesh:
                 np.concatenate([m.face_source + o for m, o in zip(meshes, src_offsets)]))
 
 
-def contact_areas(meshes: tuple[Mesh, ...] | list[Mesh], diag: float) -> list[tuple[int, int, float]]:
-    """(i, j, area) for every pair of meshes with flat sides (faces of one face_source) on one
-    plane, facing each other, that overlap with positive area (model units squared): where part i
-    is glued onto part j. Candidate pairs of sides by their planes (numpy), areas by shapely."""
+def glued_sides(meshes: tuple[Mesh, ...] | list[Mesh], diag: float) -> list[tuple[int, int, int, int, float]]:
+    """(i, side of i, j, side of j, area) for every two flat sides (faces of one face_source) of
+    meshes i < j on one plane, facing each other, that overlap with positive area (model units
+    squared): where part i is glued onto part j. Candidates by their planes (numpy), areas by
+    shapely."""
     from shapely import Polygon, unary_union
 
-    owner, normal, offset, tris = [], [], [], []
+    owner, source, normal, offset, tris = [], [], [], [], []
     for k, m in enumerate(meshes):
         src, first = np.unique(m.face_source, return_index=True)
         n = m.face_normals[first]
         owner.append(np.full(len(src), k))
+        source.append(src)
         normal.append(n)
         offset.append(np.einsum("ij,ij->i", n, m.vertices[m.faces[first, 0]]))
         tris += [m.vertices[m.faces[m.face_source == s]] for s in src]
-    owner, normal, offset = np.concatenate(owner), np.concatenate(normal), np.concatenate(offset)
+    owner, source = np.concatenate(owner), np.concatenate(source)
+    normal, offset = np.concatenate(normal), np.concatenate(offset)
     facing = (normal @ normal.T < -CONTACT_COS) & (np.abs(offset[:, None] + offset[None, :]) <= CONTACT_DIST * diag)
-    found: dict[tuple[int, int], float] = {}
+    out = []
     for a, b in np.argwhere(facing & (owner[:, None] < owner[None, :])):
         basis = plane_basis(normal[a])
         flat = [unary_union([Polygon(t @ basis.T) for t in tris[x]]) for x in (a, b)]
         area = float(flat[0].intersection(flat[1]).area)
         if area > 0.0:
-            key = (int(owner[a]), int(owner[b]))
-            found[key] = found.get(key, 0.0) + area
+            out.append((int(owner[a]), int(source[a]), int(owner[b]), int(source[b]), area))
+    return out
+
+
+def contact_areas(meshes: tuple[Mesh, ...] | list[Mesh], diag: float, sides: list | None = None
+                  ) -> list[tuple[int, int, float]]:
+    """(i, j, area) for every pair of meshes glued together (`glued_sides`, or the given ones,
+    summed per pair)."""
+    found: dict[tuple[int, int], float] = {}
+    for i, _, j, _, area in glued_sides(meshes, diag) if sides is None else sides:
+        found[(i, j)] = found.get((i, j), 0.0) + area
     return [(i, j, a) for (i, j), a in sorted(found.items())]
+
+
+def glued_faces(meshes: tuple[Mesh, ...] | list[Mesh], sides: list) -> np.ndarray:
+    """(F,) for every face of `joined(meshes)`: a face of the side it is glued onto (sides: of
+    `glued_sides`), -1 for none (the sheets print "glue to X" there, `pieces.with_side_notes`)."""
+    start = np.cumsum([0] + [m.n_faces for m in meshes])
+    out = np.full(int(start[-1]), -1, dtype=np.int64)
+    for i, si, j, sj, _ in sides:
+        fi = start[i] + np.flatnonzero(meshes[i].face_source == si)
+        fj = start[j] + np.flatnonzero(meshes[j].face_source == sj)
+        out[fi], out[fj] = fj[0], fi[0]
+    return out
 
 
 def contacts_of_parts(report: ApproximateReport, part_faces: list[np.ndarray]) -> tuple[tuple[int, int], ...]:
@@ -82,9 +106,10 @@ def contacts_of_parts(report: ApproximateReport, part_faces: list[np.ndarray]) -
 
 
 def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None]
-                     ) -> tuple[Mesh, SegmentReport, ApproximateReport]:
-    """(the approximated model, the segmentation's report, the approximation's) of `mesh` under
-    `--approximate hulls` (`--tau` / `--parts` as for make's segmentation; default tau)."""
+                     ) -> tuple[Mesh, SegmentReport, ApproximateReport, np.ndarray]:
+    """(the approximated model, the segmentation's report, the approximation's, `glued_faces` of
+    the model) of `mesh` under `--approximate hulls` (`--tau` / `--parts` as for make's
+    segmentation; default tau)."""
     ts = time.perf_counter()
     mode = "parts" if opts.parts is not None else "tau"
     say("segment", f"segmenting into nearly convex parts ({mode})")
@@ -104,7 +129,8 @@ def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Cal
         raise PolyfoldError(f"the convex parts {i} and {j} overlap (by {depth[i - 1, j - 1] / diag:.2g} of the "
                             f"diagonal, independent check): try another --tau or --parts")
     overlapping = len(pairs)
-    contacts = contact_areas(approx.parts, diag)
+    sides = glued_sides(approx.parts, diag)
+    contacts = contact_areas(approx.parts, diag, sides)
     report = ApproximateReport(
         mode="hulls", parts=approx.n_parts, faces_before=tuple(int(x) for x in approx.faces_before),
         faces_after=tuple(int(x) for x in approx.faces_after), facets=tuple(int(x) for x in approx.facets),
@@ -114,4 +140,4 @@ def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Cal
         volume_ratio=None if math.isnan(approx.volume_ratio) else round(float(approx.volume_ratio), 6),
         clip_planes=len(approx.planes), overlapping_pairs=overlapping,
         contacts=tuple((i, j, round(a, 9)) for i, j, a in contacts), seconds=time.perf_counter() - ta)
-    return joined(approx.parts), seg_report, report
+    return joined(approx.parts), seg_report, report, glued_faces(approx.parts, sides)

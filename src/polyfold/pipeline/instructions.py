@@ -73,9 +73,9 @@ def _approximation_intro(n_parts: int, pieces, contacts: tuple[tuple[int, int], 
         return f"part {k + 1} (piece{'s' if len(names.get(k, ())) > 1 else ''} {', '.join(names.get(k, ['?']))})"
 
     text = (f"The model is approximated by {n_parts} convex solids, each a closed part of its own: build every part "
-            "(its steps below), then glue the parts together where they touch, flat side on flat side (the "
-            "largest sides of a part are usually where it meets another; the pictures of where each piece goes "
-            "show the model assembled).")
+            "(its steps below), then glue the parts together where they touch, flat side on flat side: each such "
+            "side is printed \"glue to X\", X the piece whose side it goes onto (a side too small for the words "
+            "is not; the pictures of where each piece goes show the model assembled).")
     if contacts:
         text += " Glue " + "; ".join(f"{part(i)} to {part(j)}" for i, j in contacts) + "."
     return text

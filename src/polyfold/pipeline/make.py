@@ -205,12 +205,12 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
     searches, optional = hard.before(layout_s), hard.before(tail_s)
     mesh, inflate_report = _inflate(mesh, opts, say)
-    approximate_report, original, contacts = None, None, ()
+    approximate_report, original, contacts, glued_to = None, None, (), None
     if opts.approximate == "hulls":
         from .approximate import approximate_mesh, contacts_of_parts
 
         original = mesh
-        mesh, segment_report, approximate_report = approximate_mesh(mesh, opts, searches, say)
+        mesh, segment_report, approximate_report, glued_to = approximate_mesh(mesh, opts, searches, say)
         look = None  # the polyhedra's sides are not the model's faces: nothing to print on them
         # every polyhedron is a component of its own, unfolded whole (convex: one piece)
         parts, _, unfold_report = make_parts(mesh, replace(opts, tau=None, parts=None, segment="auto"), searches,
@@ -235,8 +235,10 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     fitted = split.parts
     fit_seconds = time.perf_counter() - ts
     folded, fold_report = fold_pieces(fitted, opts, searches, say, scale, hard=hard)
-    sheets = lay_out(mesh, folded, scale, opts, width, height, hard, say, planned=split)
+    sheets = lay_out(mesh, folded, scale, opts, width, height, hard, say, planned=split, glued_to=glued_to)
     checks = _check(sheets, opts, name, fold_report.verified, say)
+    if approximate_report is not None:
+        approximate_report = replace(approximate_report, unmarked_sides=sheets.unnoted_sides)
     layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)
     te = time.perf_counter()
     say("export", "writing sheets and files" + (" and the assembly guide" if opts.guide else ""))

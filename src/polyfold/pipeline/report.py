@@ -86,7 +86,8 @@ class ApproximateReport:
     the model's volume, all parts). clip_planes: planes that cut overlapping hulls apart;
     overlapping_pairs: pairs of parts the independent check (an LP per pair) found overlapping
     (0: interior-disjoint); contacts: (part i, part j, area in model units squared) of the sides
-    where two parts touch, to glue them together."""
+    where two parts touch, to glue them together (each side marked "glue to X" on the sheets, X
+    the other side's piece, but `unmarked_sides`, too small to hold the note)."""
 
     mode: str
     parts: int
@@ -101,6 +102,7 @@ class ApproximateReport:
     overlapping_pairs: int
     contacts: tuple[tuple[int, int, float], ...]
     seconds: float
+    unmarked_sides: int = 0  # glued sides too small for their "glue to X" note on the sheets
 
 
 @dataclass(frozen=True)

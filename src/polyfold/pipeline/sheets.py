@@ -29,7 +29,8 @@ from ..fabricate.fit import PieceTooLarge, split_to_fit
 from ..fabricate.pack import ORDER_TRIES, Packing, pack_outlines
 from ..fabricate.page import place
 from ..fabricate.paper import FOOTER_MM, GAP_MM, MARK_CLEAR_MM
-from ..fabricate.pieces import GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input
+from ..fabricate.pieces import (GlueEdge, LayoutStats, PieceInput, SheetPiece, build_sheet_pieces, piece_input,
+                                with_side_notes)
 from ..fabricate.split import PagePlan, plan_label_cuts, plan_pages
 from ..mesh.mesh import Mesh
 from ..unfold.net import cut_creases, piece_net
@@ -325,6 +326,7 @@ class Sheets:
     height: float
     seconds: float
     scale: float
+    unnoted_sides: int = 0  # glued sides (`glued_to`) with no room for their "glue to X" note
 
     def page_of_piece(self) -> list[int]:
         """0-based page of every piece."""
@@ -337,10 +339,13 @@ def piece_inputs(mesh: Mesh, folded: list[FoldedPiece]) -> list[PieceInput]:
 
 
 def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptions, width: float, height: float,
-            deadline: Deadline, say: Callable[[str, str], None], planned: PageSplit | None = None) -> Sheets:
+            deadline: Deadline, say: Callable[[str, str], None], planned: PageSplit | None = None,
+            glued_to: np.ndarray | None = None) -> Sheets:
     """Tabs and labels for every piece, then the pieces packed onto as few pages as possible. With
     the `planned` split, its packing order goes first; when folding split no piece, the pieces it
-    drew are the ones laid out and its order, the best of those tried on them, the only one tried."""
+    drew are the ones laid out and its order, the best of those tried on them, the only one tried.
+    glued_to: faces glued flat onto other pieces' faces (`pieces.with_side_notes`; a convex
+    approximation's touching sides)."""
     tl = time.perf_counter()
     same = planned is not None and planned.same_pieces(folded)
     if same:  # drawn before folding: the same inputs draw the same pieces
@@ -349,6 +354,9 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
         say("layout", f"tabs and labels for {len(folded)} pieces")
         pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
                                                  min_label_mm=opts.min_label_mm, deadline=deadline)
+    unnoted = 0
+    if glued_to is not None:
+        pieces, unnoted = with_side_notes(list(pieces), glued_to, opts.min_label_mm)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
     page, margin = _packer_page(pack_box(width, height, opts))
     hint = None if planned is None else planned.hint(folded, len(pieces))
@@ -356,4 +364,4 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                             time_limit=pack_budget(deadline), hint=hint, tries=tries)
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
-    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl, scale)
+    return Sheets(placed, tuple(glue), stats, packing, width, height, time.perf_counter() - tl, scale, unnoted)

@@ -107,7 +107,10 @@ def make(
         approx = rep.stages.approximate
         if approx is not None:
             glue = "; glue them face to face where they touch: " + ", ".join(
-                f"{i + 1}-{j + 1}" for i, j, _ in approx.contacts) if approx.contacts else ""
+                f"{i + 1}-{j + 1}" for i, j, _ in approx.contacts) + (
+                " (each side marked \"glue to\" its piece on the sheets" + (
+                    f", but {approx.unmarked_sides} too small for the note)" if approx.unmarked_sides else ")")
+            ) if approx.contacts else ""
             say(f"convex approximation: {approx.parts} polyhedra of {min(approx.facets)}-{max(approx.facets)} sides, "
                 f"none overlapping (independent check), {approx.clip_planes} cut apart; error (Hausdorff) up to "
                 f"{approx.hausdorff_max:.1%} of the model's diagonal"
