@@ -732,8 +732,6 @@ def match_glued_faces(hulls: list[_Polytope], cuts: list, min_corner: float) -> 
     it was (the polygon lies in both faces), so the parts stay apart. Pairs whose faces do not
     overlap (one hull only touches the plane), or share less than a square of min_corner, get
     their own faces thinned, each side alone."""
-    from shapely import Polygon
-
     # a hull's faces on two cutting planes share an edge: matching the second moves that edge
     # of the first, so the matching runs again until every glued face is matched (two rounds on
     # the shared models; MATCH_ROUNDS at most)

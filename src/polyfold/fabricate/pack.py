@@ -30,7 +30,6 @@ candidate outlines before they commit to one (`split.plan_pages` splits pieces t
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -656,7 +655,6 @@ def pack_outlines(
     packing; a seed other than 0 turns the tried rotations by a random phase. After `time_limit`
     seconds no further order is tried and the remaining pieces of the one being filled are
     shelf-packed onto new pages (`Packing.ran_out`)."""
-    t0 = time.perf_counter()
     W, H = float(page_size[0]), float(page_size[1])
     pw, ph = W - 2 * margin, H - 2 * margin
     geoms = [_polygonal(g, i) for i, g in enumerate(outlines)]
