@@ -155,3 +155,20 @@ def test_a_star_of_needle_points_folds(models_dir, tmp_path):
     for row in rep.pieces:
         if row.faces > 1:
             assert check_path(tmp_path / "star" / row.fold_file).ok
+
+
+def test_every_flat_side_is_one_polygon_of_its_net(hull_folders):
+    """A side of a convex part (several triangles in one plane) is never cut through in its net:
+    it is one polygon on paper, scored nowhere inside (issue 11's flat regions)."""
+    from conftest import assert_flat_regions_whole
+    from polyfold.mesh.geometry import merged_edges
+    from polyfold.unfold.search import unfold
+
+    folder, report = hull_folders["horse-302"]
+    polygons = 0
+    for k in range(report["stages"]["approximate"]["parts"]):
+        part = read_mesh_as_is(folder / f"part-{k}.obj")
+        net, _ = unfold(part, seed=1, time_limit=10.0, max_pieces=1)
+        assert_flat_regions_whole(net)
+        polygons += int(merged_edges(part).sum())
+    assert polygons > 0  # (sides of more than one triangle exist: the check had work to do)
