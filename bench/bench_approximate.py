@@ -28,6 +28,7 @@ import numpy as np
 from polyfold.formats.meshes import load_mesh, read_mesh_as_is
 from polyfold.formats.png import write_mesh_png
 from polyfold.formats.raster import part_colors
+from polyfold.pipeline.approximate import joined
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions
 from polyfold.segment.segment import DEFAULT_TAU, segment
@@ -65,15 +66,11 @@ def pictures(name: str, folder: Path, tau: float | None, png_dir: Path) -> None:
     colors = part_colors(seg.n_parts)
     write_mesh_png(png_dir / f"{name}-model.png", mesh.vertices, mesh.faces, colors[seg.labels], width=600, height=450)
     parts = [read_mesh_as_is(folder / f"part-{k}.obj") for k in range(seg.n_parts)]
-    offsets = [0]
-    for p in parts:
-        offsets.append(offsets[-1] + p.n_vertices)
-    v = np.concatenate([p.vertices for p in parts])
-    f = np.concatenate([p.faces + o for p, o in zip(parts, offsets)])
-    c = np.concatenate([np.repeat(colors[k][None], p.n_faces, axis=0) for k, p in enumerate(parts)])
+    model = joined(parts)
+    c = colors[np.repeat(np.arange(len(parts)), [p.n_faces for p in parts])]
     # the same view as the model: the model's own middle axis up (the hulls' extents differ a little)
     up = int(np.argsort(np.ptp(mesh.vertices, axis=0))[1])
-    write_mesh_png(png_dir / f"{name}-hulls.png", v, f, c, width=600, height=450, up_axis=up)
+    write_mesh_png(png_dir / f"{name}-hulls.png", model.vertices, model.faces, c, width=600, height=450, up_axis=up)
     if shutil.which("pdftoppm"):
         subprocess.run(["pdftoppm", "-png", "-r", "50", "-f", "1", "-l", "1", "-singlefile", str(folder / "sheets.pdf"),
                         str(png_dir / f"{name}-sheet-1")], check=True)

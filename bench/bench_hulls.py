@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from polyfold.approximate.error import overlap_volumes, signed_volume
+from polyfold.approximate.error import overlap_volumes
+from polyfold.mesh.geometry import signed_volume
 from polyfold.approximate.hulls import approximate_hulls, hull_meshes
 from polyfold.errors import PolyfoldError
 from polyfold.formats.meshes import load_mesh

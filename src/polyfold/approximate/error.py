@@ -16,18 +16,12 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import PolyfoldError
-from ..mesh.geometry import face_normals
+from ..mesh.geometry import face_normals, signed_volume
 from ..mesh.mesh import Mesh
 from ..mesh.simplify import farthest, surface_points
 
 SAMPLES = 4000  # area-weighted surface samples per part and direction (plus the vertices)
 LP_TOL = 1e-9  # x the bounding-box diagonal: an LP depth above this is an overlap
-
-
-def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
-    """Volume enclosed by closed triangles (F, 3) CCW seen from outside (negative when inward)."""
-    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
-    return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
 
 
 def hausdorff_one_sided(a: Mesh, b: Mesh, samples: int = SAMPLES, seed: int = 0) -> float:

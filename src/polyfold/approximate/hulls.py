@@ -109,11 +109,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import PolyfoldError
-from ..mesh.closest import closest_points
-from ..mesh.geometry import FLAT_REGION_RAD, face_areas
+from ..mesh.closest import surface_distances
+from ..mesh.geometry import FLAT_REGION_RAD, face_areas, signed_volume
 from ..mesh.mesh import Mesh
 from ..segment.segment import Segmentation
-from .error import SAMPLES, chebyshev_centre, part_errors, signed_volume
+from .error import SAMPLES, chebyshev_centre, part_errors
 from .kernels import volume_beyond, volumes_beyond
 from .tidy import distance_to_hull_surface, drop_crowded_corners, thin_polygon
 
@@ -615,15 +615,8 @@ def _droppable(poly: _Polytope, area: np.ndarray, min_facet: float) -> np.ndarra
 
 
 def _growth(points: np.ndarray, poly: _Polytope) -> float:
-    """The largest distance from points (N, 3) to the surface of poly: every triangle a candidate
-    of the one point-triangle primitive (`closest.closest_points`; a few dozen points, a few
-    hundred triangles)."""
-    tri = poly.corners
-    n = len(points)
-    face, bary = np.zeros(n, dtype=np.int64), np.zeros((n, 3))
-    cand = np.ascontiguousarray(np.broadcast_to(np.arange(len(tri)), (n, len(tri))))
-    closest_points(np.ascontiguousarray(points), np.zeros((n, 3)), cand, tri, np.zeros((len(tri), 3)), 0.0, face, bary)
-    return float(np.linalg.norm(np.einsum("nk,nkc->nc", bary, tri[face]) - points, axis=1).max(initial=0.0))
+    """The largest distance from points (N, 3) to the surface of poly (`closest.surface_distances`)."""
+    return float(surface_distances(points, poly.vertices, poly.tri).max(initial=0.0))
 
 
 def _simplify_hull(poly: _Polytope, others: list[_Polytope], min_facet: float, max_growth: float

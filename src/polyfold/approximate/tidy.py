@@ -25,24 +25,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh.closest import closest_points
+from ..mesh.closest import surface_distances
 
 
 def distance_to_hull_surface(point: np.ndarray, corners: np.ndarray) -> float:
-    """Distance from point (3,) to the surface of the convex hull of corners (M, 3): the nearest of
-    its qhull triangles (the one point-triangle primitive, `closest.closest_points`); inf when the
-    corners span no volume (without `point` there would be no polyhedron left)."""
+    """Distance from point (3,) to the surface of the convex hull of corners (M, 3) (its qhull
+    triangles, `closest.surface_distances`); inf when the corners span no volume (without `point`
+    there would be no polyhedron left)."""
     from scipy.spatial import ConvexHull, QhullError
 
     try:
-        tri = np.ascontiguousarray(corners[ConvexHull(corners).simplices])
+        simplices = ConvexHull(corners).simplices
     except (QhullError, ValueError):
         return np.inf
-    face, bary = np.zeros(1, dtype=np.int64), np.zeros((1, 3))
-    cand = np.arange(len(tri), dtype=np.int64)[None, :]
-    closest_points(np.ascontiguousarray(point[None, :], dtype=np.float64), np.zeros((1, 3)), cand, tri,
-                   np.zeros((len(tri), 3)), 0.0, face, bary)
-    return float(np.linalg.norm(bary[0] @ tri[face[0]] - point))
+    return float(surface_distances(point[None, :], corners, simplices)[0])
 
 
 def thin_polygon(ring: np.ndarray, min_dist: float) -> np.ndarray:

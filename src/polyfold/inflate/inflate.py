@@ -91,6 +91,7 @@ import numpy as np
 from ..collide.self_intersect import crossing_pairs
 from ..collide.tolerance import CONTACT_TOL
 from ..errors import PolyfoldError
+from ..mesh.geometry import signed_volume
 from ..mesh.mesh import Mesh
 from .kernels import AT_TARGET, COLLAPSED, FLIPPED, FOLDED_THROUGH, STALLED, run_steps, surface_geometry
 
@@ -292,11 +293,6 @@ class _Model:
                          *s.geometry, *s.scratch, s.out)
 
 
-def _signed_volume(X: np.ndarray, F: np.ndarray) -> float:
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
-
-
 class _Log:
     """What a run records: history rows (step, IF, HV, volume_change), snapshots in the input's
     frame at the wanted steps, the progress callback."""
@@ -308,12 +304,12 @@ class _Log:
         self.snapshots: dict[int, np.ndarray] = {}
         self.history: list[tuple[float, float, float, float]] = []
         self.progress = progress
-        self.v0 = _signed_volume(surface.P, surface.F)
+        self.v0 = signed_volume(surface.P, surface.F)
 
     def record(self, k: int, state: np.ndarray, hv: int) -> float:
         """Log (or replace) the row of step k; returns its IF."""
         IF = self.surface.inflation_rate(state)
-        vol = _signed_volume(state, self.surface.F)
+        vol = signed_volume(state, self.surface.F)
         dv = vol / self.v0 - 1.0 if self.v0 != 0 else float("nan")
         if self.history and self.history[-1][0] == k:
             self.history[-1] = (k, IF, hv, dv)

@@ -60,6 +60,20 @@ def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
 
 
+def signed_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(labels.max() + 1,) the volume each labelled set of faces encloses (closed, CCW seen from
+    outside: positive; inward: negative): the sum of its triangles' tetrahedra with the origin."""
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    det = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6.0
+    return np.bincount(labels, weights=det, minlength=int(labels.max()) + 1 if len(labels) else 0)
+
+
+def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """The volume closed triangles (F, 3) enclose (`signed_volumes` of all of them as one set)."""
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
+
+
 def vector_norm(v: np.ndarray) -> float:
     """np.linalg.norm(v) of a 1-D float64 vector, bit for bit (the sqrt of v.dot(v)), without its
     general-case overhead (small meshes call it per heuristic and per net)."""

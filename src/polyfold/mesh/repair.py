@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from ..errors import MeshError
 from .appearance import Appearance
-from .geometry import concavity, face_areas
+from .geometry import concavity, face_areas, signed_volumes
 from .mesh import boundary_loops, edge_topology, face_components, Mesh, Topology
 
 
@@ -214,12 +214,6 @@ def _orientation_parity(faces: np.ndarray, topo: Topology) -> tuple[np.ndarray, 
     sizes = np.bincount(labels)
     minority_is_zero = ones > sizes - ones  # ties keep the root face's orientation
     return (parity ^ minority_is_zero[labels]).astype(bool), None
-
-
-def _signed_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray) -> np.ndarray:
-    tri = vertices[faces]
-    det = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6.0
-    return np.bincount(labels, weights=det, minlength=labels.max() + 1)
 
 
 def _edges_cross(a: Mesh, b: Mesh, lo: np.ndarray, hi: np.ndarray, chunk: int = 1 << 20) -> bool:
@@ -490,7 +484,7 @@ def _orient(w: _Work, topo: Topology, labels: np.ndarray) -> int:
     n_comp = int(labels.max()) + 1
     open_faces = topo.boundary[topo.face_edges].any(axis=1)
     closed = np.bincount(labels, weights=open_faces, minlength=n_comp) == 0
-    inverted = closed & (_signed_volumes(w.vertices, w.faces, labels) < 0)
+    inverted = closed & (signed_volumes(w.vertices, w.faces, labels) < 0)
     turn = inverted[labels]
     if turn.any():
         w.notes["inverted"] = (

@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..approximate.error import lp_overlap_depths
+from ..approximate.error import LP_TOL, lp_overlap_depths
 from ..approximate.hulls import approximate_hulls, plane_basis
 from ..deadline import Deadline
 from ..errors import PolyfoldError
@@ -26,9 +26,6 @@ from ..segment.segment import DEFAULT_TAU, segment
 from .options import MakeOptions
 from .report import ApproximateReport, SegmentReport
 
-# over the bbox diagonal: a ball this deep inside two parts' polyhedra is an overlap (the LP's
-# tolerances are far below; a touching pair has depth 0 up to rounding)
-OVERLAP_DEPTH = 1e-7
 # a side within this angle (cosine) and distance (x diagonal) of another part's side lies on it
 CONTACT_COS = math.cos(1e-4)
 CONTACT_DIST = 1e-7
@@ -123,7 +120,7 @@ def approximate_mesh(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Cal
     approx = approximate_hulls(mesh, seg, seed=opts.seed)
     diag = mesh.bbox_diagonal
     depth = lp_overlap_depths(approx.parts)
-    pairs = np.argwhere(np.triu(depth > OVERLAP_DEPTH * diag, 1))
+    pairs = np.argwhere(np.triu(depth > LP_TOL * diag, 1))  # (the bound the tests hold it to)
     if len(pairs):  # the clipping's own guarantee failed: never build parts that cannot be assembled
         i, j = (int(x) + 1 for x in pairs[0])
         raise PolyfoldError(f"the convex parts {i} and {j} overlap (by {depth[i - 1, j - 1] / diag:.2g} of the "
