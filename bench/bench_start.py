@@ -6,7 +6,9 @@ Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-
 peak resident memory (the child's own rusage). Cold rows use an empty numba cache of their own
 ($NUMBA_CACHE_DIR in a temporary folder, so the project's cache is left alone):
 
-- cold make: `polyfold make` of bunny-128 with nothing compiled (a bare `pip install`);
+- cold make: `polyfold make` of bunny-128 with nothing compiled (a bare `pip install`), as it
+  runs (two or more cores: the fold stage's kernels compile in a second process, `warmup.Beside`)
+  and on one core (`taskset -c 0`: everything in one process);
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
 - warm: `--help`, `info`, `make` with the kernels cached (every later run);
 - make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
@@ -19,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -32,10 +35,10 @@ CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "p
 BUNNY = ROOT / "examples" / "bunny-128.obj"
 
 
-def run(args: list[str], env: dict | None = None) -> tuple[float, float, int]:
-    """(wall seconds, peak RSS MB, exit code) of one CLI process."""
+def run(args: list[str], env: dict | None = None, prefix: list[str] = []) -> tuple[float, float, int]:
+    """(wall seconds, peak RSS MB, exit code) of one CLI process (run under `prefix`, e.g. taskset)."""
     t0 = time.perf_counter()
-    proc = subprocess.Popen(CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    proc = subprocess.Popen(prefix + CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
     proc.returncode = os.waitstatus_to_exitcode(status)
@@ -76,7 +79,12 @@ def main() -> None:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
         wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env)
         cold_report = json.loads((tmp / "cold" / "report.json").read_text())
-        rows.append(("cold make bunny-128 (bare pip install)", wall, mb, ""))
+        rows.append(("cold make bunny-128 (bare pip install)", wall, mb,
+                     "the fold stage's kernels compile in a second process meanwhile (its memory not counted)"))
+        if shutil.which("taskset"):  # the same on one core: one process compiles everything
+            env1 = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold-1"))
+            wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold1"), "-q"], env1, ["taskset", "-c", "0"])
+            rows.append(("  the same on one core (taskset -c 0)", wall, mb, "one process"))
         env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-setup"))
         wall, mb, _ = run(["warm-up"], env)
         rows.append(("warm-up (make setup adds it)", wall, mb, ""))

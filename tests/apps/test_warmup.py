@@ -7,6 +7,8 @@ import os
 import subprocess
 import sys
 
+import numpy as np
+
 from polyfold.apps.benchpaper import kernel_signatures
 from polyfold.apps.warmup import bumpy_sphere, kernels_cached, warm_up
 
@@ -53,3 +55,107 @@ def test_kernels_cached_tells_a_cold_cache_from_a_warm_one(tmp_path):
                           capture_output=True, text=True, timeout=120,
                           env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "empty")})
     assert cold.returncode == 0 and cold.stdout.strip() == "False", cold.stderr
+
+
+# a first run's make compiles its fold stage in a second process (`Beside`) -----------------------
+
+_FOLD_STAGE_SIGNATURES = r"""
+import json, sys
+from pathlib import Path
+from polyfold.apps.benchpaper import kernel_signatures
+from polyfold.apps.warmup import SECTIONS
+from polyfold.deadline import Deadline
+from polyfold.fabricate.fit import model_scale
+from polyfold.formats.meshes import load_mesh
+from polyfold.pipeline.folding import fold_pieces
+from polyfold.pipeline.options import MakeOptions
+from polyfold.pipeline.parts import make_parts
+
+opts = MakeOptions()
+mesh = load_mesh(Path(sys.argv[1])).mesh
+parts, _, _ = make_parts(mesh, opts, Deadline.after(30.0), lambda stage, message: None)
+for name in ("fold-plan", "fold-check"):
+    SECTIONS[name][1](None)
+before = kernel_signatures()
+folded, report = fold_pieces(parts, opts, Deadline.after(30.0), lambda stage, message: None,
+                             model_scale([mesh], opts.size))
+after = kernel_signatures()
+new = {k: sorted(v - before.get(k, set())) for k, v in after.items() if v - before.get(k, set())}
+print(json.dumps({"new": new, "verified": report.verified, "pieces": report.pieces}))
+"""
+
+
+def test_the_sections_beside_compile_every_kernel_of_makes_fold_stage():
+    """What a first run waits for instead of compiling: after the sections `fold-plan` and
+    `fold-check` (on the hand-made tetrahedron net), folding the bunny's real pieces as make does
+    calls no kernel signature they did not (a fresh process; cached or compiled, the same)."""
+    import json
+    from pathlib import Path
+
+    bunny = Path(__file__).resolve().parents[2] / "examples" / "bunny-128.obj"
+    proc = subprocess.run([sys.executable, "-c", _FOLD_STAGE_SIGNATURES, str(bunny)], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    got = json.loads(proc.stdout.splitlines()[-1])
+    assert got["pieces"] >= 1 and got["verified"] == got["pieces"]
+    assert got["new"] == {}, f"make's fold stage compiles beyond the first run's sections: {got['new']}"
+
+
+def test_star_net_is_a_flat_net_that_folds_to_its_tetrahedron():
+    from shapely.geometry import Polygon
+
+    from polyfold.apps.warmup import star_net
+    from polyfold.deadline import Deadline
+    from polyfold.fabricate.fit import model_scale
+    from polyfold.pipeline.folding import fold_pieces
+    from polyfold.pipeline.options import MakeOptions
+
+    part = star_net()
+    net = part.net
+    a, b, c = net.coords[:, 0], net.coords[:, 1], net.coords[:, 2]
+    signed = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    assert (signed > 0).all()  # every face CCW, outer side up
+    # every face keeps its 3D side lengths on paper
+    v, f = net.mesh.vertices, net.mesh.faces
+    for k in range(3):
+        flat = np.linalg.norm(net.coords[:, (k + 1) % 3] - net.coords[:, k], axis=1)
+        assert np.allclose(flat, np.linalg.norm(v[f[:, (k + 1) % 3]] - v[f[:, k]], axis=1))
+    # no two faces overlap on paper (shapely, not the unfolder's test)
+    tris = [Polygon(t) for t in net.coords]
+    assert all(tris[i].intersection(tris[j]).area < 1e-12 for i in range(4) for j in range(i + 1, 4))
+    # and it folds: make's fold stage finds a path the independent check accepts
+    opts = MakeOptions()
+    _, report = fold_pieces([part], opts, Deadline.after(30.0), lambda stage, message: None,
+                            model_scale([net.mesh], opts.size))
+    assert report.pieces == 1 and report.verified == 1
+
+
+def test_beside_waits_for_its_stage_only_and_stops_a_process_left_over():
+    from polyfold.apps.warmup import Beside
+
+    with Beside(("fold-check",), (), "fold") as beside:
+        beside.ready("layout")
+        assert beside.proc is not None  # not its stage: no wait
+        beside.ready("fold")
+        assert beside.proc is None  # waited for it
+    with Beside(("make",), (), "fold") as beside:
+        proc = beside.proc
+    assert proc.returncode is not None and proc.returncode != 0  # never waited for: stopped on the way out
+
+
+def test_make_calls_ready_once_per_stage_before_its_work(tmp_path):
+    from pathlib import Path
+
+    from polyfold.pipeline.make import make
+    from polyfold.pipeline.options import MakeOptions
+
+    calls: list[str] = []
+    seen: list[tuple[str, str]] = []
+    bunny = Path(__file__).resolve().parents[2] / "examples" / "bunny-128.obj"
+    make(bunny, tmp_path / "out", MakeOptions(guide=False), lambda stage, message: seen.append((stage, message)),
+         ready=calls.append)
+    assert len(calls) == len(set(calls)) and {"load", "unfold", "layout", "fold", "export"} <= set(calls)
+    assert calls.index("fold") < calls.index("export")
+    # the fold stage's first message comes before any piece is planned (the first run waits there)
+    fold_messages = [m for s, m in seen if s == "fold"]
+    assert fold_messages[0].startswith("planning folding paths for")

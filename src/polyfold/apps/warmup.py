@@ -15,6 +15,7 @@ and both inflation modes (`make --inflate`).
 
 from __future__ import annotations
 
+import math
 import tempfile
 import time
 from typing import Callable
@@ -76,6 +77,74 @@ def _warm_fold(mesh) -> None:
             plan_fold(t, planner=planner, time_limit=0.5, seed=1)
 
 
+def star_net():
+    """A regular tetrahedron (edge 2 sqrt 2) as one Part: face 0 with the other three hinged to its
+    sides, laid out by numpy alone (each hinged face is face 0's far corner mirrored across their
+    shared side), so that the fold stage's kernels compile on it without the unfolder's."""
+    from ..mesh.mesh import Mesh
+    from ..pipeline.parts import Part
+    from ..unfold.net import Net
+
+    v = np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+    f = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]], dtype=np.int64)  # outward (CCW from outside)
+    mesh = Mesh(v, f)
+    corner = {0: np.array([0.0, 0.0]), 1: np.array([2.0 * math.sqrt(2.0), 0.0])}
+    corner[2] = np.array([math.sqrt(2.0), math.sqrt(6.0)])  # face 0 flat, CCW
+    coords = np.zeros((4, 3, 2))
+    coords[0] = [corner[i] for i in f[0]]
+    parent = np.array([-1, 0, 0, 0], dtype=np.int64)
+    parent_edge = np.full(4, -1, dtype=np.int64)
+    fe = mesh.topology.face_edges
+    for g in (1, 2, 3):
+        shared = [int(a) for a in f[g] if a in f[0]]
+        far = next(int(a) for a in f[0] if a not in shared)
+        mirrored = corner[shared[0]] + corner[shared[1]] - corner[far]  # equilateral faces
+        coords[g] = [corner[int(a)] if int(a) in shared else mirrored for a in f[g]]
+        parent_edge[g] = int(np.intersect1d(fe[0], fe[g])[0])
+    net = Net(mesh=mesh, parent=parent, parent_edge=parent_edge, order=np.arange(4, dtype=np.int64),
+              coords=coords, piece=np.zeros(4, dtype=np.int64))
+    return Part(np.arange(4, dtype=np.int64), net)
+
+
+def _star_tree():
+    """(the crease pattern, the fold tree at make's default thickness, options) of `star_net` as
+    make's fold stage builds them (default options, a 150 mm model)."""
+    from ..fabricate.fit import model_scale
+    from ..pipeline.options import MakeOptions
+    from ..unfold.pattern import crease_pattern
+
+    net = star_net().net
+    opts = MakeOptions()
+    thickness = opts.thickness / model_scale([net.mesh], opts.size)
+    pattern = crease_pattern([net])
+    return pattern, thickness, opts
+
+
+def _warm_fold_plan(mesh) -> None:
+    """make's fold stage without the check of the paths: the tree, the collision test, a plan."""
+    from ..fold.plan import plan_fold
+    from ..fold.tree import FoldTree, collides
+
+    pattern, thickness, opts = _star_tree()
+    tree = FoldTree.from_pattern(pattern, opts.contact_tol).with_thickness(thickness)
+    collides(tree, tree.goal)
+    plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=10.0, seed=opts.seed)
+
+
+def _warm_fold_check(mesh) -> None:
+    """make's independent check of a path (`pipeline.folding.verify_written`), on the straight path
+    of `star_net` (made without the planners: it runs while they compile beside)."""
+    from ..fold.plan import FoldPath
+    from ..mesh.geometry import fold_deg_to_rho
+    from ..pipeline.folding import verify_written
+
+    pattern, thickness, opts = _star_tree()
+    goal = fold_deg_to_rho(np.asarray(pattern.fold_deg, dtype=np.float64))
+    path = FoldPath(frames=np.stack([np.zeros_like(goal), goal]), linear=True, planner="linear", seconds=0.0,
+                    edges_checked=0, configs_checked=0, nodes=0)
+    verify_written(pattern, path, opts, thickness)
+
+
 def _warm_segment(mesh) -> None:
     from ..segment.segment import segment
 
@@ -98,11 +167,70 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "fold": ("the unfolder's local search and the folding planners", _warm_fold),
     "segment": ("segmentation", _warm_segment),
     "inflate": ("inflation", _warm_inflate),
+    # a first run's `Beside` (make has them both)
+    "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
+    "fold-check": ("make's fold stage: the path check", _warm_fold_check),
 }
+WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs (the rest: in make's)
 # run beside the others in a second process when there are two cores: segmentation's and
 # inflation's kernels share little with make's, so the two halves take about as long (a fresh
 # machine: 61 + 10 s against 32 + 7 s; 110 s in one process)
 BESIDE = ("segment", "inflate")
+
+
+class Beside:
+    """Warm-up sections compiled in a second Python process while this one works on, for the
+    stage that needs them: a first run's `make` (nothing in numba's cache) starts the fold stage's
+    planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
+    path check (`fold-check`) itself if the planners are still compiling, then waits for them, and
+    loads both from the cache instead of compiling them. The fold stage's kernels are the largest
+    share of a first run's compiling (40 of 65 s for the bunny here) and share little with the
+    stages before it, which this process compiles meanwhile. If the second process fails, this
+    one compiles what it needs as usual. Use as a context manager (the process is stopped on the
+    way out)."""
+
+    def __init__(self, beside: tuple[str, ...], here: tuple[str, ...], stage: str) -> None:
+        import subprocess
+        import sys
+
+        self.stage, self.here = stage, here
+        self.proc: "subprocess.Popen | None" = subprocess.Popen(
+            [sys.executable, "-m", "polyfold.apps.warmup", *beside],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def ready(self, stage: str) -> None:
+        """Called as `stage` starts (make's `ready`): when the second process compiles for it, do
+        `here` meanwhile and wait for it."""
+        if stage != self.stage or self.proc is None:
+            return
+        from ..deadline import compiling_elsewhere
+
+        if self.proc.poll() is None:
+            for name in self.here:
+                SECTIONS[name][1](None)
+        with compiling_elsewhere():  # (no deadline runs on while the kernels are made)
+            self.proc.wait()
+        self.proc = None
+
+    def __enter__(self) -> "Beside":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.proc is not None and self.proc.poll() is None:  # its stage never came (--no-fold, an error)
+            self.proc.kill()
+            self.proc.wait()
+        self.proc = None
+
+
+def compile_beside() -> "Beside | None":
+    """With two or more cores, a `Beside` for make's fold stage (for a first run:
+    `kernels_cached()` False); else None."""
+    import os
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if cores >= 2:  # (on one core the two processes would only take turns)
+        return Beside(("fold-plan",), ("fold-check",), "fold")
+    return None
 
 
 def run_sections(names: list[str], progress: Callable[[str], None] | None = None) -> dict[str, float]:
@@ -138,7 +266,7 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
                                   stderr=subprocess.PIPE, text=True)
         if progress:
             progress(f"warm-up: {' and '.join(SECTIONS[n][0] for n in BESIDE)}, in a second process")
-    here = [n for n in SECTIONS if beside is None or n not in BESIDE]
+    here = [n for n in WARM_UP if beside is None or n not in BESIDE]
     seconds = run_sections(here, progress)
     if beside is not None:
         out, err = beside.communicate()

@@ -176,8 +176,10 @@ def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline, say: C
     paper's thickness (opts.thickness mm) is mm_per_unit-scaled to model units. `deadline`: the
     searches' (each piece still gets half a second past it); past `hard` OutOfTime."""
     t0 = time.perf_counter()
-    planner = _Planner(opts, deadline, len(parts), sum(p.net.n_pieces for p in parts), say,
-                       opts.thickness / mm_per_unit, hard)
+    n_pieces = sum(p.net.n_pieces for p in parts)
+    if opts.fold:  # before any of the stage's work (make's `ready` hook waits here on a first run)
+        say("fold", f"planning folding paths for {n_pieces} piece{'s' * (n_pieces != 1)}")
+    planner = _Planner(opts, deadline, len(parts), n_pieces, say, opts.thickness / mm_per_unit, hard)
     for pi, part in enumerate(parts):
         for k in range(part.net.n_pieces):
             planner.plan(pi, part.faces, *piece_net(part.net, k), 0)

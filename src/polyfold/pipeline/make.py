@@ -167,16 +167,23 @@ def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, 
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),
-         progress: Progress | None = None, *, name: str | None = None) -> MakeResult:
+         progress: Progress | None = None, *, name: str | None = None,
+         ready: Callable[[str], None] | None = None) -> MakeResult:
     """Run the whole pipeline on a mesh file (or a `Mesh` / `LoadedMesh` in memory; `name` names it
     in the report and on the sheets) and write the make folder into `out_dir` (see `export.py`).
     Raises PolyfoldError (nothing written) on bad input, a piece too large for the paper, or a
-    failed sheet check. progress(stage, message) as the work goes."""
+    failed sheet check. progress(stage, message) as the work goes. ready(stage): called once per
+    stage as it starts, before its work (a first run waits there for kernels compiled beside it,
+    `apps.warmup.Beside`)."""
     tell = progress or _progress_noop
     compiling = CompileTally()
+    started: set[str] = set()
 
     def say(stage: str, message: str) -> None:
         compiling.enter(stage)
+        if ready is not None and stage not in started:
+            started.add(stage)
+            ready(stage)
         tell(stage, message)
 
     width, height = check_options(opts)

@@ -47,14 +47,19 @@ def make(
                                     time_limit=time_limit, fold=fold, contact_tol=contact_tol,
                                     marks=marks, min_label_mm=min_label_mm, thickness=thickness, faces=faces,
                                     color=color, dpi=dpi, guide=guide, approximate=approximate)
-    from ...pipeline.make import make as run_make
-    from ..warmup import kernels_cached
+    from contextlib import nullcontext
 
-    if not quiet and kernels_cached() is False:
-        say("first run: compiling polyfold's kernels (about a minute, once; `polyfold warm-up` does it ahead)")
+    from ...pipeline.make import make as run_make
+    from ..warmup import compile_beside, kernels_cached
+
+    first_run = kernels_cached() is False
+    beside = compile_beside() if first_run and fold else None
+    if not quiet and first_run:
+        say("first run: compiling polyfold's kernels (about a minute, once; `polyfold warm-up` does it ahead)"
+            + ("; the folding stage's in a second process" if beside is not None else ""))
     t0 = time.perf_counter()
-    with options.make_progress(say, quiet, "polyfold make") as progress:
-        result = run_make(mesh, output, opts, progress)
+    with options.make_progress(say, quiet, "polyfold make") as progress, beside or nullcontext():
+        result = run_make(mesh, output, opts, progress, ready=beside.ready if beside is not None else None)
     rep = result.report
     lay = rep.stages.layout
     if not quiet:
