@@ -296,3 +296,25 @@ def test_bad_size():
     for size in (0.0, -1.0, math.inf, math.nan):
         with pytest.raises(PolyfoldError, match="positive"):
             net_sheet([tetra_net()], size)
+
+
+def test_outline_specks_merged_without_a_ring_crossing_itself():
+    """Merging an outline's corners within OUTLINE_TOL_MM can make its ring cross itself where it
+    passes near itself (two faces meeting at a corner): this piece outline of a 1,392-face
+    subdivided bunny (mm, as drawn) made `make` stop with a GEOS error before it was mended."""
+    import shapely
+
+    from polyfold.fabricate.pieces import OUTLINE_TOL_MM, _without_specks
+
+    ring = [[35.434887, 60.967766], [47.875362, 66.56128], [47.875351, 66.561285], [51.212048, 68.315797],
+            [51.671862, 68.101445], [52.473438, 64.417822], [55.810083, 66.17232], [56.269891, 65.95797],
+            [57.071435, 62.274323], [57.071404, 62.274338], [40.032944, 58.824287], [57.071425, 62.274321],
+            [54.409565, 50.878749], [51.747659, 39.483123], [37.371084, 47.428716], [22.994475, 55.37421]]
+    outline = shapely.Polygon(ring)
+    assert outline.is_valid
+    assert not shapely.Polygon(shapely.remove_repeated_points(outline, OUTLINE_TOL_MM).exterior).is_valid
+    out = _without_specks(outline)
+    assert out.is_valid and abs(out.area - outline.area) < outline.length * OUTLINE_TOL_MM  # corners moved < tol
+    edges = [shapely.LineString(p) for g in shapely.get_parts(out) for p in zip(g.exterior.coords[:-1], g.exterior.coords[1:])]
+    assert min(e.length for e in edges) >= OUTLINE_TOL_MM  # no zero-length cuts left
+    shapely.union_all([out, shapely.box(0, 0, 1, 1)])  # and it unions (what make did next)

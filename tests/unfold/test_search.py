@@ -266,6 +266,30 @@ def test_a_blocked_single_net_is_refused_at_once(models_dir):
         assert not UnfoldProblem.from_mesh(single_component(models_dir, name)).single_net_blocked()
 
 
+def test_a_blocked_mesh_is_unfolded_into_pieces_after_a_short_search(models_dir, monkeypatch):
+    # without max_pieces=1 the search can only trade overlaps for pieces: it gets BLOCKED_SEARCH_S,
+    # not the time limit (make spent 51 s of star-4split-96's 53 s on such searches)
+    import polyfold.unfold.search as S
+
+    given = []
+    run = S.run_memetic
+
+    def recorded(problem, rng, deadline, *args, **kwargs):
+        given.append(deadline.left())
+        return run(problem, rng, deadline, *args, **kwargs)
+
+    monkeypatch.setattr(S, "run_memetic", recorded)
+    mesh = single_component(models_dir, "star-4split-96")
+    net, stats = unfold(mesh, seed=1, time_limit=60)
+    assert len(given) == 1 and given[0] <= S.BLOCKED_SEARCH_S
+    assert stats.timed_out and stats.pieces > 1
+    assert_valid_net(net, n_pieces=stats.pieces)
+    assert_flat_regions_whole(net)
+    given.clear()
+    unfold(single_component(models_dir, "bunny-128"), seed=1, time_limit=60)  # not blocked: its time limit
+    assert len(given) == 1 and given[0] > 50
+
+
 def test_fallback_cuts_only_cuttable_creases(models_dir):
     mesh = single_component(models_dir, "bumpy-528")
     problem = UnfoldProblem.from_mesh(mesh)

@@ -30,17 +30,24 @@ RUN_MAX_EDGES = 8  # a seam run printed with one label spans at most this many e
 def _without_specks(outline):
     """The outline without what the union of faces and grown tabs leaves at nm scale, which files
     written to 1e-4 mm would turn into zero-length cuts: corners within OUTLINE_TOL_MM merged,
-    then holes (and parts) that shrank to nothing dropped."""
+    then holes (and parts) that shrank to nothing dropped. Where merging corners makes the ring
+    cross itself (it passes near itself: two faces meeting at a corner; a 1,392-face subdivided
+    bunny), the corners are snapped to an OUTLINE_TOL_MM grid instead, which GEOS keeps valid."""
     import shapely
 
-    merged = shapely.remove_repeated_points(outline, OUTLINE_TOL_MM)
-    parts = []
-    for poly in getattr(merged, "geoms", [merged]):
-        if poly.geom_type != "Polygon" or poly.area <= OUTLINE_TOL_MM ** 2:
-            continue
-        holes = [r for r in poly.interiors if len(r.coords) >= 4 and shapely.Polygon(r).area > OUTLINE_TOL_MM ** 2]
-        parts.append(shapely.Polygon(poly.exterior, holes))
-    return parts[0] if len(parts) == 1 else shapely.MultiPolygon(parts)
+    def dropped(merged):
+        parts = []
+        for poly in getattr(merged, "geoms", [merged]):
+            if poly.geom_type != "Polygon" or poly.area <= OUTLINE_TOL_MM ** 2:
+                continue
+            holes = [r for r in poly.interiors if len(r.coords) >= 4 and shapely.Polygon(r).area > OUTLINE_TOL_MM ** 2]
+            parts.append(shapely.Polygon(poly.exterior, holes))
+        return parts[0] if len(parts) == 1 else shapely.MultiPolygon(parts)
+
+    out = dropped(shapely.remove_repeated_points(outline, OUTLINE_TOL_MM))
+    if not out.is_valid:
+        out = dropped(shapely.set_precision(outline, OUTLINE_TOL_MM))
+    return out
 
 
 @dataclass(frozen=True, eq=False)

@@ -2,7 +2,8 @@
 
 `make_parts` is make's segment + unfold stage: with `--tau` / `--parts` the mesh is segmented
 first; with `--segment auto` every connected component stays whole when it has a single-piece net
-(found within its share of half the time limit) and is segmented otherwise (past the searches'
+(found within its share of half the time limit, and at most SINGLE_NET_S + SINGLE_NET_S_PER_FACE x
+its faces) and is segmented otherwise (past the searches'
 deadline, or when segmenting it would not fit in their time left (SEGMENT_S_PER_FACE): unfolded
 into pieces as it is). `unfold_components`
 is the `unfold` command's: every component unfolded in its share of the time left.
@@ -27,6 +28,14 @@ from .options import MakeOptions
 from .report import NetReport, SegmentReport, UnfoldReport
 
 MIN_UNFOLD_S = 0.5  # the least time a part's search gets, however little is left
+# the most a part's search for a single net gets: SINGLE_NET_S + SINGLE_NET_S_PER_FACE x its faces
+# (a part of 144 faces 3.4 s, of 1,280 faces 14.8 s); then it is segmented, or cut into pieces. Where
+# single nets were found, the slowest took 0.53 s on the closed shared models (horse-302, seeds
+# 1-10) and 5.2 s on generated meshes of 1,000-2,100 faces (a rough 1,280-face sphere, seeds 1-5,
+# README "Where a user waits"); a search that finds none by then rarely finds one later (a
+# 144-face torus: none in 20 s on seeds 1-3), and make had searched it for 30 s of its 32 s
+SINGLE_NET_S = 2.0
+SINGLE_NET_S_PER_FACE = 0.01
 TAB_ROOM_S = 5.0  # the most time a part's net spends opening notches for tabs (`open_notches`)
 # segmenting is one kernel run the time limit cannot stop, of about this much a face and more on
 # big meshes (22k faces: 19 s; a 93,696-face subdivided Spot: minutes): a component is only
@@ -96,7 +105,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
     while todo:
         faces = todo.pop(0)
         part_mesh = mesh.submesh(faces)
-        left = share()
+        left = min(share(), SINGLE_NET_S + SINGLE_NET_S_PER_FACE * len(faces))
         say("unfold", f"part {len(out) + 1}: {len(faces)} faces")
         tu = time.perf_counter()
         try:

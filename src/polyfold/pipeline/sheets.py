@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+import shapely
 
 from ..deadline import Deadline
 from ..errors import PolyfoldError
@@ -79,16 +80,16 @@ PLAN_ROUNDS = 3  # plans of the cuts for one page count, each on the pieces the 
 # where a plan puts a part it splits off: on the emptiest page that takes one, then (when that fails)
 # on the first; the plans are greedy, and which of the two meets a page count varies from model to model
 PAGE_CHOICES = (True, False)
-# page counts at which the outlines would fill more than this of the printable area are not tried:
-# on the benchmark models no plan above 0.60 succeeded, and failing plans take the longest
-MAX_FILL = 0.75
+# page counts at which the outlines grown by half the gap (the room the packer gives each) would fill
+# more than this of the printable area are not tried, and failing plans take the longest: over the
+# 35 closed shared models and 8 generated meshes (80-1,280 faces) every plan that met its page count
+# filled at most 0.68 (torus, 0.64 with compact parts: star-24) and every one above 0.72 failed, in
+# 0.4-2.9 s each (the 1,280-face sphere tried 3 pages at 0.76 twice: 4.5 s of its 11 s layout; it
+# had tried every count whose outlines, not grown, filled at most 0.75)
+MAX_FILL = 0.7
 # hull areas (fractions of the printable area) that compact parts are cut to, the coarsest first
 # (fewest cuts): a sprawling net encloses gaps that the bottom-left fill cannot use
 CAPS = (0.4, 0.3, 0.2, 0.15, 0.1)
-# page counts at which the outlines grown by half the gap (the room the packer gives each) would fill
-# more than this are not tried with compact parts: on the benchmark models those that met their page
-# count filled up to 0.64 of it (star-24), and the plans fail slowly (fish-472 at 0.84: 4 s for all caps)
-COMPACT_FILL = 0.7
 
 
 def pack_budget(deadline: Deadline) -> float:
@@ -207,14 +208,15 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     """Cut creases where that puts the pieces on fewer pages (`fabricate.split`), before folding.
 
     The pieces are drawn (tabs and labels included) and packed as they are. Then, for each page
-    count from the fewest whose area they could fill to MAX_FILL up to one fewer than that packing:
+    count from the fewest that their outlines grown by half the gap fill to at most MAX_FILL up to
+    one fewer than that packing:
     `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and planned
     again, up to PLAN_ROUNDS times, until a plan needs no cut; the redrawn pieces are packed in the
     plan's order; when that misses the page count, the plans are made again with PAGE_CHOICES'
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
     search. Then one page fewer than the best so far is planned with compact parts (`plan_pages`'
     cap, each of CAPS in turn, emptiest page first) while the outlines grown by half the gap would
-    fill at most COMPACT_FILL of the pages; when that is met, one page fewer again. `box`:
+    fill at most MAX_FILL of the pages; when that is met, one page fewer again. `box`:
     `pack_box`. Time: `pack_budget` and one drawing's time (as long as the first drawing took),
     from after the first drawing (`lay_out` reuses it when folding splits nothing); a plan is only
     started with that drawing's time left. `deadline` ends this optional work (the label rounds
@@ -243,7 +245,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     budget = deadline.within(pack_budget(deadline) + draw_seconds)
     best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
-    fewest = max(1, math.ceil(sum(p.footprint.area for p in pieces) / (MAX_FILL * box_area) - 1e-9))
+    grown = float(shapely.area(shapely.buffer([p.footprint for p in pieces], GAP_MM / 2)).sum()) / box_area
+    fewest = max(1, math.ceil(grown / MAX_FILL - 1e-9))
     ran_out = packing.ran_out
     rasters: dict[int, tuple] = {}  # per drawing: (the drawing, kept alive so its id stays its own, rasters)
 
@@ -290,11 +293,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             break
     # one page fewer than that, with the parts cut compact (hulls of at most CAPS of a page, the
     # largest first); when that is met, one page fewer again
-    n_pages, least = best[0] - 1, fewest
-    if n_pages >= fewest:  # (only then: growing the outlines of a dense model takes a while)
-        grown = sum(p.footprint.buffer(GAP_MM / 2).area for p in pieces) / box_area
-        least = max(fewest, math.ceil(grown / COMPACT_FILL - 1e-9))
-    while n_pages >= least and not ran_out:
+    n_pages = best[0] - 1
+    while n_pages >= fewest and not ran_out:
         say("layout", f"splitting pieces into compact parts to fit {n_pages} page{'s' * (n_pages > 1)}")
         for cap in CAPS:
             attempt(n_pages, cap, True)

@@ -21,7 +21,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..deadline import Deadline
+from ..deadline import Deadline, clock
 from ..errors import NoNetFound
 from ..mesh.mesh import Mesh
 from . import kernels as K
@@ -44,6 +44,11 @@ class UnfoldStats:
     accepted: bool | None = None  # passed the caller's `accept` test (None: no test asked)
 
 
+# the search's time when no single net exists (`UnfoldProblem.single_net_blocked`): it can only trade
+# overlaps for pieces, and a short search does that as well as a long one (9 blocked parts of 16-580
+# faces, star-4split-96's and a subdivided bunny's, seeds 1-3: the same piece counts at 0.25-0.5 s as
+# at 5-10 s; make had spent 51 s of the star's 53 s searching its four blocked parts)
+BLOCKED_SEARCH_S = 0.5
 FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
 RESTART_GENERATIONS = 3  # the memetic search's restart unit (generations, times the Luby sequence)
 
@@ -435,7 +440,8 @@ def unfold(
 
     method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
     raises `NoNetFound` instead of falling back to several pieces (at once when
-    `UnfoldProblem.single_net_blocked`). Deterministic for a given seed
+    `UnfoldProblem.single_net_blocked`; without max_pieces such a mesh is searched for at most
+    BLOCKED_SEARCH_S). Deterministic for a given seed
     (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
     within the time limit, for a valid net that also passes this test (e.g. linear foldability);
     `UnfoldStats.accepted` says whether one did. deadline: when given, the search stops there
@@ -450,9 +456,12 @@ def unfold(
         time_limit = deadline.left()
     rng = np.random.default_rng(seed)
     problem = UnfoldProblem.from_mesh(mesh)
-    if max_pieces == 1 and problem.single_net_blocked():  # no search can succeed: say so at once
+    blocked = problem.single_net_blocked()
+    if max_pieces == 1 and blocked:  # no search can succeed: say so at once
         raise NoNetFound("no single-piece net can keep the flat regions whole (hyperbolic vertices on their "
                          "edges need cuts that split the net)")
+    if blocked and time_limit > BLOCKED_SEARCH_S:  # a net in pieces whatever the search: a short one
+        deadline, time_limit = Deadline(min(deadline.at, clock() + BLOCKED_SEARCH_S)), BLOCKED_SEARCH_S
     if np.count_nonzero(mesh.topology.interior) == mesh.n_faces - 1:
         # the faces' adjacency is a tree (one face, or a strip that closes no loop): the one
         # spanning tree there is, whatever the weights

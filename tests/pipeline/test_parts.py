@@ -1,0 +1,31 @@
+"""pipeline/parts.py (make's segment + unfold stage): how long a component's single net is
+searched for before it is segmented."""
+
+from __future__ import annotations
+
+from conftest import single_component
+
+import polyfold.pipeline.parts as parts_module
+from polyfold.deadline import Deadline
+from polyfold.pipeline.options import MakeOptions
+from polyfold.pipeline.parts import SINGLE_NET_S, SINGLE_NET_S_PER_FACE, make_parts
+
+
+def test_a_single_net_is_searched_for_as_long_as_its_faces_warrant(models_dir, monkeypatch):
+    """torus-12x6-144 has no single net the search finds (none in 20 s, seeds 1-3): make searched
+    30 s for one before segmenting it; now SINGLE_NET_S + SINGLE_NET_S_PER_FACE x 144 faces, and the
+    two parts it is segmented into get theirs from the same rule."""
+    given: list[tuple[int, float]] = []
+    unfold = parts_module.unfold
+
+    def recorded(mesh, **kwargs):
+        given.append((mesh.n_faces, kwargs["time_limit"]))
+        return unfold(mesh, **kwargs)
+
+    monkeypatch.setattr(parts_module, "unfold", recorded)
+    mesh = single_component(models_dir, "torus-12x6-144")
+    parts, seg, report = make_parts(mesh, MakeOptions(), Deadline.after(30.0), lambda stage, message: None)
+    assert given[0] == (144, SINGLE_NET_S + SINGLE_NET_S_PER_FACE * 144)
+    assert all(limit <= SINGLE_NET_S + SINGLE_NET_S_PER_FACE * n for n, limit in given)
+    assert len(parts) >= 2 and seg.segmented_components == (0,)
+    assert sum(len(p.faces) for p in parts) == 144 and all(p.net.n_pieces == 1 for p in parts)
