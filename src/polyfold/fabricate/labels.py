@@ -116,26 +116,29 @@ class _Boxes:
         (x0, y0), (x1, y1) = box.min(axis=0) // CELL_MM, box.max(axis=0) // CELL_MM
         return [(i, j) for i in range(int(x0), int(x1) + 1) for j in range(int(y0), int(y1) + 1)]
 
-    def hits(self, box: np.ndarray) -> bool:
-        """True when `box` (4, 2), grown by LABEL_PAD_MM, meets a placed box."""
-        from shapely.geometry import Polygon
-
-        return self.hits_bounds(Polygon(box).buffer(LABEL_PAD_MM, quad_segs=1), box)
-
-    def hits_geom(self, geom) -> bool:
-        """True when a shapely geometry meets a placed box."""
-        x0, y0, x1, y1 = geom.bounds
-        return self.hits_bounds(geom, np.array([[x0, y0], [x1, y1]]))
-
-    def hits_bounds(self, geom, corners: np.ndarray) -> bool:
-        seen = set()
+    def at(self, corners: np.ndarray) -> list:
+        """The placed geometries in the cells of the points `corners` (k, 2)' bounding box, each
+        once, in the order they were placed per cell (what `hits` tests against)."""
+        seen: set[int] = set()
+        out = []
         for key in self._keys(corners):
             for i, other in self.cells.get(key, ()):
                 if i not in seen:
                     seen.add(i)
-                    if geom.intersects(other):
-                        return True
-        return False
+                    out.append(other)
+        return out
+
+    def hits(self, box: np.ndarray) -> bool:
+        """True when `box` (4, 2), grown by LABEL_PAD_MM, meets a placed box."""
+        return _grown_box_hits(box, self.at(box))
+
+    def hits_geom(self, geom) -> bool:
+        """True when a shapely geometry meets a placed box."""
+        import shapely
+
+        x0, y0, x1, y1 = geom.bounds
+        near = self.at(np.array([[x0, y0], [x1, y1]]))
+        return bool(near) and bool(shapely.intersects(geom, np.array(near, dtype=object)).any())
 
     def add(self, box: np.ndarray) -> None:
         from shapely.geometry import Polygon
@@ -150,13 +153,16 @@ class _Boxes:
         for key in self._keys(np.array([[x0, y0], [x1, y1]])):
             self.cells.setdefault(key, []).append(item)
 
-    def near(self, corners: np.ndarray) -> list:
-        """The placed geometries in the cells that the box `corners` (2, 2) covers."""
-        seen = {}
-        for key in self._keys(corners):
-            for i, other in self.cells.get(key, ()):
-                seen[i] = other
-        return list(seen.values())
+
+def _grown_box_hits(box: np.ndarray, near: list) -> bool:
+    """Whether the label box (4, 2) grown by LABEL_PAD_MM meets any of the geometries `near` (grown
+    only when there are any: most candidate spots have none around)."""
+    if not near:
+        return False
+    import shapely
+
+    grown = shapely.Polygon(box).buffer(LABEL_PAD_MM, quad_segs=1)
+    return bool(shapely.intersects(grown, np.array(near, dtype=object)).any())
 
 
 @dataclass
@@ -314,9 +320,9 @@ class _Taken:
         for g in labels.room.extra:
             self.mark(g, TAB_CLEAR_MM)
         everywhere = np.array([[x0, y0], [x1, y1]])
-        for g in labels.boxes.near(everywhere):
+        for g in labels.boxes.at(everywhere):
             self.mark(g, LABEL_PAD_MM, text=True)
-        for g in labels.strips.near(everywhere):
+        for g in labels.strips.at(everywhere):
             self.mark(g, LABEL_PAD_MM)
 
     def _cells(self, pts: np.ndarray) -> np.ndarray:
@@ -451,6 +457,7 @@ class PieceLabels:
         self.cut_sides = np.zeros((0, 2, 2)) if cut_sides is None else np.asarray(cut_sides, dtype=float)
         # off-face labels stay in the room fitting a piece to the page leaves for its tabs
         self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
+        shapely.prepare(self.allowed)  # asked whether it contains a label box for every spot tried
         self.size = size
         self.boxes = _Boxes()
         self.strips = _Boxes()  # leader lines drawn across the piece (`_elsewhere`)
@@ -464,7 +471,7 @@ class PieceLabels:
 
     def _hits(self, box: np.ndarray) -> bool:
         """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
-        return self.boxes.hits(box) or self.strips.hits(box)
+        return _grown_box_hits(box, self.boxes.at(box) + self.strips.at(box))
 
     def _off_faces(self, geoms: list) -> None:
         """Record what an off-face label puts on the paper (its box, its leader's stretch beyond

@@ -106,6 +106,7 @@ class Room:
     tree: object = field(init=False)
     extra: list = field(default_factory=list)
     _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
+    _bounds_array: np.ndarray | None = None  # _bounds as an array, made when asked (None: stale)
 
     def __post_init__(self) -> None:
         import shapely
@@ -115,7 +116,7 @@ class Room:
     def copy(self) -> Room:
         """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
         out = copy.copy(self)
-        out.extra, out._bounds = list(self.extra), list(self._bounds)
+        out.extra, out._bounds, out._bounds_array = list(self.extra), list(self._bounds), None
         return out
 
     def add(self, geoms) -> None:
@@ -123,6 +124,7 @@ class Room:
         for g in geoms:
             self.extra.append(g)
             self._bounds.append(g.bounds)
+        self._bounds_array = None
 
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
@@ -133,7 +135,9 @@ class Room:
         if not self._bounds:
             return []
         x0, y0, x1, y1 = region.bounds
-        b = np.asarray(self._bounds)
+        if self._bounds_array is None:  # (asked about a dozen times between two additions)
+            self._bounds_array = np.asarray(self._bounds)
+        b = self._bounds_array
         hit = np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
         return [self.extra[i] for i in hit]
 
