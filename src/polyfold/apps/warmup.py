@@ -107,8 +107,8 @@ def star_net():
 
 
 def _star_tree():
-    """(the crease pattern, the fold tree at make's default thickness, options) of `star_net` as
-    make's fold stage builds them (default options, a 150 mm model)."""
+    """(the crease pattern of `star_net`, the paper's thickness in its model units, the options)
+    as make's fold stage has them (default options, a 150 mm model)."""
     from ..fabricate.fit import model_scale
     from ..pipeline.options import MakeOptions
     from ..unfold.pattern import crease_pattern
@@ -178,6 +178,9 @@ WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs
 BESIDE = ("segment", "inflate")
 
 
+BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section takes 40-45 s here)
+
+
 class Beside:
     """Warm-up sections compiled in a second Python process while this one works on, for the
     stage that needs them: a first run's `make` (nothing in numba's cache) starts the fold stage's
@@ -203,13 +206,19 @@ class Beside:
         `here` meanwhile and wait for it."""
         if stage != self.stage or self.proc is None:
             return
+        import subprocess
+
         from ..deadline import compiling_elsewhere
 
         if self.proc.poll() is None:
             for name in self.here:
                 SECTIONS[name][1](None)
         with compiling_elsewhere():  # (no deadline runs on while the kernels are made)
-            self.proc.wait()
+            try:
+                self.proc.wait(timeout=BESIDE_WAIT_S)
+            except subprocess.TimeoutExpired:  # stuck: this process compiles what it needs itself
+                self.proc.kill()
+                self.proc.wait()
         self.proc = None
 
     def __enter__(self) -> "Beside":
@@ -238,7 +247,8 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
     from ..mesh.mesh import Mesh
 
     say = progress or (lambda line: None)
-    mesh = Mesh(*bumpy_sphere())
+    # (make's fold-stage sections bring their own net: no trimesh sphere to build for them)
+    mesh = Mesh(*bumpy_sphere()) if set(names) - {"fold-plan", "fold-check"} else None
     seconds: dict[str, float] = {}
     for name in names:
         what, run = SECTIONS[name]
