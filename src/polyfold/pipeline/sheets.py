@@ -83,9 +83,9 @@ PAGE_CHOICES = (True, False)
 # page counts at which the outlines grown by half the gap (the room the packer gives each) would fill
 # more than this of the printable area are not tried, and failing plans take the longest: over the
 # 35 closed shared models and 8 generated meshes (80-1,280 faces) every plan that met its page count
-# filled at most 0.68 (torus, 0.64 with compact parts: star-24) and every one above 0.72 failed, in
-# 0.4-2.9 s each (the 1,280-face sphere tried 3 pages at 0.76 twice: 4.5 s of its 11 s layout; it
-# had tried every count whose outlines, not grown, filled at most 0.75)
+# filled at most 0.68 (a generated torus; with compact parts at most 0.58) and every one above 0.72
+# failed, in 0.4-2.9 s each (the 1,280-face sphere tried 3 pages at 0.76 twice: 4.5 s of its 11 s
+# layout; it had tried every count whose outlines, not grown, filled at most 0.75)
 MAX_FILL = 0.7
 # hull areas (fractions of the printable area) that compact parts are cut to, the coarsest first
 # (fewest cuts): a sprawling net encloses gaps that the bottom-left fill cannot use
