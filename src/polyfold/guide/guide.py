@@ -101,7 +101,10 @@ def _seams(mesh: Mesh, pieces, glue, folded, scale: float) -> tuple[list[Seam], 
     """The plan's seams of the sheets' glue pairs (meeting times from the pieces' paths), and per
     net piece its path facts (tree, done frames) for the folding pictures."""
     topo = mesh.topology
-    keys = topo.edges[:, 0] * mesh.n_vertices + topo.edges[:, 1]
+    # edges are in the order of their sorted vertex pairs, but a boundary edge is stored as its
+    # face runs it (`mesh.edge_topology`): keys of the sorted pairs, or an open mesh's lookups miss
+    lo, hi = np.sort(topo.edges, axis=1).T
+    keys = lo * mesh.n_vertices + hi
     paths: dict[int, dict] = {}
     for i, fp in enumerate(folded):
         if fp.path is None or len(fp.path.frames) < 2:
