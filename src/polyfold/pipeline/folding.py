@@ -95,15 +95,12 @@ class _Planner:
                 # piece can eat the whole time limit
                 share = max(0.5, min(self.deadline.left() / max(1, self.pending),
                                      FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
-                clash = _clash_at_goal(tree, opts.resolution_deg)
-                if clash is not None:  # no planner's path gets there: split at once (below)
-                    note = (f"at the goal, faces {clash[0]} and {clash[1]} come closer than the paper's "
-                            f"{opts.thickness:g} mm thickness (vertices that close but not joined in the mesh)")
-                else:
-                    try:
-                        path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
-                    except PolyfoldError as exc:
-                        path, note = None, str(exc)
+                impossible = ""  # why no path can exist for this piece (its faces clash at the goal)
+                try:
+                    path = plan_fold(tree, resolution_deg=opts.resolution_deg, time_limit=share, seed=opts.seed)
+                except PolyfoldError as exc:
+                    path, note = None, str(exc)
+                    impossible = note
                 if path is not None:
                     check = verify_written(pattern, path, opts, self.thickness)
                     if not check.ok:
@@ -113,7 +110,7 @@ class _Planner:
                 may_split = path is None and depth < MAX_SPLITS and self.deadline.left() > 0
                 cut = balanced_cut(pnet, 0) if may_split else None  # None: one flat polygon, never cut
                 if cut is not None:
-                    self.say("fold", "its faces clash at the goal: split the piece in two" if clash is not None
+                    self.say("fold", f"{impossible}: split the piece in two" if impossible
                              else f"no verified path in {share:.1f} s: split the piece in two")
                     self._split(pi, faces, pnet, fids, cut, depth)
                     return
@@ -134,22 +131,6 @@ class _Planner:
         for h in range(2):
             sub, sub_fids = piece_net(halves, h)
             self.plan(pi, faces, sub, fids[sub_fids], depth + 1)
-
-
-def _clash_at_goal(tree: FoldTree, resolution_deg: float) -> tuple[int, int] | None:
-    """Two faces of the net that the planners' test at the tree's thickness finds colliding in the
-    folded goal, or None. The goal itself is only required not to intersect (`plan_fold` checks it
-    without thickness: faces meet there along seams by design), but where two faces come closer
-    than the thickness there without sharing a mesh vertex, the configurations near it collide
-    too, and every planner spends its whole budget failing: over the 35 closed shared models and 8
-    generated meshes, 3 of 487 pieces had such a goal (hull-ellipsoid-rand-236, two vertices 0.25 mm
-    apart at 150 mm), none found a path, 12.6 s in all; all others had none."""
-    import math
-
-    from ..fold.checker import ValidityChecker
-
-    check = ValidityChecker(tree, math.radians(resolution_deg))
-    return None if check.valid(tree.goal) else check.last_hit()
 
 
 def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: float, time_limit: float, seed: int,
