@@ -18,9 +18,12 @@ from __future__ import annotations
 import math
 import tempfile
 import time
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import subprocess
 
 
 def kernels_cached() -> bool | None:
@@ -175,9 +178,7 @@ WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs
 # run beside the others in a second process when there are two cores: segmentation's and
 # inflation's kernels share little with make's, so the two halves take about as long (a fresh
 # machine: 61 + 10 s against 32 + 7 s; 110 s in one process)
-BESIDE = ("segment", "inflate")
-
-
+SECOND_PROCESS = ("segment", "inflate")
 BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section takes 40-45 s here)
 
 
@@ -193,13 +194,8 @@ class Beside:
     way out)."""
 
     def __init__(self, beside: tuple[str, ...], here: tuple[str, ...], stage: str) -> None:
-        import subprocess
-        import sys
-
         self.stage, self.here = stage, here
-        self.proc: "subprocess.Popen | None" = subprocess.Popen(
-            [sys.executable, "-m", "polyfold.apps.warmup", *beside],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.proc: "subprocess.Popen | None" = start_sections(beside, capture=False)
 
     def ready(self, stage: str) -> None:
         """Called as `stage` starts (make's `ready`): when the second process compiles for it, do
@@ -234,12 +230,27 @@ class Beside:
 def compile_beside() -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
     `kernels_cached()` False); else None."""
-    import os
-
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if cores >= 2:  # (on one core the two processes would only take turns)
+    if usable_cores() >= 2:  # (on one core the two processes would only take turns)
         return Beside(("fold-plan",), ("fold-check",), "fold")
     return None
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its affinity, as `taskset` sets it, where the OS says)."""
+    import os
+
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def start_sections(names: tuple[str, ...] | list[str], capture: bool) -> "subprocess.Popen":
+    """A second Python process running the named SECTIONS (`python -m polyfold.apps.warmup`); its
+    last stdout line, when `capture`, is their seconds as JSON."""
+    import subprocess
+    import sys
+
+    out = subprocess.PIPE if capture else subprocess.DEVNULL
+    return subprocess.Popen([sys.executable, "-m", "polyfold.apps.warmup", *names], stdout=out, stderr=out,
+                            text=True)
 
 
 def run_sections(names: list[str], progress: Callable[[str], None] | None = None) -> dict[str, float]:
@@ -261,29 +272,25 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 
 def warm_up(progress: Callable[[str], None] | None = None, processes: int | None = None) -> dict[str, float]:
     """Call every compiled kernel a command can reach once; seconds per section. processes: 1 runs
-    every section here; 2 (the default with two or more cores) runs BESIDE in a second Python
+    every section here; 2 (the default with two or more cores) runs SECOND_PROCESS in a second Python
     process at the same time (numba compiles in one thread; its cache is written file by file, a
     temporary file renamed, so two processes may fill it together)."""
     import json
-    import os
-    import subprocess
-    import sys
 
-    processes = processes or (2 if (os.cpu_count() or 1) >= 2 else 1)
+    processes = processes or (2 if usable_cores() >= 2 else 1)
     beside = None
     if processes >= 2:
-        beside = subprocess.Popen([sys.executable, "-m", "polyfold.apps.warmup", *BESIDE], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True)
+        beside = start_sections(SECOND_PROCESS, capture=True)
         if progress:
-            progress(f"warm-up: {' and '.join(SECTIONS[n][0] for n in BESIDE)}, in a second process")
-    here = [n for n in WARM_UP if beside is None or n not in BESIDE]
+            progress(f"warm-up: {' and '.join(SECTIONS[n][0] for n in SECOND_PROCESS)}, in a second process")
+    here = [n for n in WARM_UP if beside is None or n not in SECOND_PROCESS]
     seconds = run_sections(here, progress)
     if beside is not None:
         out, err = beside.communicate()
         if beside.returncode == 0:
             seconds.update(json.loads(out.splitlines()[-1]))
         else:  # whatever went wrong there, compile them here
-            seconds.update(run_sections(list(BESIDE), progress))
+            seconds.update(run_sections(list(SECOND_PROCESS), progress))
     return seconds
 
 
