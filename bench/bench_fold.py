@@ -125,13 +125,14 @@ def collision_table() -> None:
         work = collision_work(tree.n_faces)
         q = np.empty(tree.n_edges)
         t = tree
-        checked = sum(segment_free(a, b, math.radians(0.5), t.order, t.parent, t.crease, t.axis, t.flat, t.piece,
-                                   t.tol, q, 1 << 40, work)[1] for a, b in zip(frames[:-1], frames[1:]))
+        segments = [(a, b, max(1, int(math.ceil(np.abs(b - a).max() / math.radians(0.5) - 1e-12))))
+                    for a, b in zip(frames[:-1], frames[1:])]
+        checked = sum(segment_free(a, b, m, t.order, t.parent, t.crease, t.axis, t.flat, t.piece,
+                                   t.tol, q, 1 << 40, work)[1] for a, b, m in segments)
 
         def run():
-            for a, b in zip(frames[:-1], frames[1:]):
-                segment_free(a, b, math.radians(0.5), t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, q,
-                             1 << 40, work)
+            for a, b, m in segments:
+                segment_free(a, b, m, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, q, 1 << 40, work)
         return best_of(run) / checked * 1e6
 
     nets = []

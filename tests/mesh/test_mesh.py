@@ -1,4 +1,4 @@
-"""mesh/mesh.py: the edge table of `edge_topology` (one numba pass) against np.unique and a
+"""mesh/mesh.py: the edge table of `edge_topology` (one lexsort) against np.unique and a
 lexsort loop on random face lists (non-manifold, unoriented, degenerate), and on a known mesh."""
 
 import numpy as np

@@ -14,6 +14,13 @@ its `FaceGeometry`, computed once per face and configuration (`face_geometry`) a
 of a `geo` array (`store_face` / `load_face`, GEO_SIZE values per row, the face's box from
 GEO_LO on) by the broad phase (`sweep.py`).
 
+The small helpers (`_span`, `_no_contact_spans`, `face_geometry`, `tri_corners`, ...) are plain
+compiled calls: LLVM inlines them all the same (the collision test's time per configuration is
+unchanged, `bench/bench_fold.py --collision`), while numba's own inline="always" typed each
+again at every call site, 6-7 s of a first run's compiling (the fold stage's 34 -> 27 s here).
+Only the per-face pair tests with array reads (`load_face`, `store_face`, `faces_cross`,
+`thick_collides`) stay inlined: as calls they cost 10-15% of the test.
+
 With the paper's thickness (README "Paper thickness") the planners ask `thick_collides` instead:
 crossing, or closer than the thickness with overlapping projections (`faces_near`, the same
 separating-axis machinery with a margin), where faces sharing a vertex may touch near it (quick
@@ -32,7 +39,7 @@ from numba import njit
 _AXIS_EPS2 = 1e-24  # a candidate axis is skipped when |axis| < 1e-12 * (product of the lengths crossed)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def tri_corners(tris, f):
     """Triangle f of tris (F, 3, 3) as a tuple of corner tuples."""
     return ((tris[f, 0, 0], tris[f, 0, 1], tris[f, 0, 2]),
@@ -64,7 +71,7 @@ def _is_sliver(n2, l2, tol):
     return not (n2 > _AXIS_EPS2 * longest2 * longest2) or n2 <= tol * tol * longest2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _span(t, n, o):
     """(min, max) of the corners of triangle t projected on axis n (unit), origin o."""
     s0 = n[0] * (t[0][0] - o[0]) + n[1] * (t[0][1] - o[1]) + n[2] * (t[0][2] - o[2])
@@ -73,7 +80,7 @@ def _span(t, n, o):
     return min(min(s0, s1), s2), max(max(s0, s1), s2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _no_contact_spans(amin, amax, bmin, bmax, tol):
     """True when the projections [amin, amax], [bmin, bmax] on one axis prove the triangles do not
     cross: a gap > tol, or a touching witness (depth <= tol, unless both are thinner than tol)."""
@@ -121,7 +128,7 @@ GEO_SIZE = 29  # values per face in a `geo` row: the 23 of a FaceGeometry, then 
 GEO_LO = 23
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def face_geometry(t, tol):
     """The FaceGeometry of triangle t."""
     e = (_edge(t, 0), _edge(t, 1), _edge(t, 2))
@@ -306,7 +313,7 @@ def _corner_at(a, p, tol):
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _turn_ok(det, ll, scale2):
     """det >= -1e-9 |x| |y|, det being n . (x cross y) scaled by sqrt(scale2) (ll = |x|^2 |y|^2)."""
     return det >= 0.0 or det * det <= 1e-18 * ll * scale2
@@ -531,12 +538,12 @@ def _thick_rest(a, b, ga, gb, ma, mb, edge, tol, thick, reach):
     return False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _one_bit(m):
     return m == 1 or m == 2 or m == 4
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _corner_of(m):
     """The corner (0, 1, 2) of a one-bit corner mask m (`_one_bit`)."""
     return 0 if m == 1 else (1 if m == 2 else 2)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..mesh.geometry import fold_deg_to_rho
+from ..mesh.kernels import fold_deg_to_rho
 
 OK = 0
 # faces

@@ -3,7 +3,8 @@
     mesh.py       `Mesh` (vertices, CCW faces, source face of each triangle) and its edge `Topology`
     geometry.py   normals, areas, corner and fold angles (the one sign convention), angle sums, concavity
     repair.py     checks and repairs of a loaded mesh (`LoadedMesh`), the `info` report
-    kernels.py    numba: the edge table and per-corner / per-edge vectors
+    kernels.py    numba: face normals, fold-angle vectors, texture sampling (imported where used:
+                  loading and checking a mesh, `polyfold info`, compiles and loads nothing)
 
 Files are read by `formats/meshes.py` (`load_mesh`), which calls `repair.repair`.
 """

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numba import njit
 
 KINDS = ("texture", "vertex", "face")  # what the file had: an image, colours per vertex, per face
 WHITE = (255, 255, 255)
@@ -119,38 +118,12 @@ def texel_coords(uv: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
-def texel(image, x, y):
-    """The bilinear colour (3 floats, 0..255) of `image` (h, w, 3) uint8 at texel coordinates
-    (x, y), the image repeating outside."""
-    h, w = image.shape[0], image.shape[1]
-    fx, fy = np.floor(x), np.floor(y)
-    ax, ay = x - fx, y - fy
-    x0, y0 = int(fx) % w, int(fy) % h
-    x1, y1 = (x0 + 1) % w, (y0 + 1) % h
-    r = np.empty(3)
-    for c in range(3):
-        top = image[y0, x0, c] * (1.0 - ax) + image[y0, x1, c] * ax
-        bottom = image[y1, x0, c] * (1.0 - ax) + image[y1, x1, c] * ax
-        r[c] = top * (1.0 - ay) + bottom * ay
-    return r
-
-
-@njit(cache=True)
-def _sample_many(image, xy, out):
-    for i in range(xy.shape[0]):
-        if not (np.isfinite(xy[i, 0]) and np.isfinite(xy[i, 1])):
-            out[i, :] = 255
-            continue
-        c = texel(image, xy[i, 0], xy[i, 1])
-        for k in range(3):
-            out[i, k] = min(255, max(0, int(c[k] + 0.5)))
-
-
 def sample_texture(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """(N, 3) uint8 bilinear colours of `image` at texel coordinates xy (N, 2) (`texel_coords`);
     white where a coordinate is not finite."""
+    from .kernels import sample_many
+
     xy = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
     out = np.empty((len(xy), 3), dtype=np.uint8)
-    _sample_many(np.ascontiguousarray(image, dtype=np.uint8), xy, out)
+    sample_many(np.ascontiguousarray(image, dtype=np.uint8), xy, out)
     return out

@@ -8,7 +8,8 @@ files use FOLD's fold angle (degrees, valley positive, mountain negative): `rho_
 `fold_deg_to_rho` are the one place the sign flips.
 
 The floating-point results are bitwise those of the numpy formulas (see `kernels.py`): every stage
-must see the same bits.
+must see the same bits. Loading and checking a mesh (`polyfold info`) needs no compiled kernel:
+the kernels are imported where they are used.
 """
 
 from __future__ import annotations
@@ -17,9 +18,6 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
-
-from . import kernels as MK
 
 if TYPE_CHECKING:
     from .mesh import Mesh, Topology
@@ -35,23 +33,24 @@ FLAT_EPS = 1e-10  # |rho| below this (radians) is a flat crease ("F" in FOLD, no
 FLAT_REGION_RAD = 1e-3
 
 
-@njit(cache=True)
 def rho_to_fold_deg(rho):
     """FOLD fold angle (degrees, valley positive) of signed fold angles rho (radians, + = convex =
-    mountain); a scalar or an array, in Python or inside kernels. x * (180 / pi) is how
-    np.degrees rounds: the same bits."""
+    mountain); a scalar or an array. x * (180 / pi) is how np.degrees rounds: the same bits.
+    Kernels call its compiled form (`kernels.rho_to_fold_deg`)."""
     return -(rho * (180.0 / np.pi))
 
 
-@njit(cache=True)
 def fold_deg_to_rho(deg):
     """Signed fold angle rho (radians, + = mountain) of FOLD fold angles in degrees (valley
-    positive); the inverse of `rho_to_fold_deg` (np.radians rounds as x * (pi / 180))."""
+    positive); the inverse of `rho_to_fold_deg` (np.radians rounds as x * (pi / 180)). Kernels
+    call its compiled form (`kernels.fold_deg_to_rho`)."""
     return -(deg * (np.pi / 180.0))
 
 
 def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Unit normals (m, 3) of CCW faces; zero rows for degenerate faces."""
+    from . import kernels as MK
+
     return MK.face_normals(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
 
 
@@ -88,17 +87,22 @@ def row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Interior angle (m, 3) of each face at each corner (atan2 form, well conditioned)."""
-    a, b, y = MK.corner_vectors(np.ascontiguousarray(vertices, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64))
-    out = np.empty((y.shape[1], 3))
-    for k in range(3):  # one numpy call per corner, on the same (m,) layout as always
-        out[:, k] = np.arctan2(y[k], row_dots(a[k], b[k]))
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    out = np.empty((len(f), 3))
+    for k in range(3):  # one numpy call per corner
+        p = v[f[:, k]]
+        a, b = v[f[:, (k + 1) % 3]] - p, v[f[:, (k + 2) % 3]] - p
+        out[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), row_dots(a, b))
     return out
 
 
 def vertex_angle_sums(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Sum of corner angles at every vertex (n,)."""
-    faces = np.ascontiguousarray(faces, dtype=np.int64)
-    return MK.scatter_sums(len(vertices), faces.reshape(-1), corner_angles(vertices, faces).reshape(-1))
+    """Sum of corner angles at every vertex (n,), added in corner order (np.add.at: np.bincount's
+    sums differ in the last bits)."""
+    out = np.zeros(len(vertices))
+    np.add.at(out, np.asarray(faces, dtype=np.int64).reshape(-1), corner_angles(vertices, faces).reshape(-1))
+    return out
 
 
 def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) -> np.ndarray:
@@ -106,6 +110,8 @@ def edge_fold_angles(vertices: np.ndarray, faces: np.ndarray, topo: Topology) ->
 
     Positive on convex edges; 0 on boundary edges.
     """
+    from . import kernels as MK
+
     inner, cross, u, n0, n1 = MK.fold_angle_vectors(np.ascontiguousarray(vertices, dtype=np.float64),
                                                     np.ascontiguousarray(faces, dtype=np.int64), topo.edges, topo.edge_faces)
     rho = np.zeros(topo.n_edges)

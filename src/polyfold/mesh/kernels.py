@@ -1,5 +1,7 @@
-"""numba kernels behind `mesh.py`: the edge table and the per-corner / per-edge vectors of the
-geometric quantities.
+"""numba kernels of the mesh package: face normals and the per-edge vectors of fold angles
+(`geometry.py`), the compiled fold-angle conversions other stages' kernels call, and texture
+sampling (`appearance.py`). Imported where they are used: loading and checking a mesh compiles
+nothing (`polyfold info` starts without numba).
 
 The floating-point results must stay bitwise equal to the numpy formulas they replace, so the
 kernels only do what rounds the same way in both (differences, products, sums in numpy's order,
@@ -11,79 +13,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from . import geometry
 
-@njit(cache=True)
-def edge_table(faces):
-    """Edges of a triangle mesh, as `mesh.edge_topology` documents them.
-
-    faces (m, 3) int64 -> (edges (E, 2), edge_faces (E, 2), face_edges (m, 3), face_count (E,)).
-    Edges are numbered in lexicographic order of their sorted vertex pair (as np.unique of the
-    rows); slot 0 of an edge takes the first face (in face order) that runs it low -> high, slot 1
-    the first that runs it high -> low; a second face running the same way takes a free slot and
-    further faces are only counted (non-manifold input). Boundary edges keep their face in slot 0
-    and are flipped so that face runs edges[e, 0] -> edges[e, 1].
-    """
-    m = faces.shape[0]
-    n_d = 3 * m
-    lo = np.empty(n_d, dtype=np.int64)
-    hi = np.empty(n_d, dtype=np.int64)
-    forward = np.empty(n_d, dtype=np.bool_)
-    for f in range(m):
-        for k in range(3):
-            a = faces[f, k]
-            b = faces[f, (k + 1) % 3]
-            i = 3 * f + k
-            forward[i] = a <= b
-            lo[i] = min(a, b)
-            hi[i] = max(a, b)
-    # lexicographic (lo, hi) order, stable: hi first, then lo (both merge sorts)
-    by_hi = np.argsort(hi, kind="mergesort")
-    by_lo = np.argsort(lo[by_hi], kind="mergesort")
-    order = by_hi[by_lo]
-    inverse = np.empty(n_d, dtype=np.int64)
-    n_e = 0
-    for r in range(n_d):
-        i = order[r]
-        if r > 0:
-            j = order[r - 1]
-            if lo[i] != lo[j] or hi[i] != hi[j]:
-                n_e += 1
-        inverse[i] = n_e
-    if n_d > 0:
-        n_e += 1
-    edges = np.empty((n_e, 2), dtype=np.int64)
-    counts = np.zeros(n_e, dtype=np.int64)
-    edge_faces = np.full((n_e, 2), -1, dtype=np.int64)
-    start = 0
-    while start < n_d:
-        e = inverse[order[start]]
-        stop = start
-        while stop < n_d and inverse[order[stop]] == e:
-            stop += 1
-        edges[e, 0] = lo[order[start]]
-        edges[e, 1] = hi[order[start]]
-        counts[e] = stop - start
-        # faces running the edge low -> high first, each group in face order
-        for want in (True, False):
-            for r in range(start, stop):
-                i = order[r]
-                if forward[i] != want:
-                    continue
-                slot = 0 if want else 1
-                if edge_faces[e, slot] >= 0:
-                    slot = 1 - slot
-                    if edge_faces[e, slot] >= 0:
-                        continue
-                edge_faces[e, slot] = i // 3
-        start = stop
-    for e in range(n_e):
-        if edge_faces[e, 0] < 0 and edge_faces[e, 1] >= 0:
-            edge_faces[e, 0] = edge_faces[e, 1]
-            edge_faces[e, 1] = -1
-            a = edges[e, 0]
-            edges[e, 0] = edges[e, 1]
-            edges[e, 1] = a
-    return edges, edge_faces, inverse.reshape(m, 3), counts
+# geometry's conversions, compiled for kernels (one formula: the sign flips in geometry.py only)
+rho_to_fold_deg = njit(cache=True)(geometry.rho_to_fold_deg)
+fold_deg_to_rho = njit(cache=True)(geometry.fold_deg_to_rho)
 
 
 @njit(cache=True, inline="always")
@@ -92,38 +26,6 @@ def _cross_into(ax, ay, az, bx, by, bz, out, i):
     out[i, 0] = ay * bz - az * by
     out[i, 1] = az * bx - ax * bz
     out[i, 2] = ax * by - ay * bx
-
-
-@njit(cache=True)
-def corner_vectors(vertices, faces):
-    """Side vectors at every corner: a[k, f] = v[f, k+1] - v[f, k], b[k, f] = v[f, k+2] - v[f, k]
-    (k mod 3), both (3, m, 3), and y (3, m) = |a x b| (as np.linalg.norm(np.cross(a, b), axis=1))."""
-    m = faces.shape[0]
-    a = np.empty((3, m, 3))
-    b = np.empty((3, m, 3))
-    y = np.empty((3, m))
-    c = np.empty((1, 3))
-    for k in range(3):
-        for f in range(m):
-            p = faces[f, k]
-            q = faces[f, (k + 1) % 3]
-            r = faces[f, (k + 2) % 3]
-            for i in range(3):
-                a[k, f, i] = vertices[q, i] - vertices[p, i]
-                b[k, f, i] = vertices[r, i] - vertices[p, i]
-            _cross_into(a[k, f, 0], a[k, f, 1], a[k, f, 2], b[k, f, 0], b[k, f, 1], b[k, f, 2], c, 0)
-            y[k, f] = np.sqrt(c[0, 0] * c[0, 0] + c[0, 1] * c[0, 1] + c[0, 2] * c[0, 2])
-    return a, b, y
-
-
-@njit(cache=True)
-def scatter_sums(n, index, values):
-    """out (n,): out[index[i]] += values[i] in order of i (the sums of np.add.at; np.bincount's
-    differ in the last bits)."""
-    out = np.zeros(n)
-    for i in range(index.shape[0]):
-        out[index[i]] += values[i]
-    return out
 
 
 @njit(cache=True)
@@ -176,3 +78,33 @@ def fold_angle_vectors(vertices, faces, edges, edge_faces):
         _cross_into(n0[i, 0], n0[i, 1], n0[i, 2], n1[i, 0], n1[i, 1], n1[i, 2], cr, i)
         i += 1
     return inner, cr, u, n0, n1
+
+
+@njit(cache=True)
+def texel(image, x, y):
+    """The bilinear colour (3 floats, 0..255) of `image` (h, w, 3) uint8 at texel coordinates
+    (x, y), the image repeating outside."""
+    h, w = image.shape[0], image.shape[1]
+    fx, fy = np.floor(x), np.floor(y)
+    ax, ay = x - fx, y - fy
+    x0, y0 = int(fx) % w, int(fy) % h
+    x1, y1 = (x0 + 1) % w, (y0 + 1) % h
+    r = np.empty(3)
+    for c in range(3):
+        top = image[y0, x0, c] * (1.0 - ax) + image[y0, x1, c] * ax
+        bottom = image[y1, x0, c] * (1.0 - ax) + image[y1, x1, c] * ax
+        r[c] = top * (1.0 - ay) + bottom * ay
+    return r
+
+
+@njit(cache=True)
+def sample_many(image, xy, out):
+    """out (N, 3) uint8: the `texel` colours of `image` at texel coordinates xy (N, 2) (rounded),
+    white where a coordinate is not finite (`appearance.sample_texture`)."""
+    for i in range(xy.shape[0]):
+        if not (np.isfinite(xy[i, 0]) and np.isfinite(xy[i, 1])):
+            out[i, :] = 255
+            continue
+        c = texel(image, xy[i, 0], xy[i, 1])
+        for k in range(3):
+            out[i, k] = min(255, max(0, int(c[k] + 0.5)))

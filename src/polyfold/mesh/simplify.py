@@ -25,7 +25,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import PolyfoldError
-from .flat import merge_flat
 from .geometry import face_areas
 from .mesh import Mesh
 from .repair import LoadedMesh, RawMesh, repair
@@ -186,6 +185,8 @@ def simplify(loaded: LoadedMesh, faces: int) -> Simplified:
         return len(tris) > 1.05 * faces, int((angles < SLIVER_DEG).sum()), -float(angles.min(initial=180.0))
 
     diag = float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
+    from .flat import merge_flat  # (a compiled kernel: loaded only when a mesh is simplified)
+
     flat = merge_flat(mesh)  # flat regions whole first: exact, and the collapse does badly on them
     used, tris = np.unique(flat.faces, return_inverse=True)
     points, tris = flat.vertices[used], tris.reshape(-1, 3)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..mesh.geometry import rho_to_fold_deg
+from ..mesh.kernels import rho_to_fold_deg
 
 
 @njit(cache=True)
