@@ -105,7 +105,7 @@ def overlapping_pairs(tris: np.ndarray, parent: np.ndarray, tol: float, max_pair
 @njit(cache=True)
 def all_overlapping_pairs(tris: np.ndarray, parent: np.ndarray, tol: float) -> np.ndarray:
     """Every overlapping pair (k, 2) of `overlapping_pairs` (one sweep counts, a second collects)."""
-    count, pairs = overlapping_pairs(tris, parent, tol, 0)
+    count, pairs = overlapping_pairs(tris, parent, tol, np.int64(0))  # (a literal 0 compiles it twice)
     if count:
         count, pairs = overlapping_pairs(tris, parent, tol, count)
     return pairs

@@ -105,17 +105,17 @@ def _hull_at(p, rel_eps):
     if ext <= 0:
         return empty_v, empty_e
     # initial tetrahedron: extreme x, farthest from it, farthest from their line, farthest from the plane
-    i0 = 0
+    i0 = np.int64(0)  # (int64 from the start: literals compile the helpers they reach twice)
     for i in range(1, n):
         if p[i0, 0] == p[i0, 0] and (p[i, 0] < p[i0, 0] or p[i, 0] != p[i, 0]):
             i0 = i
-    i1, best = -1, -1.0
+    i1, best = np.int64(-1), -1.0
     for i in range(n):
         d = (p[i, 0] - p[i0, 0]) ** 2 + (p[i, 1] - p[i0, 1]) ** 2 + (p[i, 2] - p[i0, 2]) ** 2
         if d > best:
             best, i1 = d, i
     d01 = math.sqrt(best)
-    i2, best = -1, -1.0
+    i2, best = np.int64(-1), -1.0
     for i in range(n):
         nx, ny, nz, d, ln = _plane(p, i0, i1, i)
         if ln > best:
@@ -134,7 +134,7 @@ def _hull_at(p, rel_eps):
     F = np.empty((cap, 3), dtype=np.int64)
     E = np.empty((cap, 4))
     alive = np.zeros(cap, dtype=np.bool_)
-    nf = 0
+    nf = np.int64(0)
     if best > 0:  # i3 above the plane (i0, i1, i2): orient that face downwards
         i1, i2 = i2, i1
     for a, b, c in ((i0, i1, i2), (i0, i3, i1), (i1, i3, i2), (i2, i3, i0)):
@@ -283,7 +283,7 @@ def depth_chain(pts, pstart, unxt, ua, ub, eq, limit):
 @njit(cache=True)
 def max_depth(pts, eq, limit):
     """max_i min_j -(eq[j, :3] . pts[i] + eq[j, 3]) (>= 0); stops early once it exceeds `limit`."""
-    return depth_chain(pts, np.array([0, pts.shape[0]]), np.array([-1]), 0, -1, eq, limit)
+    return depth_chain(pts, np.array([0, pts.shape[0]]), np.array([-1]), np.int64(0), np.int64(-1), eq, limit)
 
 
 @njit(cache=True)

@@ -99,8 +99,8 @@ def _heap_pop(hc, he, hi, hj, size):
     """Remove the smallest entry (moved to index `size - 1` for the caller to read): the new size.
     (The sift-down is written out here, not called: see the module docstring.)"""
     size -= 1
-    _swap(hc, he, hi, hj, 0, size)
-    k = 0
+    _swap(hc, he, hi, hj, np.int64(0), size)
+    k = np.int64(0)
     settled = False
     while not settled:
         c = 2 * k + 1
@@ -118,7 +118,7 @@ def _heap_pop(hc, he, hi, hj, size):
 def _heap_compact(hc, he, hi, hj, size, alive):
     """Drop the entries of merged clusters and rebuild the heap in place: the new size. Each pair
     of live clusters has at most one entry, so at most as many remain as there are live pairs."""
-    n = 0
+    n = np.int64(0)
     for k in range(size):
         if alive[hi[k]] and alive[hj[k]]:
             hc[n], he[n], hi[n], hj[n] = hc[k], he[k], hi[k], hj[k]
@@ -147,7 +147,7 @@ def _adjacency(label, n, ef0, ef1, edge_len, conc_w, cap):
     conc_len = np.empty(m + 1)
     table = np.full(pow2(2 * m + 2), -1, dtype=np.int64)
     deg = np.zeros(cap, dtype=np.int64)
-    n_pairs = 0
+    n_pairs = np.int64(0)
     for e in range(m):
         x, y = label[ef0[e]], label[ef1[e]]
         if x != y:
@@ -184,7 +184,7 @@ def _adjacency(label, n, ef0, ef1, edge_len, conc_w, cap):
 @njit(cache=True)
 def _nb_compact(nb_lo, nb_n, nb_id, nb_slot, alive, n):
     """Move the lists of the live clusters among 0..n-1 to the front of the pool: its new end."""
-    end = 0
+    end = np.int64(0)
     for c in range(n):
         if alive[c]:
             lo = nb_lo[c]
@@ -305,7 +305,7 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
     utail = np.full(cap, -1, dtype=np.int64)
     unxt = np.full(unit_conc.shape[0], -1, dtype=np.int64)
     label = np.empty(n_fm, dtype=np.int64)
-    nid = 0
+    nid = np.int64(0)
     for s in range(seed_unit.shape[0]):
         u0 = seed_unit[s]
         lo, hi = (sub_lo[s], sub_hi[s]) if unit_conc[u0] > limit else (u0, u0 + 1)
@@ -333,14 +333,14 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
     # Each live pair has at most one entry, so compacting makes room for any cluster's pushes.
     h_cap = 2 * n_pairs + 64
     hc, he, hi_, hj = np.empty(h_cap), np.empty(h_cap, np.int64), np.empty(h_cap, np.int64), np.empty(h_cap, np.int64)
-    size = 0
+    size = np.int64(0)
     for i in range(nid):
         for t in range(nb_lo[i], nb_lo[i] + nb_n[i]):
             j = nb_id[t]
             if i < j and max(conc[i], conc[j]) <= limit:
                 s = nb_slot[t]
                 cst = _cost(i, j, shared[s], conc_len[s], max(conc[i], conc[j]), area, perim, w_compact, w_seam, scale)
-                size = _heap_push(hc, he, hi_, hj, size, cst, 0, i, j)
+                size = _heap_push(hc, he, hi_, hj, size, cst, np.int64(0), i, j)
     stop = 1 if target < 0 else target
     n_alive = nid
     ok = True
@@ -359,7 +359,7 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
                     cst = _cost(i, j, shared[s], conc_len[s], m_conc[u], area, perim, w_compact, w_seam, scale)
                     if size + 1 > h_cap:
                         size = _heap_compact(hc, he, hi_, hj, size, alive)
-                    size = _heap_push(hc, he, hi_, hj, size, cst, 1, i, j)
+                    size = _heap_push(hc, he, hi_, hj, size, cst, np.int64(1), i, j)
             elif ok:
                 c = nid
                 nid += 1
@@ -375,7 +375,7 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
                     if max(conc[c], conc[j]) <= limit:
                         s = nb_slot[t]
                         cst = _cost(c, j, shared[s], conc_len[s], max(conc[c], conc[j]), area, perim, w_compact, w_seam, scale)
-                        size = _heap_push(hc, he, hi_, hj, size, cst, 0, c, j)
+                        size = _heap_push(hc, he, hi_, hj, size, cst, np.int64(0), c, j)
 
     # small parts join the neighbour with the cheapest admissible merge
     changed = True
@@ -383,12 +383,12 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
         changed = False
         ids = np.flatnonzero(alive[:nid])
         order = np.argsort(n_faces[ids], kind="mergesort")  # stable: ties in id order
-        t = 0
+        t = np.int64(0)
         while t < order.shape[0] and not changed and ok:
             i = ids[order[t]]
             t += 1
             if n_faces[i] < min_faces:
-                best_j, best_c, best_u = -1, 0.0, -1
+                best_j, best_c, best_u = np.int64(-1), 0.0, np.int64(-1)
                 for q in range(nb_lo[i], nb_lo[i] + nb_n[i]):
                     j = nb_id[q]
                     u, bk = memo_lookup(i, j, limit, key, table, keys, m_conc, m_exact)

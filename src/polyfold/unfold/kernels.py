@@ -81,8 +81,8 @@ def prim_tree(weights, base, adj_ptr, adj_face, adj_edge, parent, parent_edge, o
     hp = np.empty(cap, dtype=np.int64)
     he = np.empty(cap, dtype=np.int64)
     done = np.zeros(n, dtype=np.bool_)
-    size = 0
-    counter = 0
+    size = np.int64(0)  # (int64 from the start: a literal 0 compiled the heap's helpers twice)
+    counter = np.int64(0)
     parent[base] = -1
     parent_edge[base] = -1
     done[base] = True
@@ -228,8 +228,8 @@ def tree_from_creases(crease, base, adj_ptr, adj_face, adj_edge, parent, parent_
     order[0] = base
     reached = np.zeros(n, dtype=np.int64)
     reached[base] = 1
-    return crease_bfs(crease, np.ones(n, dtype=np.bool_), reached, 1, adj_ptr, adj_face, adj_edge, parent,
-                      parent_edge, order, 0)
+    return crease_bfs(crease, np.ones(n, dtype=np.bool_), reached, np.int64(1), adj_ptr, adj_face, adj_edge, parent,
+                      parent_edge, order, np.int64(0))
 
 
 @njit(cache=True)
@@ -338,9 +338,9 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                 sub[n_sub] = y
                 n_sub += 1
         # reservoir-sample a reconnecting cut edge, and one at an end of c (NEAR_MOVES)
-        pick = -1
+        pick = np.int64(-1)  # (not a literal: see prim_tree's size)
         seen = 0
-        near_pick = -1
+        near_pick = np.int64(-1)
         near_seen = 0
         for e in range(n_e):
             if crease[e] or e == c or merged[e]:
@@ -414,7 +414,7 @@ def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_fa
     reached). new_order: the other faces in `order`'s order, then the subtree's in BFS order (parents
     first). Returns the number of other faces."""
     hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
-    n_rest = 0
+    n_rest = np.int64(0)  # (not a literal: see prim_tree's size)
     for idx in range(order.shape[0]):
         if not in_sub[order[idx]]:
             new_order[n_rest] = order[idx]

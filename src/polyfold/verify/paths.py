@@ -303,7 +303,7 @@ def _slab_overlap(T, f, g, nf, lf, w, tol, feats, nfeat, reach, buf, gshared):
     px, py, pz, qx, qy, qz = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5]
     for k in range(3):
         px[k], py[k], pz[k] = T[g, k, 0], T[g, k, 1], T[g, k, 2]
-    n = _clip(px, py, pz, qx, qy, qz, 3, nf, o, w, 1.0)
+    n = _clip(px, py, pz, qx, qy, qz, np.int64(3), nf, o, w, 1.0)  # (a literal 3 compiles _clip twice)
     n = _clip(px, py, pz, qx, qy, qz, n, nf, o, w, -1.0)
     if n < 3:
         return False
