@@ -69,3 +69,41 @@ def test_a_label_beside_its_edge_is_nearer_that_edge_than_any_other() -> None:
         assert from_a < from_b
     else:  # a leader from A's middle to the label
         assert LineString([a.p0, a.p1]).distance(Point(*labels.leaders[0][0])) < 1e-9
+
+
+@pytest.mark.parametrize("name,size,paper", [("bunny-128", 150.0, "a4"), ("fish-472", 60.0, "80x80mm")])
+def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, name, size, paper) -> None:
+    """`pieces._labels` places each piece on its own, in forked processes from PARALLEL_LABELS
+    labels on: the sheets are the same as in one process, when every edge gets its label (the
+    bunny) and when that fails and seam runs are labelled instead (the fish at 60 mm, cut to fit
+    80 mm pages: 11 pieces)."""
+    import shapely
+
+    from polyfold.deadline import Deadline
+    from polyfold.fabricate import pieces as P
+    from polyfold.fabricate.fit import model_scale
+    from polyfold.formats.meshes import load_mesh
+    from polyfold.pipeline.options import MakeOptions, paper_size
+    from polyfold.pipeline.parts import make_parts
+    from polyfold.pipeline.sheets import fit_parts, pack_box, part_piece_inputs
+
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    opts = MakeOptions(size=size, paper=paper)
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    fitted, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts), name)
+    inputs = part_piece_inputs(mesh, fitted)
+
+    def sheet(workers: int):
+        monkeypatch.setattr(P, "PARALLEL_LABELS", 0)
+        monkeypatch.setattr("polyfold.processes.usable_cores", lambda: workers)
+        pieces, glue, stats = P.build_sheet_pieces(inputs, scale)
+        for i, piece in enumerate(pieces[:len(inputs)]):  # every piece got its own labels
+            assert [t.text for t in piece.texts if t.kind == "piece-label"] == [P.piece_name(i)]
+        return ([(p.texts, p.leaders.tobytes(), shapely.to_wkb(p.outline), shapely.to_wkb(p.footprint)) for p in pieces],
+                [(g.label, g.printed) for g in glue], stats)
+
+    one, many = sheet(1), sheet(3)
+    assert len(inputs) >= 3 and sum(len(p[0]) for p in one[0]) > len(inputs)  # names and glue labels
+    assert one == many
+    assert (one[2].seam_runs > 0) == (name == "fish-472")

@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from ..processes import usable_cores
+
 if TYPE_CHECKING:
     import subprocess
 
@@ -233,13 +235,6 @@ def compile_beside() -> "Beside | None":
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
         return Beside(("fold-plan",), ("fold-check",), "fold")
     return None
-
-
-def usable_cores() -> int:
-    """The cores this process may run on (its affinity, as `taskset` sets it, where the OS says)."""
-    import os
-
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def start_sections(names: tuple[str, ...] | list[str], capture: bool) -> "subprocess.Popen":

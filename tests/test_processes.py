@@ -1,0 +1,42 @@
+"""processes.py: `fork_map` runs a function over items in forked processes, in order, and raises
+what it raises; `usable_cores` counts this process's cores."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from polyfold.errors import OutOfTime
+from polyfold.processes import fork_map, usable_cores
+
+BIG = np.arange(1_000_000)  # read by the children through the fork, never pickled
+
+
+def test_results_in_order_computed_in_other_processes() -> None:
+    got = fork_map(lambda i: (i, int(BIG[i * 1000]), os.getpid()), list(range(12)), 3)
+    assert [g[:2] for g in got] == [(i, i * 1000) for i in range(12)]
+    if os.uname().sysname == "Linux":
+        assert os.getpid() not in {g[2] for g in got}  # forked workers did the work
+
+
+def test_serial_when_one_worker_or_one_item() -> None:
+    for items, workers in (([1, 2, 3], 1), ([5], 4), ([], 4)):
+        assert [g[1] for g in fork_map(lambda x: (x, os.getpid()), items, workers)] == [os.getpid()] * len(items)
+
+
+def test_an_exception_in_a_worker_is_raised_here() -> None:
+    def fn(x):
+        if x == 3:
+            raise OutOfTime("out of time", "placing labels")
+        return x
+
+    with pytest.raises(OutOfTime) as err:
+        fork_map(fn, list(range(6)), 2)
+    assert err.value.doing == "placing labels"
+
+
+def test_usable_cores() -> None:
+    n = usable_cores()
+    assert 1 <= n <= (os.cpu_count() or 1)
