@@ -299,9 +299,9 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
 
 
 # glue labels to place from which `_labels` places pieces in parallel (forked processes, one piece
-# at a time each): below it the pool's start (tens of ms) costs more than it saves. The 1,280-face
-# sphere places about 3,800 per drawing (3 s in one process), the bunny 150 (0.1 s).
-PARALLEL_LABELS = 400
+# at a time each): a pool costs 15-20 ms (the bunny, 136 labels: 0.128 s in one process, 0.141 s
+# in two), and horse-302 (308) gains 0.69 -> 0.58 s, fish-472 (478) 1.78 -> 1.15 s here
+PARALLEL_LABELS = 250
 
 
 @dataclass(frozen=True, eq=False)
