@@ -93,9 +93,14 @@ def dxf_document(page: Page):
     return doc
 
 
-def write_dxf_page(page: Page, path: str | os.PathLike) -> None:
-    """Write one page as a DXF file (R2010, mm, layers CUT / MOUNTAIN / VALLEY / LABELS) to
-    `path`, atomically."""
+def dxf_string(page: Page) -> str:
+    """One page as DXF text (R2010, mm, layers CUT / MOUNTAIN / VALLEY / LABELS): what a .dxf file
+    holds (R2007+ DXF is UTF-8 text)."""
     buf = _io.StringIO()
-    dxf_document(page).write(buf)  # R2007+ DXF is UTF-8 text; atomic_write encodes it as such
-    atomic_write(path, buf.getvalue())
+    dxf_document(page).write(buf)
+    return buf.getvalue()
+
+
+def write_dxf_page(page: Page, path: str | os.PathLike) -> None:
+    """Write one page as a DXF file (`dxf_string`) to `path`, atomically."""
+    atomic_write(path, dxf_string(page))
