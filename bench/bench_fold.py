@@ -92,8 +92,6 @@ def collision_table() -> None:
     """Print us per configuration of the collision test (see the module docstring)."""
     import math
 
-    from numba import njit
-
     from polyfold.fold.checker import segment_free
     from polyfold.fold.checker import collision_work, segment_collides
     from polyfold.segment.segment import segment

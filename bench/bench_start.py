@@ -2,9 +2,10 @@
 
     .venv/bin/python bench/bench_start.py [--skip-cold] [--sizes 128,1500,5000]
 
-Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-clock, with its
-peak resident memory (the child's own rusage). Cold rows use an empty numba cache of their own
-($NUMBA_CACHE_DIR in a temporary folder, so the project's cache is left alone):
+Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-clock, with the
+peak memory of it and the processes it starts (PSS, sampled: pages they share counted once).
+Cold rows use an empty numba cache of their own ($NUMBA_CACHE_DIR in a temporary folder, so the
+project's cache is left alone):
 
 - cold make: `polyfold make` of bunny-128 with nothing compiled (a bare `pip install`), as it
   runs (two or more cores: the fold stage's kernels compile in a second process, `warmup.Beside`)
@@ -35,17 +36,51 @@ CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "p
 BUNNY = ROOT / "examples" / "bunny-128.obj"
 
 
+def _tree_pss_mb(pid: int) -> float:
+    """Proportional set size (MB) of process `pid` and its descendants (Linux /proc; 0 elsewhere):
+    pages the forked workers share with make count once, split between them."""
+    def tree(p: int) -> list[int]:
+        try:
+            kids = open(f"/proc/{p}/task/{p}/children").read().split()
+        except OSError:
+            return [p]
+        return [p] + [q for k in kids for q in tree(int(k))]
+
+    total = 0.0
+    for p in tree(pid):
+        try:
+            with open(f"/proc/{p}/smaps_rollup") as f:
+                total += next(int(line.split()[1]) for line in f if line.startswith("Pss:")) / 1024.0
+        except (OSError, StopIteration):
+            pass
+    return total
+
+
 def run(args: list[str], env: dict | None = None, prefix: list[str] = []) -> tuple[float, float, int]:
-    """(wall seconds, peak RSS MB, exit code) of one CLI process (run under `prefix`, e.g. taskset)."""
+    """(wall seconds, peak memory MB, exit code) of one CLI process (run under `prefix`, e.g.
+    taskset). Memory: the peak of its process tree's PSS (make's forked workers included), sampled
+    every 0.1 s; where /proc cannot say, the process's own peak RSS."""
+    import threading
+
     t0 = time.perf_counter()
     proc = subprocess.Popen(prefix + CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    peak, done = [0.0], threading.Event()
+
+    def sample() -> None:
+        while not done.wait(0.1):  # (reading smaps costs: rarer samples keep it out of the times)
+            peak[0] = max(peak[0], _tree_pss_mb(proc.pid))
+
+    watcher = threading.Thread(target=sample, daemon=True)
+    watcher.start()
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
+    done.set()
+    watcher.join()
     proc.returncode = os.waitstatus_to_exitcode(status)
     err = proc.stderr.read().decode() if proc.stderr else ""
     if proc.returncode != 0:
         print(f"  ! {' '.join(args)}: exit {proc.returncode}: {err.strip().splitlines()[-1:]}", file=sys.stderr)
-    return wall, usage.ru_maxrss / 1024.0, proc.returncode
+    return wall, peak[0] or usage.ru_maxrss / 1024.0, proc.returncode
 
 
 def stages(out: Path) -> dict[str, float]:
@@ -80,7 +115,7 @@ def main() -> None:
         wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env)
         cold_report = json.loads((tmp / "cold" / "report.json").read_text())
         rows.append(("cold make bunny-128 (bare pip install)", wall, mb,
-                     "the fold stage's kernels compile in a second process meanwhile (its memory not counted)"))
+                     "the fold stage's kernels compile in a second process meanwhile (its memory counted)"))
         if shutil.which("taskset"):  # the same on one core: one process compiles everything
             env1 = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold-1"))
             wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold1"), "-q"], env1, ["taskset", "-c", "0"])
