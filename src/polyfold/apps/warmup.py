@@ -3,8 +3,8 @@ real command does not wait for them.
 
 numba compiles a kernel the first time a process calls it and keeps the machine code in its cache
 (`__pycache__` beside the sources, or $NUMBA_CACHE_DIR); later processes load it in milliseconds.
-Without this step a fresh install spends its first `polyfold make` compiling: about 45 s of a
-bunny's 47 s on a 2-core machine. `make setup` runs it once (README "Set-up").
+Without this step a fresh install spends its first `polyfold make` compiling: about 28 s of a
+bunny's 31 s on a 2-core machine (57 s of compiling shared by two processes). `make setup` runs it once (README "Set-up").
 
 In: nothing (generated bumpy spheres of 80 and 320 faces, seeded, so no file is needed). Out:
 seconds per stage. Every stage of `make` runs once (load, check, segment, unfold, fold, sheets,
@@ -181,7 +181,7 @@ WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs
 # inflation's kernels share little with make's, so the two halves take about as long (a fresh
 # machine: 61 + 10 s against 32 + 7 s; 110 s in one process)
 SECOND_PROCESS = ("segment", "inflate")
-BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section takes 40-45 s here)
+BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section takes 25-30 s here)
 
 
 class Beside:
@@ -190,7 +190,7 @@ class Beside:
     planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
     path check (`fold-check`) itself if the planners are still compiling, then waits for them, and
     loads both from the cache instead of compiling them. The fold stage's kernels are the largest
-    share of a first run's compiling (40 of 65 s for the bunny here) and share little with the
+    share of a first run's compiling (about 31 of 57 s for the bunny here) and share little with the
     stages before it, which this process compiles meanwhile. If the second process fails, this
     one compiles what it needs as usual. Use as a context manager (the process is stopped on the
     way out)."""
