@@ -40,3 +40,16 @@ def test_an_exception_in_a_worker_is_raised_here() -> None:
 def test_usable_cores() -> None:
     n = usable_cores()
     assert 1 <= n <= (os.cpu_count() or 1)
+
+
+def test_a_dead_worker_does_not_hang_the_work() -> None:
+    """A worker killed mid-item (here: os._exit in a child) breaks the pool; the items are then
+    done in this process, and nothing waits for the dead one."""
+    parent = os.getpid()
+
+    def fn(x):
+        if x == 2 and os.getpid() != parent:
+            os._exit(1)
+        return x * x
+
+    assert fork_map(fn, list(range(5)), 2) == [0, 1, 4, 9, 16]

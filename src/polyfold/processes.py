@@ -31,16 +31,22 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     inherited by the fork, not pickled; each item and result is pickled. fn must not depend on
     side effects of other calls (each child changes only its own copy of memory). An exception
     raised by fn is raised here. Runs here, in order, when workers or items are fewer than two, on
-    other systems than Linux, or in a daemonic process (which may not have children)."""
+    other systems than Linux, in a daemonic process (which may not have children), or when no
+    pool can be made (no /dev/shm for its locks); when a worker dies (killed, out of memory) the
+    items are done here instead of waiting for it forever."""
     import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
 
     global _TASK
     workers = min(workers, len(items))
     if workers < 2 or not sys.platform.startswith("linux") or mp.current_process().daemon:
         return [fn(x) for x in items]
-    _TASK = fn
+    _TASK = fn  # (set before the workers fork: they start when the items are handed out)
     try:
-        with mp.get_context("fork").Pool(workers) as pool:
-            return pool.map(_call, items, chunksize=1)
+        with ProcessPoolExecutor(workers, mp_context=mp.get_context("fork")) as pool:
+            return list(pool.map(_call, items))
+    except (OSError, BrokenProcessPool):
+        return [fn(x) for x in items]
     finally:
         _TASK = None
