@@ -42,11 +42,15 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     workers = min(workers, len(items))
     if workers < 2 or not sys.platform.startswith("linux") or mp.current_process().daemon:
         return [fn(x) for x in items]
+    try:
+        pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"))
+    except OSError:  # its queues' locks need /dev/shm (an error raised by fn is not caught here)
+        return [fn(x) for x in items]
     _TASK = fn  # (set before the workers fork: they start when the items are handed out)
     try:
-        with ProcessPoolExecutor(workers, mp_context=mp.get_context("fork")) as pool:
+        with pool:
             return list(pool.map(_call, items))
-    except (OSError, BrokenProcessPool):
+    except BrokenProcessPool:
         return [fn(x) for x in items]
     finally:
         _TASK = None

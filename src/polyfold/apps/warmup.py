@@ -4,7 +4,8 @@ real command does not wait for them.
 numba compiles a kernel the first time a process calls it and keeps the machine code in its cache
 (`__pycache__` beside the sources, or $NUMBA_CACHE_DIR); later processes load it in milliseconds.
 Without this step a fresh install spends its first `polyfold make` compiling: about 28 s of a
-bunny's 31 s on a 2-core machine (57 s of compiling shared by two processes). `make setup` runs it once (README "Set-up").
+bunny's 31 s on a 2-core machine (57 s of compiling shared by two processes). `make setup` runs
+it once (README "Set-up").
 
 In: nothing (generated bumpy spheres of 80 and 320 faces, seeded, so no file is needed). Out:
 seconds per stage. Every stage of `make` runs once (load, check, segment, unfold, fold, sheets,

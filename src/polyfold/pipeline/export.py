@@ -139,6 +139,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
 
     pages, printed = sheet_pages(sheets, model, opts, look)
     rows = piece_reports(folded, sheets)
+    svgs = [f"sheet-{k + 1:02d}.svg" for k in range(len(pages))]  # (instructions.html shows them)
 
     def guide_files() -> tuple[str, str, bytes | None, GuideReport | None]:
         """assembly.json, instructions.html, guide.pdf and the guide's report (no guide: None)."""
@@ -147,7 +148,6 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             from ..guide.guide import build_guide
 
             guide = build_guide(mesh, sheets.pieces, sheets.glue, sheets.page_of_piece(), folded, sheets.scale)
-        svgs = [f"sheet-{k + 1:02d}.svg" for k in range(len(pages))]
         html = instructions_html(model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue,
                                  sheets.page_of_piece(), sheets.packing.n_pages, opts, svgs, guide, contacts)
         guide_pdf, guide_report = None, None
@@ -166,7 +166,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         """sheets.pdf, then per page its SVG, cut SVG and DXF: (name, contents)."""
         out: list[tuple[str, str | bytes]] = [("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))]
         for k, page in enumerate(pages):
-            out += [(f"sheet-{k + 1:02d}.svg", svg_page_string(page)), (f"cut-{k + 1:02d}.svg", cut_svg_string(page)),
+            out += [(svgs[k], svg_page_string(page)), (f"cut-{k + 1:02d}.svg", cut_svg_string(page)),
                     (f"sheet-{k + 1:02d}.dxf", dxf_string(page))]
         return out
 
