@@ -298,6 +298,7 @@ class _Taken:
         self.texts = np.zeros_like(self.grid)  # the labels alone (a leader may not cross them)
         self._last = np.array([nx - 1, ny - 1], dtype=np.int32)
         self._free: dict[tuple[int, int], np.ndarray] = {}  # `free`'s maps by half box size in cells
+        self._pending: list[tuple[object, float, bool]] = []  # (geometry, grow, into texts) to mark: `_flush`
         # face sides: points every half cell along them, then grown by a disc
         tri = shapely.get_coordinates(np.asarray(labels.room.faces, dtype=object)).reshape(-1, 4, 2)[:, :3]
         a, b = tri.reshape(-1, 2), np.roll(tri, -1, axis=1).reshape(-1, 2)
@@ -333,51 +334,74 @@ class _Taken:
     def mark(self, geom, grow: float, text: bool = False) -> None:
         """Mark the cells whose centres lie in `geom` grown by `grow` mm; a label's box (`text`)
         also in `texts`, grown by half the step between a leader's points and half a cell's
-        diagonal beyond LEADER_HALF_MM, as a leader is looked up at the cells of its points."""
-        self._fill(self.grid, geom, grow)
+        diagonal beyond LEADER_HALF_MM, as a leader is looked up at the cells of its points.
+        (Marked when the raster is next read: `_flush`.)"""
+        self._pending.append((geom, grow, False))
         if text:
-            self._fill(self.texts, geom, LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM)
+            self._pending.append((geom, LEADER_HALF_MM + 0.5 * LEADER_STEP_MM + 0.71 * FREE_CELL_MM, True))
 
     def close(self, geom) -> None:
         """No later leader path through the cells at `geom` (a bent leader's turns: `routed_near`
         paths go around them; labels may still sit beside them)."""
-        self._fill(self.texts, geom, 0.5 * FREE_CELL_MM)
+        self._pending.append((geom, 0.5 * FREE_CELL_MM, True))
 
-    def _fill(self, grid: np.ndarray, geom, grow: float) -> None:
+    def _flush(self) -> None:
+        """Mark what `mark` and `close` were given since the last flush, all at once (a piece places
+        a hundred labels beside their edges between two searches of the raster): each geometry
+        grown (shapely's buffer, quad_segs=2) and rasterised by its cells' centres over its bounds
+        (`pack.fill_inside`); then `free`'s maps again where cells were taken."""
+        if not self._pending:
+            return
         import shapely
 
-        g = geom.buffer(grow, quad_segs=2)
-        x0, y0, x1, y1 = g.bounds
-        (c0, r0), (c1, r1) = self._cells(np.array([[x0, y0], [x1, y1]]))
-        cx = self.origin[0] + (np.arange(c0, c1 + 1) + 0.5) * FREE_CELL_MM
-        cy = self.origin[1] + (np.arange(r0, r1 + 1) + 0.5) * FREE_CELL_MM
-        gx, gy = np.meshgrid(cx, cy)
-        grid[r0:r1 + 1, c0:c1 + 1] |= shapely.contains_xy(g, gx, gy)
-        if grid is self.grid:
-            self._refresh(r0, r1, c0, c1)
+        from .pack import fill_inside, ring_edges
+
+        geoms, grows, to_texts = (np.array(v, dtype=t) for v, t in zip(zip(*self._pending), (object, float, bool)))
+        self._pending = []
+        grown = shapely.buffer(geoms, grows, quad_segs=2)
+        bounds = shapely.bounds(grown)
+        (c0, r0), (c1, r1) = self._cells(bounds[:, :2]).T, self._cells(bounds[:, 2:]).T
+        windows = np.stack([r0, r1, c0, c1], axis=1).astype(np.int64)
+        for target, chosen in ((self.grid, ~to_texts), (self.texts, to_texts)):
+            if not chosen.any():
+                continue
+            p0, p1, owner = ring_edges(grown[chosen])
+            start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1)).astype(np.int64)
+            scale = 1.0 / FREE_CELL_MM
+            fill_inside(target, (p0 - self.origin) * scale, (p1 - self.origin) * scale, start, windows[chosen])
+        if (~to_texts).any():
+            self._refresh(windows[~to_texts])
 
     def free(self, w: float, h: float) -> np.ndarray:
         """(ny, nx) `_free_centres` of the whole raster for w x h mm boxes, kept up to date as
         cells are taken (`_refresh`): a label is looked for a dozen times between two placements."""
+        self._flush()
         key = (_half_cells(w), _half_cells(h))
         if key not in self._free:
             self._free[key] = _free_centres(self.grid, w, h)
         return self._free[key]
 
-    def _refresh(self, r0: int, r1: int, c0: int, c1: int) -> None:
-        """`free` again where cells r0..r1 x c0..c1 may have been taken: at the centres whose boxes
-        reach them, from the cells those boxes cover."""
+    def _refresh(self, windows: np.ndarray) -> None:
+        """`free` again where the cells of `windows` (k, 4: first and last row, first and last
+        column) may have been taken: at the centres whose boxes reach them, from the cells those
+        boxes cover; the whole map at once when that is less work."""
         ny, nx = self.grid.shape
         for (hw, hh), free in self._free.items():
-            t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
-            s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
-            part = _free_centres(self.grid[s0:s1 + 1, v0:v1 + 1], (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
-            free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
+            near = (windows[:, 1] - windows[:, 0] + 1 + 4 * hh) * (windows[:, 3] - windows[:, 2] + 1 + 4 * hw)
+            if near.sum() > ny * nx:
+                free[:] = _free_centres(self.grid, (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
+                continue
+            for r0, r1, c0, c1 in windows.tolist():
+                t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
+                s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
+                part = _free_centres(self.grid[s0:s1 + 1, v0:v1 + 1], (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
+                free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
 
     def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
         """Centres (up to want, 2) of level w x h mm boxes that touch no taken cell and whose
         leader from p crosses no label, within ELSEWHERE_MM of p, nearest first; centred in a
         face (`inside`) or off the faces."""
+        self._flush()
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         if self.grid[r0:r1 + 1, c0:c1 + 1].all():
             return np.zeros((0, 2))
@@ -409,6 +433,7 @@ class _Taken:
         over 8 neighbours up to ELSEWHERE_MM long. Up to `want`, nearest along the path first:
         (index into sizes, centre, the leader's points from p to the centre, kept at its turns:
         each stretch is clear of labels), each path made when asked for."""
+        self._flush()
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         free = ~self.texts[r0:r1 + 1, c0:c1 + 1]
         sc, sr = self._cells(p[None])[0] - (c0, r0)
@@ -430,6 +455,7 @@ class _Taken:
     def _turns(self, pts: np.ndarray) -> np.ndarray:
         """A path of cell centres cut to its turns: from each kept point the farthest later one a
         straight stretch reaches without crossing a label."""
+        self._flush()
         keep = [0]
         while keep[-1] < len(pts) - 1:
             i = keep[-1]

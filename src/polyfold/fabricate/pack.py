@@ -229,12 +229,14 @@ def fits_page(outline: Polygon | MultiPolygon, page_size: tuple[float, float], m
 # rasters
 
 
-def _ring_edges(geom) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end points (e, 2) of every edge of every ring of a (Multi)Polygon."""
-    rings = shapely.get_rings(shapely.get_parts(geom))
+def ring_edges(geoms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Start and end points (e, 2) of every edge of every ring of (Multi)Polygons `geoms` (a
+    geometry or an array of them), and the index (e,) of each edge's geometry, in order."""
+    parts, part_owner = shapely.get_parts(geoms, return_index=True)
+    rings, ring_part = shapely.get_rings(parts, return_index=True)
     xy, idx = shapely.get_coordinates(rings, return_index=True)
     same = idx[1:] == idx[:-1]  # consecutive points of one ring (rings are closed)
-    return xy[:-1][same], xy[1:][same]
+    return xy[:-1][same], xy[1:][same], part_owner[ring_part[idx[:-1][same]]]
 
 
 @njit(cache=True)
@@ -258,6 +260,28 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
             parity ^= toggles[r, c]
             inside[r, c] = parity == 1
     return inside
+
+
+@njit(cache=True)
+def fill_inside(grid: np.ndarray, p0: np.ndarray, p1: np.ndarray, start: np.ndarray, windows: np.ndarray) -> None:
+    """Set the cells of `grid` (h, w) bool whose centres lie inside polygon g (as `_raster`), for
+    every g: its ring edges p0 -> p1 in grid cell units are rows start[g]:start[g + 1], and only
+    the cells of its window (g, 4) = first row, last row, first column, last column (inclusive,
+    inside the grid) are looked at."""
+    for g in range(windows.shape[0]):
+        r0, r1, c0, c1 = windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3]
+        a, b = start[g], start[g + 1]
+        q0 = p0[a:b].copy()
+        q1 = p1[a:b].copy()
+        q0[:, 0] -= c0
+        q0[:, 1] -= r0
+        q1[:, 0] -= c0
+        q1[:, 1] -= r0
+        inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
+        for r in range(inside.shape[0]):
+            for c in range(inside.shape[1]):
+                if inside[r, c]:
+                    grid[r0 + r, c0 + c] = True
 
 
 @dataclass
@@ -312,7 +336,7 @@ class _Piece:
         self.xy = _hull_xy(geom)
         self.area = float(geom.area)
         self.degs = degs
-        self.p0, self.p1 = _ring_edges(geom.buffer(grow, quad_segs=_QUAD_SEGS))
+        self.p0, self.p1, _ = ring_edges(geom.buffer(grow, quad_segs=_QUAD_SEGS))
         self.res, self.pad, self.pw, self.ph = res, pad, pw, ph
         self.rots = _rots(degs)
         self.lo, self.hi = _extents(self.xy, degs)

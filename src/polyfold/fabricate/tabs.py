@@ -21,7 +21,9 @@ stays TAB_CLEAR_MM from everything else on its piece, so a blade never runs two 
 from __future__ import annotations
 
 import copy
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -141,9 +143,11 @@ class Room:
         hit = np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
         return [self.extra[i] for i in hit]
 
-    def blocked(self, poly, skip_face: int | None = None, clear: float = 0.0, keep_free: list | None = None) -> bool:
+    def blocked(self, poly, skip_face: int | None = None, clear: float = 0.0,
+                keep_free: Callable[[], object] | None = None) -> bool:
         """True when `poly` overlaps a face (but `skip_face`) or an extra, or comes within `clear`
-        mm of one outside the discs `keep_free` (shapely geometries where near contact is expected)."""
+        mm of one outside `keep_free()` (a shapely geometry where near contact is expected, made
+        only when asked for)."""
         import shapely
 
         grown = poly.buffer(clear, quad_segs=2) if clear else poly
@@ -157,8 +161,8 @@ class Room:
         if not clear:
             return False
         hit = shapely.intersection(grown, others)
-        if keep_free:
-            hit = shapely.difference(hit, shapely.union_all(keep_free))
+        if keep_free is not None:
+            hit = shapely.difference(hit, keep_free())
         return shapely.area(hit).sum() > OVERLAP_MM2
 
 
@@ -225,10 +229,16 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
     """The tab of a glued pair: the first of TAB_VARIANTS that fits on either side (the first side
     first), else the larger clipped tab of the two sides; None when nothing fits (see the module
     docstring). A tab may touch the faces beside its fold line at the corners, nothing else."""
-    from shapely.geometry import Point, Polygon
+    import shapely
+    from shapely.geometry import Polygon
 
-    # where a tab's fold line meets the neighbouring faces: near contact expected there
-    corners = [[Point(side.p0).buffer(2 * TAB_CLEAR_MM), Point(side.p1).buffer(2 * TAB_CLEAR_MM)] for side in sides]
+    # where a tab's fold line meets the neighbouring faces: near contact expected there (the discs
+    # around a side's ends, made the first time a tab on that side comes near something)
+    @functools.cache
+    def corners(s: int):
+        ends = shapely.points([sides[s].p0, sides[s].p1])
+        return shapely.union_all(shapely.buffer(ends, 2 * TAB_CLEAR_MM, quad_segs=16))  # (Point.buffer's 16)
+
     for depth_kind, side_deg, reason in TAB_VARIANTS:
         for s, side in enumerate(sides):
             depth = full_depth(side.length) if depth_kind == "full" else TAB_MIN_MM
@@ -238,7 +248,8 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
             if poly is None:
                 continue
             tab = Polygon(poly)
-            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, corners[s]):
+            near_ends = functools.partial(corners, s)
+            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, near_ends):
                 return Tab(s, (poly,), np.array([[side.p0, side.p1]]), depth, reason)
     clipped = [tab for s, side in enumerate(sides) if (tab := _clipped(s, side, rooms[side.piece])) is not None]
     return max(clipped, key=_area, default=None)
