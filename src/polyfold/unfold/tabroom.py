@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..collide.flat import overlapping_pairs
+from ..collide.flat import overlapping_pairs, overlapping_pairs_between
 from ..deadline import Deadline
 from ..mesh.geometry import corner_angles, merged_edges
 from . import kernels as K
@@ -160,8 +160,11 @@ def _swap_gains(e2, cand, crease, edges, pen, ptr, inc_face, inc_corner, face_ed
     return delta, touched, new
 
 
-def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
-    """The single-piece net of `crease` rooted where `net` is, or None when it overlaps."""
+def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndarray) -> Net | None:
+    """The single-piece net of `crease` rooted where `net` is, or None when it overlaps. moved
+    (F,) bool: the faces a swap turned (a subtree of `net`, now hung from another edge): their
+    pairs with the other faces are tested first, as only those can start to overlap, and every
+    pair only when none does."""
     mesh = net.mesh
     n = mesh.n_faces
     parent = np.empty(n, np.int64)
@@ -172,6 +175,12 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
         return None
     coords = np.empty((n, 3, 2))
     K.layout_tree(order, parent, parent_edge, mesh.faces, mesh.topology.face_edges, problem.local, coords)
+    x, y = coords[..., 0], coords[..., 1]  # (the faces' bounds: numpy's min over axis 1 is 10x slower)
+    xmin, xmax = np.minimum(np.minimum(x[:, 0], x[:, 1]), x[:, 2]), np.maximum(np.maximum(x[:, 0], x[:, 1]), x[:, 2])
+    ymin, ymax = np.minimum(np.minimum(y[:, 0], y[:, 1]), y[:, 2]), np.maximum(np.maximum(y[:, 0], y[:, 1]), y[:, 2])
+    if len(overlapping_pairs_between(coords, parent, np.flatnonzero(moved), np.flatnonzero(~moved),
+                                     xmin, xmax, ymin, ymax, problem.tol)):
+        return None
     count, _ = overlapping_pairs(coords, parent, problem.tol, 0)
     if count:
         return None
@@ -246,7 +255,7 @@ def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep
         scored.sort(key=lambda s: (round(s[0], 2), float(np.linalg.norm(mid[s[1]] - here)), s[1]))
         for delta, g, new in scored[:MAX_TRIES]:
             crease[e2], crease[g] = False, True
-            relaid = _relaid(net, problem, crease)
+            relaid = _relaid(net, problem, crease, in_sub)
             if relaid is not None:
                 for u, p in new.items():
                     pen[u] = p
