@@ -160,3 +160,28 @@ def test_a_join_that_would_close_a_hole_is_refused():
     assert _encloses(u, closing) and not _encloses(u, beside)
     nearly = closing + [0.0, 0.01]  # 0.01 mm off: still closes the loop for a cutter
     assert _encloses(u, nearly)
+
+
+def test_hull_fits_decides_as_the_grown_hull_does():
+    """`_hull_fits` answers from the points' extents where those decide it; it must say what the
+    grown hull itself says (`_hull_scale` >= 1) on point sets of every shape at every distance from
+    fitting, those within the pad's arcs of the page's edge included."""
+    from polyfold.fabricate.fit import PACK_ANGLES, _hull_fits, _hull_scale
+    from polyfold.fabricate.pack import _best_fit
+
+    rng = np.random.default_rng(5)
+    page, margin, pad = (210.0, 297.0), 10.0, 7.0
+    decided = 0
+    for k in range(3000):
+        n = int(rng.integers(3, 40))
+        pts = rng.normal(size=(n, 2)) * rng.uniform(0.05, 1.0, size=2)
+        if k % 3 == 0:  # polygons: the extreme points are corners
+            t = np.linspace(0, 2 * np.pi, n + 3)
+            pts = np.stack([np.cos(t), rng.uniform(0.1, 1) * np.sin(t)], 1)
+        pts = pts @ np.array([[math.cos(k), -math.sin(k)], [math.sin(k), math.cos(k)]])
+        bare = _best_fit(pts, PACK_ANGLES, page[0] - 2 * margin, page[1] - 2 * margin)[0]  # the bare points just fit
+        pts = pts * bare * rng.uniform(0.85, 1.0)  # from 2 pads short of fitting to just fitting
+        want = _hull_scale(pts, page, margin, pad) >= 1.0
+        assert _hull_fits(pts, page, margin, pad) == want
+        decided += want
+    assert 0 < decided < 3000  # both answers met

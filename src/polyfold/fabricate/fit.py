@@ -62,6 +62,32 @@ def _hull_scale(points_mm: np.ndarray, page_size, margin: float, pad: float) -> 
     return _best_fit(shapely.get_coordinates(hull), PACK_ANGLES, pw, ph)[0]
 
 
+# In any direction the hull grown by shapely's buffer (quad_segs=2) reaches between this many
+# times `pad` past the hull (its arcs are chords of at most 67.5 degrees: GEOS rounds the count of
+# 45-degree steps to the nearest) and `pad` (the arc's corners and the offset sides lie on it).
+_ARC_CHORD = 0.8  # < cos(67.5 / 2 degrees) = 0.83
+_FIT_EPS_MM = 1e-9  # (floats in GEOS's arcs)
+
+
+def _hull_fits(points_mm: np.ndarray, page_size, margin: float, pad: float) -> bool:
+    """`_hull_scale(...) >= 1` (the grown hull fits the page in a PACK_ANGLES rotation), from the
+    points' own extents when those decide it (the grown hull's lie within 2 pad of them, and more
+    than 2 _ARC_CHORD pad out): the grown hull is built only for pieces within half a pad of
+    fitting."""
+    from .pack import _extents, hull_corners
+
+    pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
+    xy = np.ascontiguousarray(points_mm, dtype=np.float64)
+    lo, hi = _extents(xy[hull_corners(xy)], PACK_ANGLES)
+    ext = hi - lo
+    room = np.array([pw, ph])
+    if ((ext + 2 * pad + _FIT_EPS_MM) <= room).all(axis=1).any():
+        return True
+    if not ((ext + 2 * _ARC_CHORD * pad - _FIT_EPS_MM) <= room).all(axis=1).any():
+        return False
+    return _hull_scale(points_mm, page_size, margin, pad) >= 1.0
+
+
 def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
     """(shortest edge, smallest face height) of the mesh's faces printed at `scale` mm per model
     unit, in mm. A face's smallest height is twice its area over its longest side: the width of
@@ -82,7 +108,7 @@ def _model_factor(points_mm: np.ndarray, page_size, margin: float, pad: float) -
     import shapely
 
     def fits(factor: float) -> bool:
-        return _hull_scale(points_mm * factor, page_size, margin, pad) >= 1.0
+        return _hull_fits(points_mm * factor, page_size, margin, pad)
 
     hull = shapely.get_coordinates(points_hull(points_mm))
     lo = _best_fit(hull, PACK_ANGLES, page_size[0] - 2 * (margin + pad), page_size[1] - 2 * (margin + pad))[0]
@@ -133,7 +159,7 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
             if root in fits:
                 continue
             faces = np.sort(by_tin[tin[root]:tout[root]])
-            if sub_area[root] <= printable and _hull_scale(xy[faces].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+            if sub_area[root] <= printable and _hull_fits(xy[faces].reshape(-1, 2), page_size, margin, pad):
                 fits.add(root)
                 continue
             todo = faces
@@ -153,11 +179,11 @@ def _peel_to_fit(net: Net, scale: float, page_size: tuple[float, float], margin:
         whole = float(sub_area[todo[net.parent[todo] < 0][0]])
         for c in cand[sub_area[cand] <= printable]:
             members = by_tin[tin[c]:tout[c]]
-            if _hull_scale(xy[members].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+            if _hull_fits(xy[members].reshape(-1, 2), page_size, margin, pad):
                 fitting.append(int(c))
                 rest = in_piece.copy()
                 rest[members] = False
-                if whole - sub_area[c] <= printable and _hull_scale(xy[rest].reshape(-1, 2), page_size, margin, pad) >= 1.0:
+                if whole - sub_area[c] <= printable and _hull_fits(xy[rest].reshape(-1, 2), page_size, margin, pad):
                     chosen = int(c)
                     break
                 if len(fitting) >= MAX_PEEL_TRIES:
@@ -208,7 +234,7 @@ def join_pieces(net: Net, scale: float, page_size: tuple[float, float], margin: 
             fixed, moving = np.flatnonzero(piece == piece[f]), np.flatnonzero(piece == piece[g])
             both = np.concatenate([coords[fixed], moved])
             hinge = (int(np.searchsorted(fixed, f)), len(fixed) + int(np.searchsorted(moving, g)))
-            if (_hull_scale(both.reshape(-1, 2) * scale, page_size, margin, pad) < 1.0
+            if (not _hull_fits(both.reshape(-1, 2) * scale, page_size, margin, pad)
                     or _overlap(both, len(fixed), hinge, tol)
                     or _encloses(coords[fixed] * scale, moved * scale)):
                 failed.add(e)
@@ -245,15 +271,18 @@ def _hinged(coords: np.ndarray, faces: np.ndarray, edge: np.ndarray, f: int, g: 
     z = (pts[..., 0] + 1j * pts[..., 1] - complex(*ga)) * r + complex(*fa)
     moved = np.stack([z.real, z.imag], axis=-1)
     fixed = piece == piece[f]
-    at: dict[int, list[np.ndarray]] = {}
-    for v, xy in zip(faces[fixed].ravel().tolist(), coords[fixed].reshape(-1, 2)):
-        at.setdefault(v, []).append(xy)
+    at = np.argsort(faces[fixed].ravel(), kind="stable")  # the fixed corners by vertex, in order
+    fixed_v, fixed_xy = faces[fixed].ravel()[at], coords[fixed].reshape(-1, 2)[at]
     flat = moved.reshape(-1, 2)
-    for k, v in enumerate(faces[moving].ravel().tolist()):
-        for xy in at.get(v, ()):
-            if abs(flat[k, 0] - xy[0]) <= tol and abs(flat[k, 1] - xy[1]) <= tol:
-                flat[k] = xy
-                break
+    moved_v = faces[moving].ravel()
+    lo, hi = np.searchsorted(fixed_v, moved_v, "left"), np.searchsorted(fixed_v, moved_v, "right")
+    todo, k = np.flatnonzero(hi > lo), 0
+    while len(todo):  # each moved corner takes the first fixed corner at its vertex within tol
+        at = lo[todo] + k
+        todo, at = todo[at < hi[todo]], at[at < hi[todo]]
+        near = (np.abs(flat[todo, 0] - fixed_xy[at, 0]) <= tol) & (np.abs(flat[todo, 1] - fixed_xy[at, 1]) <= tol)
+        flat[todo[near]] = fixed_xy[at[near]]
+        todo, k = todo[~near], k + 1
     return moved
 
 
