@@ -349,12 +349,13 @@ class _Taken:
         """Mark what `mark` and `close` were given since the last flush, all at once (a piece places
         a hundred labels beside their edges between two searches of the raster): each geometry
         grown (shapely's buffer, quad_segs=2) and rasterised by its cells' centres over its bounds
-        (`pack.fill_inside`); then `free`'s maps again where cells were taken."""
+        (`pack._raster`, the packer's: compiled by every make already); then `free`'s maps again
+        where cells were taken."""
         if not self._pending:
             return
         import shapely
 
-        from .pack import fill_inside, ring_edges
+        from .pack import _raster, ring_edges
 
         geoms, grows, to_texts = (np.array(v, dtype=t) for v, t in zip(zip(*self._pending), (object, float, bool)))
         self._pending = []
@@ -366,9 +367,12 @@ class _Taken:
             if not chosen.any():
                 continue
             p0, p1, owner = ring_edges(grown[chosen])
-            start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1)).astype(np.int64)
-            scale = 1.0 / FREE_CELL_MM
-            fill_inside(target, (p0 - self.origin) * scale, (p1 - self.origin) * scale, start, windows[chosen])
+            start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
+            p0, p1 = (p0 - self.origin) * (1.0 / FREE_CELL_MM), (p1 - self.origin) * (1.0 / FREE_CELL_MM)
+            for g, (r0, r1, c0, c1) in enumerate(windows[chosen].tolist()):
+                corner = np.array([c0, r0], dtype=np.float64)
+                a, b = start[g], start[g + 1]
+                target[r0:r1 + 1, c0:c1 + 1] |= _raster(p0[a:b] - corner, p1[a:b] - corner, r1 - r0 + 1, c1 - c0 + 1)
         if (~to_texts).any():
             self._refresh(windows[~to_texts])
 

@@ -262,28 +262,6 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     return inside
 
 
-@njit(cache=True)
-def fill_inside(grid: np.ndarray, p0: np.ndarray, p1: np.ndarray, start: np.ndarray, windows: np.ndarray) -> None:
-    """Set the cells of `grid` (h, w) bool whose centres lie inside polygon g (as `_raster`), for
-    every g: its ring edges p0 -> p1 in grid cell units are rows start[g]:start[g + 1], and only
-    the cells of its window (g, 4) = first row, last row, first column, last column (inclusive,
-    inside the grid) are looked at."""
-    for g in range(windows.shape[0]):
-        r0, r1, c0, c1 = windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3]
-        a, b = start[g], start[g + 1]
-        q0 = p0[a:b].copy()
-        q1 = p1[a:b].copy()
-        q0[:, 0] -= c0
-        q0[:, 1] -= r0
-        q1[:, 0] -= c0
-        q1[:, 1] -= r0
-        inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
-        for r in range(inside.shape[0]):
-            for c in range(inside.shape[1]):
-                if inside[r, c]:
-                    grid[r0 + r, c0 + c] = True
-
-
 @dataclass
 class _Shape:
     """One piece in one rotation, rasterised on a grid aligned with its rotated bounding box."""
