@@ -60,7 +60,7 @@ def test_kernels_cached_tells_a_cold_cache_from_a_warm_one(tmp_path):
 # a first run's make compiles its fold stage in a second process (`Beside`) -----------------------
 
 _FOLD_STAGE_SIGNATURES = r"""
-import json, sys
+import json, os, sys
 from pathlib import Path
 from polyfold.apps.benchpaper import kernel_signatures
 from polyfold.apps.warmup import SECTIONS
@@ -76,6 +76,8 @@ mesh = load_mesh(Path(sys.argv[1])).mesh
 parts, _, _ = make_parts(mesh, opts, Deadline.after(30.0), lambda stage, message: None)
 for name in ("fold-plan", "fold-check"):
     SECTIONS[name][1](None)
+# on one core fold_pieces plans every piece here, not in forked processes: their kernels are this one's
+os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
 before = kernel_signatures()
 folded, report = fold_pieces(parts, opts, Deadline.after(30.0), lambda stage, message: None,
                              model_scale([mesh], opts.size))

@@ -50,3 +50,46 @@ def test_a_goal_clashing_within_the_thickness_is_split_without_planning(models_d
         opts.thickness / model_scale([mesh], opts.size))
     with pytest.raises(PolyfoldError, match=r"clash at the goal: net faces (\d+) and (?!\1)\d+ come closer"):
         plan_fold(whole, resolution_deg=opts.resolution_deg, time_limit=30.0)
+
+
+def test_pieces_planned_side_by_side_get_the_paths_planned_one_by_one(models_dir, monkeypatch):
+    """With two cores (and PARALLEL_FOLD_FACES) the pieces are planned in forked processes (`processes.fork_map`, the largest
+    first) and put back in order: the same pieces, paths (every frame), reports and counts as
+    planning them one by one in this process."""
+    import numpy as np
+
+    import polyfold.processes as processes
+
+    from polyfold.pipeline.options import paper_size
+    from polyfold.pipeline.sheets import fit_parts, pack_box
+
+    mesh = single_component(models_dir, "fish-472")
+    opts = MakeOptions()
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(30.0), lambda stage, message: None)
+    scale = model_scale([mesh], opts.size)
+    parts, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts), "fish-472")  # as make
+    runs, asked = {}, []
+    real = processes.fork_map
+
+    def recorded(fn, items, workers):
+        asked.append(workers)
+        return real(fn, items, workers)
+
+    monkeypatch.setattr(processes, "fork_map", recorded)
+    for cores in (1, 2):
+        monkeypatch.setattr(processes, "usable_cores", lambda cores=cores: cores)
+        runs[cores] = folding.fold_pieces(parts, opts, Deadline.after(60.0), lambda stage, m: None, scale)
+    assert asked == [1, 2]
+    (one, one_report), (two, two_report) = runs[1], runs[2]
+    assert len(one) == len(two) > 2 and one_report.verified >= 2
+    if one_report.splits_for_folding == 0:  # in the order of the parts' pieces
+        expected = [np.flatnonzero(p.net.piece == k) for p in parts for k in range(p.net.n_pieces)]
+        assert all(np.array_equal(fp.fids, want) for fp, want in zip(one, expected))
+    for a, b in zip(one, two):
+        assert (a.part, a.info.path, a.info.planner, a.info.frames) == (b.part, b.info.path, b.info.planner, b.info.frames)
+        assert np.array_equal(a.mesh_faces, b.mesh_faces) and np.array_equal(a.net.coords, b.net.coords)
+        assert (a.path is None) == (b.path is None) and a.info.note == b.info.note
+        if a.path is not None:
+            assert a.path.frames.shape == b.path.frames.shape and np.array_equal(a.path.frames, b.path.frames)
+    assert (one_report.splits_for_folding, one_report.rejected_paths) == (two_report.splits_for_folding,
+                                                                        two_report.rejected_paths)

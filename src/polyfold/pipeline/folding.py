@@ -28,6 +28,11 @@ from .report import FoldReport
 FOLD_BUDGET_S = 3.0  # planning time per piece before it is split: this + per face
 FOLD_BUDGET_PER_FACE_S = 0.03
 MAX_SPLITS = 3  # halvings of one piece at most
+# faces from which the pieces are planned side by side (`fold_pieces`): forked planners load the
+# fold stage's kernels each (and the guide's process then again), which costs the 128-face bunny
+# 0.13 s; from 300 faces it gains (make, wall: horse-302 4.7 -> 4.2 s, fish-472 3.9 -> 3.6 s,
+# bunny-348 3.7 both ways, a 1,280-face sphere's fold stage 0.87 -> 0.54 s)
+PARALLEL_FOLD_FACES = 300
 
 
 @dataclass(frozen=True)
@@ -63,9 +68,10 @@ class FoldedPiece:
 
 
 class _Planner:
-    """The fold stage's state: pieces still to plan (for the time shares), splits, results."""
+    """The fold stage's state: pieces still to plan (for the time shares: `pending.value`, shared
+    by the processes that plan pieces side by side), splits, results."""
 
-    def __init__(self, opts: MakeOptions, deadline: Deadline, n_parts: int, pending: int,
+    def __init__(self, opts: MakeOptions, deadline: Deadline, n_parts: int, pending,
                  say: Callable[[str, str], None], thickness: float, hard: Deadline) -> None:
         self.opts, self.deadline, self.n_parts, self.say = opts, deadline, n_parts, say
         self.hard = hard  # past it no piece is planned: OutOfTime
@@ -83,7 +89,7 @@ class _Planner:
         if pnet.mesh.n_faces == 1:
             info = PathInfo(path=True, linear=True, planner="trivial", note="single face")
         elif opts.fold:
-            self.hard.check(f"planning folding paths ({self.pending} pieces to go)")
+            self.hard.check(f"planning folding paths ({self.pending.value} pieces to go)")
             self.say("fold", f"part {pi + 1}/{self.n_parts}: planning a path for {pnet.mesh.n_faces} faces")
             tf = time.perf_counter()
             tree = FoldTree.from_pattern(pattern, opts.contact_tol).with_thickness(self.thickness)
@@ -93,7 +99,7 @@ class _Planner:
             else:
                 # a short budget, then split: two halves usually fold at once, while a hard
                 # piece can eat the whole time limit
-                share = max(0.5, min(self.deadline.left() / max(1, self.pending),
+                share = max(0.5, min(self.deadline.left() / max(1, self.pending.value),
                                      FOLD_BUDGET_S + FOLD_BUDGET_PER_FACE_S * pnet.mesh.n_faces))
                 impossible = ""  # why no path can exist for this piece (its faces clash at the goal)
                 try:
@@ -121,13 +127,13 @@ class _Planner:
             seconds = time.perf_counter() - tf
             info = PathInfo(note=note, seconds=seconds) if path is None else PathInfo(
                 path=True, linear=bool(path.linear), planner=path.planner, seconds=seconds, frames=len(path.frames))
-        self.pending -= 1
+        self.pending.value -= 1
         self.results.append(FoldedPiece(pi, faces, pnet, fids, pattern, path, info))
 
     def _split(self, pi: int, faces: np.ndarray, pnet: Net, fids: np.ndarray, cut: int, depth: int) -> None:
         halves = cut_creases(pnet, np.array([cut]))
         self.splits += 1
-        self.pending += 1
+        self.pending.value += 1
         for h in range(2):
             sub, sub_fids = piece_net(halves, h)
             self.plan(pi, faces, sub, fids[sub_fids], depth + 1)
@@ -175,19 +181,42 @@ def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, th
 
 def fold_pieces(parts: list[Part], opts: MakeOptions, deadline: Deadline, say: Callable[[str, str], None],
                 mm_per_unit: float, hard: Deadline = Deadline.never()) -> tuple[list[FoldedPiece], FoldReport]:
-    """Every piece of every part's net, with its folding path (see the module docstring); the
-    paper's thickness (opts.thickness mm) is mm_per_unit-scaled to model units. `deadline`: the
-    searches' (each piece still gets half a second past it); past `hard` OutOfTime."""
+    """Every piece of every part's net, with its folding path (see the module docstring), in the
+    order of the parts and their pieces; the paper's thickness (opts.thickness mm) is
+    mm_per_unit-scaled to model units. `deadline`: the searches' (each piece still gets half a
+    second past it; a piece's share of what is left is divided by the pieces not yet planned,
+    counted across the processes); past `hard` OutOfTime. With two or more cores the pieces are
+    planned side by side in forked processes: a piece's path depends on that piece only."""
+    from multiprocessing import RawValue
+
+    from ..processes import fork_map, usable_cores
+
     t0 = time.perf_counter()
-    n_pieces = sum(p.net.n_pieces for p in parts)
+    jobs = [(pi, k) for pi, part in enumerate(parts) for k in range(part.net.n_pieces)]
+    faces = sum(p.net.mesh.n_faces for p in parts)
+    workers = usable_cores() if opts.fold and len(jobs) > 1 and faces >= PARALLEL_FOLD_FACES else 1
     if opts.fold:  # before any of the stage's work (make's `ready` hook waits here on a first run)
-        say("fold", f"planning folding paths for {n_pieces} piece{'s' * (n_pieces != 1)}")
-    planner = _Planner(opts, deadline, len(parts), n_pieces, say, opts.thickness / mm_per_unit, hard)
-    for pi, part in enumerate(parts):
-        for k in range(part.net.n_pieces):
-            planner.plan(pi, part.faces, *piece_net(part.net, k), 0)
-    results = planner.results
-    report = FoldReport(enabled=opts.fold, seconds=time.perf_counter() - t0, splits_for_folding=planner.splits,
+        say("fold", f"planning folding paths for {len(jobs)} piece{'s' * (len(jobs) != 1)}"
+                    + (f" in {min(workers, len(jobs))} processes" if workers > 1 else ""))
+    pending = RawValue("l", len(jobs))  # (shared with the forked planners)
+    # pieces are planned side by side in processes forked from this one (`processes.fork_map`,
+    # the largest first); their own messages stay there (a forked copy of a live status line
+    # could wait forever on a lock its drawing thread held): the same paths as one by one, but
+    # where a time share runs out
+    quiet = say if workers == 1 else (lambda stage, message: None)
+
+    def plan(job: tuple[int, int]) -> tuple[list[FoldedPiece], int, int]:
+        pi, k = job
+        planner = _Planner(opts, deadline, len(parts), pending, quiet, opts.thickness / mm_per_unit, hard)
+        planner.plan(pi, parts[pi].faces, *piece_net(parts[pi].net, k), 0)
+        return planner.results, planner.splits, planner.rejected
+
+    sizes = [int(np.count_nonzero(parts[pi].net.piece == k)) for pi, k in jobs]
+    order = sorted(range(len(jobs)), key=lambda j: -sizes[j])
+    done = dict(zip(order, fork_map(plan, [jobs[j] for j in order], workers)))
+    results = [fp for j in range(len(jobs)) for fp in done[j][0]]
+    report = FoldReport(enabled=opts.fold, seconds=time.perf_counter() - t0,
+                        splits_for_folding=sum(d[1] for d in done.values()),
                         verified=sum(r.info.path for r in results), pieces=len(results),
-                        thickness_mm=opts.thickness, rejected_paths=planner.rejected)
+                        thickness_mm=opts.thickness, rejected_paths=sum(d[2] for d in done.values()))
     return results, report
