@@ -211,3 +211,39 @@ def test_a_stage_picture_turns_to_show_a_hidden_crease() -> None:
     assert P.draw_lines(img2.copy(), cam2, zbuf2, hidden[None], P.MOUNTAIN_RGB, width=3.0)[0] > 0.75
     *_rest, kept = _stage_view(pose, rotation, front, back, [(shown[None], P.VALLEY_RGB)])
     assert not kept
+
+
+def test_pictures_drawn_side_by_side_are_the_pictures_drawn_one_by_one(models_dir: Path, tmp_path: Path,
+                                                                       monkeypatch) -> None:
+    """The guide's pictures (the overview, each part's, each step's and its folding pictures) drawn
+    in forked processes, and instructions.html and guide.pdf written side by side: the same
+    instructions.html (every picture embedded in it) and assembly.json, and a guide.pdf of as
+    many pages, as drawing and writing them one by one."""
+    import polyfold.guide.guide as guide
+    import polyfold.pipeline.export as export
+    import polyfold.processes as processes
+
+    from multiprocessing import RawValue
+
+    spread = RawValue("i", 0)  # (shared: the guide is made in a process forked by the export)
+    real = processes.fork_map
+
+    def recorded(fn, items, workers):
+        if len(items) > 10 and workers == 2:
+            spread.value += 1
+        return real(fn, items, workers)
+
+    monkeypatch.setattr(processes, "fork_map", recorded)
+    monkeypatch.setattr(guide, "PARALLEL_PICTURES", 0)
+    monkeypatch.setattr(export, "PARALLEL_GUIDE_PICTURES", 0)
+    got = {}
+    for cores in (1, 2):
+        monkeypatch.setattr(processes, "usable_cores", lambda cores=cores: cores)
+        make(models_dir / "bunny-128.obj", tmp_path / str(cores), MakeOptions(parts=3, time_limit=60))
+        got[cores] = [(tmp_path / str(cores) / name).read_bytes() for name in ("instructions.html", "assembly.json")]
+        got[cores].append(_read(tmp_path / str(cores))[1]["stages"]["guide"])
+    assert got[1][:2] == got[2][:2]
+    for key in ("steps", "pictures", "pdf_pages", "closing_seams"):
+        assert got[1][2][key] == got[2][2][key]
+    # with two cores the pictures (the model's and 3 parts' sides, then the steps) were spread
+    assert spread.value >= 1

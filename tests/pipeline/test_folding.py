@@ -53,9 +53,9 @@ def test_a_goal_clashing_within_the_thickness_is_split_without_planning(models_d
 
 
 def test_pieces_planned_side_by_side_get_the_paths_planned_one_by_one(models_dir, monkeypatch):
-    """With two cores (and PARALLEL_FOLD_FACES) the pieces are planned in forked processes (`processes.fork_map`, the largest
-    first) and put back in order: the same pieces, paths (every frame), reports and counts as
-    planning them one by one in this process."""
+    """With two cores (and PARALLEL_FOLD_FACES) the pieces are planned in forked processes
+    (`processes.fork_map`, the largest first) and put back in order: the same pieces, paths
+    (every frame), reports and counts as planning them one by one in this process."""
     import numpy as np
 
     import polyfold.processes as processes
@@ -86,7 +86,8 @@ def test_pieces_planned_side_by_side_get_the_paths_planned_one_by_one(models_dir
         expected = [np.flatnonzero(p.net.piece == k) for p in parts for k in range(p.net.n_pieces)]
         assert all(np.array_equal(fp.fids, want) for fp, want in zip(one, expected))
     for a, b in zip(one, two):
-        assert (a.part, a.info.path, a.info.planner, a.info.frames) == (b.part, b.info.path, b.info.planner, b.info.frames)
+        facts = [(x.part, x.info.path, x.info.planner, x.info.frames) for x in (a, b)]
+        assert facts[0] == facts[1]
         assert np.array_equal(a.mesh_faces, b.mesh_faces) and np.array_equal(a.net.coords, b.net.coords)
         assert (a.path is None) == (b.path is None) and a.info.note == b.info.note
         if a.path is not None:
