@@ -356,6 +356,8 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
 
     n_labels = sum(len(j) for j in jobs)
     order = sorted(range(len(drawn)), key=lambda i: -len(jobs[i]))
+    if n_labels >= PARALLEL_LABELS:
+        import scipy.ndimage  # noqa: F401 (the free-spot rasters': imported once here, not in every worker)
     done = fork_map(place, order, usable_cores() if n_labels >= PARALLEL_LABELS else 1)
     if failed.value or any(p is None for p in done):
         return None
