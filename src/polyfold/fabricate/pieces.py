@@ -9,6 +9,7 @@ side carries the glue tab (`tabs.choose_tab`).
 
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field, replace
 
@@ -356,8 +357,8 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
 
     n_labels = sum(len(j) for j in jobs)
     order = sorted(range(len(drawn)), key=lambda i: -len(jobs[i]))
-    if n_labels >= PARALLEL_LABELS:
-        import scipy.ndimage  # noqa: F401 (the free-spot rasters': imported once here, not in every worker)
+    if n_labels >= PARALLEL_LABELS:  # the free-spot rasters' module: imported here once, not in every worker
+        importlib.import_module("scipy.ndimage")
     done = fork_map(place, order, usable_cores() if n_labels >= PARALLEL_LABELS else 1)
     if failed.value or any(p is None for p in done):
         return None
