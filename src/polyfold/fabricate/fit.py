@@ -20,7 +20,7 @@ from ..mesh.geometry import face_areas
 from ..mesh.mesh import Mesh
 from ..unfold import kernels as K
 from ..unfold.net import Net, cut_creases, subtree_areas
-from .pack import _best_fit, points_hull
+from .pack import _best_fit, _extents, hull_corners, points_hull
 from .tabs import TAB_ROOM_MM
 
 MAX_PEEL_TRIES = 64
@@ -74,18 +74,17 @@ def _hull_fits(points_mm: np.ndarray, page_size, margin: float, pad: float) -> b
     points' own extents when those decide it (the grown hull's lie within 2 pad of them, and more
     than 2 _ARC_CHORD pad out): the grown hull is built only for pieces within half a pad of
     fitting."""
-    from .pack import _extents, hull_corners
-
     pw, ph = page_size[0] - 2 * margin, page_size[1] - 2 * margin
     xy = np.ascontiguousarray(points_mm, dtype=np.float64)
-    lo, hi = _extents(xy[hull_corners(xy)], PACK_ANGLES)
+    corners = xy[hull_corners(xy)]  # (the same hull as all the points)
+    lo, hi = _extents(corners, PACK_ANGLES)
     ext = hi - lo
     room = np.array([pw, ph])
     if ((ext + 2 * pad + _FIT_EPS_MM) <= room).all(axis=1).any():
         return True
     if not ((ext + 2 * _ARC_CHORD * pad - _FIT_EPS_MM) <= room).all(axis=1).any():
         return False
-    return _hull_scale(points_mm, page_size, margin, pad) >= 1.0
+    return _hull_scale(corners, page_size, margin, pad) >= 1.0
 
 
 def smallest_printed(mesh: Mesh, scale: float) -> tuple[float, float]:
