@@ -19,6 +19,16 @@ def test_left_expired_and_shares():
     assert never.at == math.inf and not never.expired() and never.within(1.0).at < math.inf
 
 
+def test_or_when_is_up_once_its_test_says_so_and_shares_keep_the_test():
+    stopped = []
+    d = Deadline.after(100).or_when(lambda: bool(stopped))
+    assert not d.expired() and d.left() > 90 and not d.within(5).expired() and not d.share(2).expired()
+    stopped.append(True)
+    for made in (d, d.within(5), d.share(2), d.before(1)):
+        assert made.expired() and made.left() == 0.0
+    assert Deadline(clock() - 1).or_when(lambda: False).expired()  # the clock still counts
+
+
 def test_check_raises_out_of_time_only_when_expired():
     import pytest
 

@@ -1,5 +1,6 @@
 """processes.py: `fork_map` runs a function over items in forked processes, in order, and raises
-what it raises; `usable_cores` counts this process's cores."""
+what it raises; `beside` runs one function in a forked process while another runs here;
+`usable_cores` counts this process's cores."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from polyfold.errors import OutOfTime
-from polyfold.processes import fork_map, usable_cores
+from polyfold.processes import beside, fork_map, usable_cores
 
 BIG = np.arange(1_000_000)  # read by the children through the fork, never pickled
 
@@ -65,3 +66,32 @@ def test_the_workers_see_this_process_frozen_and_it_is_thawed_after() -> None:
     if os.uname().sysname == "Linux":
         assert min(counts) > 0  # the workers inherited the frozen objects
     assert gc.get_freeze_count() == 0
+
+
+def test_beside_runs_one_here_and_one_in_a_fork_at_once() -> None:
+    """The two run at the same time (each waits for the other's mark in shared memory), there()
+    in another process, reading this process's data through the fork; an exception from either
+    is raised here; where no process can be forked both run here, here() first."""
+    import time
+    from multiprocessing import RawArray
+
+    marks = RawArray("b", [0, 0])
+
+    def meet(k: int) -> tuple[int, int]:
+        marks[k] = 1
+        t0 = time.monotonic()
+        while not marks[1 - k] and time.monotonic() - t0 < 20:
+            time.sleep(0.001)
+        return int(marks[1 - k]), os.getpid()
+
+    (met_here, pid_here), (met_there, pid_there) = beside(lambda: meet(0), lambda: meet(1))
+    if os.uname().sysname == "Linux":
+        assert met_here == met_there == 1 and pid_here == os.getpid() != pid_there
+    assert beside(lambda: int(BIG[7]), lambda: int(BIG[999_999])) == (7, 999_999)
+
+    def fail():
+        raise OutOfTime("out of time", "racing")
+
+    for here, there in ((fail, lambda: 1), (lambda: 1, fail)):
+        with pytest.raises(OutOfTime):
+            beside(here, there)

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .errors import OutOfTime
 
@@ -100,9 +100,11 @@ class CompileTally:
 
 @dataclass(frozen=True)
 class Deadline:
-    """at: the `clock()` value at which time is up (math.inf: never)."""
+    """at: the `clock()` value at which time is up (math.inf: never); stop: also up once this
+    says so (`or_when`), whatever the clock."""
 
     at: float
+    stop: Callable[[], bool] | None = field(default=None, compare=False)
 
     @classmethod
     def after(cls, seconds: float) -> Deadline:
@@ -114,11 +116,18 @@ class Deadline:
         return cls(math.inf)
 
     def left(self) -> float:
-        """Seconds left, never negative."""
+        """Seconds left, never negative (none once stopped)."""
+        if self.stop is not None and self.stop():
+            return 0.0
         return max(0.0, self.at - clock())
 
     def expired(self) -> bool:
-        return clock() >= self.at
+        return clock() >= self.at or (self.stop is not None and self.stop())
+
+    def or_when(self, stop: Callable[[], bool]) -> Deadline:
+        """This deadline, also up once stop() is true (a search that another has beaten; the
+        deadlines made from it keep the test)."""
+        return Deadline(self.at, stop)
 
     def check(self, doing: str) -> None:
         """Raise OutOfTime("... while <doing>") when time is up: the check between steps of work
@@ -129,11 +138,11 @@ class Deadline:
 
     def before(self, seconds: float) -> Deadline:
         """The deadline `seconds` earlier than this one (a share kept back for the work after)."""
-        return Deadline(self.at - seconds)
+        return Deadline(self.at - seconds, self.stop)
 
     def within(self, seconds: float) -> Deadline:
         """The earlier of this deadline and `seconds` from now."""
-        return Deadline(min(self.at, clock() + seconds))
+        return Deadline(min(self.at, clock() + seconds), self.stop)
 
     def share(self, parts: int) -> Deadline:
         """A deadline for one of `parts` equal shares of the time left (the first of them)."""

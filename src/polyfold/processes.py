@@ -1,5 +1,6 @@
 """Work spread over this machine's cores (standard library only): how many cores this process may
-use, and `fork_map`, which runs independent pieces of work in processes forked from this one.
+use; `fork_map`, which runs independent pieces of work in processes forked from this one, and
+`beside`, which runs one piece of work in a forked process while this one does another.
 
 Forked, not spawned: a child starts as a copy of this process (its modules, kernels and data), so
 nothing but the items and the results is pickled and a pool costs milliseconds to start, not the
@@ -26,6 +27,21 @@ def _call(item: Any) -> Any:
     return _TASK(item)
 
 
+def _forking_pool(processes: int):
+    """A ProcessPoolExecutor of `processes` processes forked from this one (when first given
+    work), or None where work must run here: other systems than Linux, a daemonic process (which
+    may not have children), or no pool to be had (its queues' locks need /dev/shm)."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    if not sys.platform.startswith("linux") or mp.current_process().daemon:
+        return None
+    try:
+        return ProcessPoolExecutor(processes, mp_context=mp.get_context("fork"))
+    except OSError:  # (an error raised by the work is not caught here)
+        return None
+
+
 def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list[Any]:
     """[fn(x) for x in items], in that order, run by up to `workers` processes forked from this
     one, which take the items one at a time (put the longest first). fn and whatever it reads are
@@ -35,17 +51,12 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     other systems than Linux, in a daemonic process (which may not have children), or when no
     pool can be made (no /dev/shm for its locks); when a worker dies (killed, out of memory) the
     items are done here instead of waiting for it forever."""
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
     global _TASK
     workers = min(workers, len(items))
-    if workers < 2 or not sys.platform.startswith("linux") or mp.current_process().daemon:
-        return [fn(x) for x in items]
-    try:
-        pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"))
-    except OSError:  # its queues' locks need /dev/shm (an error raised by fn is not caught here)
+    pool = _forking_pool(workers) if workers >= 2 else None
+    if pool is None:
         return [fn(x) for x in items]
     _TASK = fn  # (set before the workers fork: they start when the items are handed out)
     # what this process holds is no garbage the workers need look at: frozen, their collections
@@ -57,6 +68,35 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
             return list(pool.map(_call, items))
     except BrokenProcessPool:
         return [fn(x) for x in items]
+    finally:
+        _TASK = None
+        gc.unfreeze()
+
+
+def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]:
+    """(here(), there()): there() in a process forked from this one, here() in this one
+    meanwhile (so here() may show progress; a forked child must stay quiet). As with `fork_map`,
+    there() and what it reads are inherited, its result pickled, an exception in either raised
+    here (when here() raises, once there() is done), and both run here, here() first, where
+    fork_map would run its items here (there() is also run here when its process dies)."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    global _TASK
+    pool = _forking_pool(1)
+    if pool is None:
+        return here(), there()
+    _TASK = lambda _: there()  # noqa: E731 (inherited by the child: a pool forks its processes at the first submit)
+    gc.freeze()
+    try:
+        with pool:
+            future = pool.submit(_call, None)
+            _TASK = None
+            near = here()
+            try:
+                far = future.result()
+            except BrokenProcessPool:
+                far = there()
+        return near, far
     finally:
         _TASK = None
         gc.unfreeze()

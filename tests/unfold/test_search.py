@@ -325,7 +325,7 @@ def test_luby_sequence() -> None:
 def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     """A search cut into restarts after 1, 1, 2, ... generations (restart unit 1): on horse-302,
     seed 29 finds its net in the third generation, after two restarts, the same net every time,
-    and the net has no overlap."""
+    and the net has no overlap (one search: no race)."""
     import polyfold.unfold.search as search
 
     mesh = load_mesh(models_dir / "horse-302.obj").components[0]
@@ -333,7 +333,7 @@ def test_memetic_restarts_are_deterministic_and_find_nets(models_dir) -> None:
     kept = search.RESTART_GENERATIONS
     search.RESTART_GENERATIONS = 1
     try:
-        runs = [search.run_memetic(problem, np.random.default_rng(29), Deadline.never(), 4, population=50)
+        runs = [search.run_memetic(problem, np.random.default_rng(29), Deadline.never(), 4, population=50, race=False)
                 for _ in range(2)]
     finally:
         search.RESTART_GENERATIONS = kept
@@ -388,3 +388,45 @@ def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> N
             assert score == G + 100 * L, (seed, iterations)
             scores.append(score)
     assert max(scores) > 0 and len(set(scores)) > 4  # overlapping trees and moves that changed them
+
+
+@pytest.mark.parametrize("seed", [4, 34, 86])
+def test_two_racing_searches_give_the_earlier_rounds_net_on_one_core_or_two(models_dir, monkeypatch, seed) -> None:
+    """When the first search's first batch and generation find no net, a second search (its own
+    random stream) races it in rounds of a generation: the net found in the earlier round wins,
+    the first search's on a tie. On horse-302, seed 4 ties (both in round 2), seed 34 is won by
+    the second and seed 86 by the first; the winner is the one each search finds alone, and the
+    net, generations and evaluations are the same on one core (turns) as on two (a fork)."""
+    import polyfold.processes as processes
+    import polyfold.unfold.search as search
+
+    mesh = load_mesh(models_dir / "horse-302.obj").components[0]
+    problem = UnfoldProblem.from_mesh(mesh)
+    args = (Deadline.never(), 40, 400, 7, 0.4, 0.5, None, None)  # (unfold's population at 302 faces)
+
+    def alone(rng, offset: int):
+        """The round a search finds its net in, numbered on from offset, and the net (or None)."""
+        s = search._Stream(problem, rng, *args)
+        while not s.over():
+            s.step()
+        return (s.counts[-1][0] + offset, s.answer[0]) if s.answer is not None else (search.NEVER, None)
+
+    rng = np.random.default_rng(seed)
+    first = search._Stream(problem, rng, *args)
+    while first.steps < search.SOLO_STEPS:
+        first.step()
+    assert first.answer is None  # the race is run
+    solo = first.generation
+    rounds = [alone(np.random.default_rng(seed), 0), alone(np.random.default_rng(seed).spawn(1)[0], solo)]
+    expected = min((r, k) for k, (r, _) in enumerate(rounds))
+    assert expected[0] < search.NEVER
+    runs = []
+    for cores in (1, 2):
+        monkeypatch.setattr(processes, "usable_cores", lambda cores=cores: cores)
+        runs.append(search.run_memetic(problem, np.random.default_rng(seed), Deadline.never(), 40, population=400))
+    (w1, f1, g1, e1, _), (w2, f2, g2, e2, _) = runs
+    assert f1 == f2 == 0.0 and (g1, e1) == (g2, e2) and np.array_equal(w1, w2)
+    assert np.array_equal(w1, rounds[expected[1]][1])  # the winner's net: the one it finds alone
+    G, L = problem.evaluate(w1[None, :])
+    assert float(search._fitness(G, L)[0]) == 0.0
+    assert {4: (2, 0), 34: (2, 1), 86: (2, 0)}[seed] == expected

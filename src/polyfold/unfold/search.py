@@ -219,6 +219,123 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
     return _genome_of_tree(crease, rng), int(score), done_iters
 
 
+class _Stream:
+    """One memetic search (`run_memetic`), a step at a time: a step builds a first batch of the
+    population (at the start and at each restart) or runs one generation. `answer` is set when a
+    step finds a valid net that `accept` passes; `over()` once that or its budget ends it."""
+
+    def __init__(self, problem: UnfoldProblem, rng: np.random.Generator, deadline: Deadline, max_generations: int,
+                 population: int, tournament: int, p_cross: float, temperature: float,
+                 progress: Callable[[int, float], None] | None, accept: Callable[[np.ndarray], bool] | None):
+        self.problem, self.rng, self.deadline = problem, rng, deadline
+        self.max_generations, self.population, self.tournament = max_generations, population, tournament
+        self.p_cross, self.temperature, self.progress = p_cross, temperature, progress
+        self.finished = _AcceptFirst(accept)
+        self.pop: np.ndarray | None = None
+        self.fit = np.zeros(0)
+        self.best: np.ndarray | None = None
+        self.best_fit = -np.inf
+        self.generation = self.evaluations = self.since = self.batches = self.steps = 0
+        self.answer: tuple[np.ndarray, str] | None = None  # (genome, how it was found)
+        self.counts: list[tuple[int, int, int]] = []  # (round, generations, evaluations) of each step
+
+    def over(self) -> bool:
+        return self.answer is not None or (self.pop is not None and (
+            self.generation >= self.max_generations or self.deadline.expired()))
+
+    def step(self) -> None:
+        """One step; its round is the generation it runs or builds the population for."""
+        round_ = self.generation + 1
+        self.steps += 1
+        self._step()
+        self.counts.append((round_, self.generation, self.evaluations))
+
+    def _step(self) -> None:
+        problem, rng, deadline = self.problem, self.rng, self.deadline
+        if self.pop is None or self.since == RESTART_GENERATIONS * luby(self.batches):
+            pop, fit, origin, more_ev, hit = _seed_population(problem, rng, deadline,
+                                                              min(FIRST_BATCH, self.population), self.finished)
+            self.evaluations += more_ev
+            if hit >= 0:
+                self.answer = (pop[hit].copy(), origin[hit])
+                return
+            self.pop, self.fit = pop, fit
+            if fit.max() > self.best_fit:
+                self.best, self.best_fit = pop[int(np.argmax(fit))].copy(), float(fit.max())
+            self.batches += 1
+            self.since = 0
+            return
+        pop, fit = self.pop, self.fit
+        self.generation += 1
+        self.since += 1
+        if self.since == 1:
+            child = pop[int(np.argmax(fit))].copy()
+        else:
+            if self.since == 2 and len(pop) < self.population:
+                more, more_fit, more_origin, more_ev, hit = _seed_population(
+                    problem, rng, deadline, self.population - len(pop), self.finished)
+                self.evaluations += more_ev
+                if hit >= 0:
+                    self.answer = (more[hit].copy(), more_origin[hit])
+                    return
+                pop, fit = self.pop, self.fit = np.concatenate([pop, more]), np.concatenate([fit, more_fit])
+            draws = rng.integers(0, len(pop), size=(2, self.tournament))
+            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
+            swap = rng.random(pop.shape[1]) < self.p_cross
+            child = np.where(swap, pop[winners[1]], pop[winners[0]])
+        genome, score, done_iters = tree_local_search(problem, child, rng, deadline, self.temperature)
+        self.evaluations += done_iters
+        worst = int(np.argmin(fit))
+        pop[worst] = genome
+        fit[worst] = -float(score)
+        if self.progress is not None:
+            self.progress(self.generation, max(self.best_fit, float(fit.max())))
+        if score == 0:
+            if self.finished(genome):
+                self.answer = (genome, "ga+local-search")
+                return
+            fit[worst] = -0.5
+        if fit[worst] > self.best_fit:
+            self.best, self.best_fit = genome.copy(), float(fit[worst])
+
+    def outcome(self) -> _Outcome:
+        """What the search found (picklable: a forked race returns it)."""
+        if self.answer is not None:
+            return _Outcome(self.answer[0], 0.0, self.answer[1], True, False, tuple(self.counts))
+        if self.finished.fallback is not None:
+            return _Outcome(self.finished.fallback, 0.0, "ga+local-search", False, True, tuple(self.counts))
+        best, best_fit = self.best, self.best_fit
+        if len(self.fit):
+            i = int(np.argmax(self.fit))
+            if self.fit[i] > best_fit:
+                best, best_fit = self.pop[i].copy(), float(self.fit[i])
+        return _Outcome(best, best_fit, "ga+local-search", False, False, tuple(self.counts))
+
+
+@dataclass(frozen=True, eq=False)
+class _Outcome:
+    """A stream's result: run_memetic's tuple, whether `accept` passed the genome (solved) or it
+    is the valid net it turned down first (fallback)."""
+
+    genome: np.ndarray
+    fitness: float
+    origin: str
+    solved: bool
+    fallback: bool
+    counts: tuple[tuple[int, int, int], ...]  # (round, generations, evaluations) of each step
+
+    def upto(self, last_round: int) -> tuple[int, int]:
+        """(generations, evaluations) after its steps of rounds up to last_round."""
+        done = [(g, e) for r, g, e in self.counts if r <= last_round]
+        return done[-1] if done else (0, 0)
+
+
+# steps (first batch, first generation) the memetic search takes alone before a second search
+# races it: most nets are found by then, and a race costs a forked process and its first batch
+SOLO_STEPS = 2
+NEVER = 2**62  # a race round no search reaches
+
+
 def run_memetic(
     problem: UnfoldProblem,
     rng: np.random.Generator,
@@ -230,6 +347,7 @@ def run_memetic(
     temperature: float = 0.5,
     progress: Callable[[int, float], None] | None = None,
     accept: Callable[[np.ndarray], bool] | None = None,
+    race: bool = True,
 ) -> tuple[np.ndarray, float, int, int, str]:
     """GA of ALGORITHMS.md 5.5 with a Lamarckian tree local search ("auto").
 
@@ -240,68 +358,93 @@ def run_memetic(
     new first batch after 3, 3, 6, 3, 3, 6, 12, ... generations (`luby`). Returns the same tuple as
     `run_ga` (the best genome met across restarts); stops like it.
 
+    race: when the first SOLO_STEPS steps (`_Stream`) found no net, a second search with a random
+    stream of its own (`rng.spawn`) races this one (`_race`); generations and evaluations are then
+    the two searches' together, max_generations each one's, and progress is this one's.
+
     accept: optional extra test of a valid (overlap-free) genome; the search goes on, within the
     budget, until a valid genome passes it, and falls back to the first valid one otherwise.
     """
-    finished = _AcceptFirst(accept)
-    n_e = problem.mesh.topology.n_edges
     # The first batch of the population only, then one local search from its best: most nets
     # are finished by that search, and building the whole population (hundreds of heuristic
     # trees) first would cost ten times more. The rest of the population is built only if not.
     # Restarts: the time a search needs is heavy-tailed (one seed in seconds, the next stuck on one
     # overlap for minutes), so runs are cut after a Luby sequence of generations (1, 1, 2, 1, 1,
     # 2, 4, ... x RESTART_GENERATIONS) and start afresh from a new first batch, the random stream
-    # going on (deterministic for a seed).
-    pop = fit = best = None
-    best_fit = -np.inf
-    generation = evaluations = since = batches = 0
-    while pop is None or (generation < max_generations and not deadline.expired()):
-        if pop is None or since == RESTART_GENERATIONS * luby(batches):
-            pop, fit, origin, more_ev, hit = _seed_population(problem, rng, deadline, min(FIRST_BATCH, population),
-                                                              finished)
-            evaluations += more_ev
-            if hit >= 0:
-                return pop[hit].copy(), 0.0, generation, evaluations, origin[hit]
-            if fit.max() > best_fit:
-                best, best_fit = pop[int(np.argmax(fit))].copy(), float(fit.max())
-            batches += 1
-            since = 0
-            continue  # (the deadline may have passed while building)
-        generation += 1
-        since += 1
-        if since == 1:
-            child = pop[int(np.argmax(fit))].copy()
-        else:
-            if since == 2 and len(pop) < population:
-                more, more_fit, more_origin, more_ev, hit = _seed_population(
-                    problem, rng, deadline, population - len(pop), finished)
-                evaluations += more_ev
-                if hit >= 0:
-                    return more[hit].copy(), 0.0, generation, evaluations, more_origin[hit]
-                pop, fit = np.concatenate([pop, more]), np.concatenate([fit, more_fit])
-            draws = rng.integers(0, len(pop), size=(2, tournament))
-            winners = draws[np.arange(2), np.argmax(fit[draws], axis=1)]
-            swap = rng.random(n_e) < p_cross
-            child = np.where(swap, pop[winners[1]], pop[winners[0]])
-        genome, score, done_iters = tree_local_search(problem, child, rng, deadline, temperature)
-        evaluations += done_iters
-        worst = int(np.argmin(fit))
-        pop[worst] = genome
-        fit[worst] = -float(score)
-        if progress is not None:
-            progress(generation, max(best_fit, float(fit.max())))
-        if score == 0:
-            if finished(genome):
-                return genome, 0.0, generation, evaluations, "ga+local-search"
-            fit[worst] = -0.5
-        if fit[worst] > best_fit:
-            best, best_fit = genome.copy(), float(fit[worst])
-    if finished.fallback is not None:
-        return finished.fallback, 0.0, generation, evaluations, "ga+local-search"
-    i = int(np.argmax(fit))
-    if fit[i] > best_fit:
-        best, best_fit = pop[i].copy(), float(fit[i])
-    return best, best_fit, generation, evaluations, "ga+local-search"
+    # going on (deterministic for a seed). The same tail is why two searches racing find a net
+    # sooner than one running twice as long.
+    args = (max_generations, population, tournament, p_cross, temperature)
+    first = _Stream(problem, rng, deadline, *args, progress, accept)
+    while not first.over() and (first.steps < SOLO_STEPS or not race):
+        first.step()
+    if first.over():
+        return _result(first.outcome())
+    second = _Stream(problem, rng.spawn(1)[0], deadline, *args, None, accept)
+    base = first.generation  # (the second search's rounds are numbered on from here)
+    (a, b), won = _race(first, second)
+    if min(won) < NEVER:  # the search that found a net in the earlier round; on a tie the first
+        k = int(np.argmin(won))
+        winner = (a, b)[k]
+        # counted: the steps taken in turns up to the winning one (so the same on one core or two),
+        # the first search's up to its round, the second's before it (on a tie the first is first)
+        (g1, e1), (g2, e2) = a.upto(won[k]), b.upto(won[k] - base - (k == 0))
+    else:  # neither: a valid net that `accept` turned down, else the fitter (the first on a tie)
+        winner = a if a.fallback or (not b.fallback and a.fitness >= b.fitness) else b
+        (g1, e1), (g2, e2) = a.upto(NEVER), b.upto(NEVER)
+    return winner.genome, winner.fitness, g1 + g2, e1 + e2, winner.origin
+
+
+def _result(out: _Outcome) -> tuple[np.ndarray, float, int, int, str]:
+    return (out.genome, out.fitness, *out.upto(NEVER), out.origin)
+
+
+def _race(first: _Stream, second: _Stream) -> tuple[tuple[_Outcome, _Outcome], list[int]]:
+    """Two searches in rounds, a generation each (a step that builds a population belongs to the
+    round of the generation after it): the first one's numbered on from its generations so far,
+    the second's from there. Returns their outcomes and the round each found a net in
+    (NEVER: none): the earliest wins, the first on a tie, so the winner does not depend on which
+    search runs faster. With two cores the second runs in a forked process (`processes.beside`)
+    and each stops once the other has won a round it cannot beat (its deadline is up then, so
+    mid-step); on one core they take turns, a round each, until one wins."""
+    from multiprocessing import RawArray
+
+    from ..processes import beside, usable_cores
+
+    streams, offset = (first, second), (0, first.generation)
+    won = RawArray("q", [NEVER, NEVER])  # (shared with the forked process)
+    at = [0, 0]  # the round each search is in (or won); each process keeps its own's
+
+    def beaten(k: int) -> bool:
+        return (won[1 - k], 1 - k) < (at[k], k)
+
+    def step(k: int) -> bool:
+        """One step of search k unless it is over or beaten; whether it took one."""
+        s = streams[k]
+        if s.over():
+            return False
+        at[k] = s.generation + 1 + offset[k]
+        if beaten(k):
+            return False
+        s.step()
+        if s.answer is not None:
+            won[k] = at[k]
+        return True
+
+    for k, s in enumerate(streams):
+        s.deadline = s.deadline.or_when(lambda k=k: beaten(k))
+
+    def run(k: int) -> _Outcome:
+        while step(k):
+            pass
+        return streams[k].outcome()
+
+    if usable_cores() >= 2:
+        outcomes = beside(lambda: run(0), lambda: run(1))
+    else:
+        while any([step(0), step(1)]):
+            pass
+        outcomes = (first.outcome(), second.outcome())
+    return outcomes, list(won)
 
 
 def luby(i: int) -> int:
