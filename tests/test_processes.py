@@ -95,3 +95,21 @@ def test_beside_runs_one_here_and_one_in_a_fork_at_once() -> None:
     for here, there in ((fail, lambda: 1), (lambda: 1, fail)):
         with pytest.raises(OutOfTime):
             beside(here, there)
+
+
+def test_beside_ends_the_forked_work_when_here_raises() -> None:
+    """An interrupt (or any exception) here does not wait for there() to finish."""
+    import time
+
+    def slow():
+        time.sleep(60)
+        return 1
+
+    def interrupted():
+        time.sleep(0.2)
+        raise KeyboardInterrupt
+
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        beside(interrupted, slow)
+    assert time.monotonic() - t0 < 10

@@ -76,27 +76,47 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
 def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]:
     """(here(), there()): there() in a process forked from this one, here() in this one
     meanwhile (so here() may show progress; a forked child must stay quiet). As with `fork_map`,
-    there() and what it reads are inherited, its result pickled, an exception in either raised
-    here (when here() raises, once there() is done), and both run here, here() first, where
-    fork_map would run its items here (there() is also run here when its process dies)."""
-    from concurrent.futures.process import BrokenProcessPool
+    there() and what it reads are inherited and its result pickled; an exception raised by
+    there() is raised here, one raised by here() (an interrupt too) ends the forked process at
+    once. Both run here, here() first, where fork_map would run its items here, and there() is
+    run here when its process dies."""
+    import multiprocessing as mp
 
-    global _TASK
-    pool = _forking_pool(1)
-    if pool is None:
+    if not sys.platform.startswith("linux") or mp.current_process().daemon:
         return here(), there()
-    _TASK = lambda _: there()  # noqa: E731 (inherited by the child: a pool forks its processes at the first submit)
-    gc.freeze()
+    ctx = mp.get_context("fork")
+    receive, send = ctx.Pipe(duplex=False)
+
+    def child() -> None:
+        try:
+            out = (True, there())
+        except BaseException as exc:  # (raised in the parent instead)
+            out = (False, exc)
+        send.send(out)
+
+    gc.freeze()  # (see fork_map)
     try:
-        with pool:
-            future = pool.submit(_call, None)
-            _TASK = None
+        proc = ctx.Process(target=child)
+        try:
+            proc.start()
+        except OSError:
+            return here(), there()
+        send.close()  # (the child's copy stays open: its end tells this one the child is gone)
+        answered = False
+        try:
             near = here()
             try:
-                far = future.result()
-            except BrokenProcessPool:
-                far = there()
-        return near, far
+                ok, far = receive.recv()
+            except EOFError:  # the child died (killed, out of memory) before it answered
+                ok, far = True, there()
+            answered = True
+        finally:
+            if not answered:  # here() raised: the child's work is not wanted
+                proc.terminate()
+            proc.join()
+            receive.close()
     finally:
-        _TASK = None
         gc.unfreeze()
+    if not ok:
+        raise far
+    return near, far
