@@ -13,7 +13,9 @@ project's cache is left alone):
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
 - warm: `--help`, `info`, `make` with the kernels cached (every later run);
 - make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
-  faces), warm cache, fold on, A4 at 150 mm: seconds and peak memory.
+  faces, one per noise seed of --sphere-seeds; bunny-348 Loop-subdivided once, 1,392 faces, a
+  model whose small faces crowd its labels at 150 mm), warm cache, fold on, A4 at 150 mm: seconds
+  and peak memory.
 Prints a table; compile seconds per stage are the cold make's own (report.json "compile_seconds").
 """
 
@@ -34,6 +36,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "polyfold").exists() else [sys.executable, "-m", "polyfold"]
 BUNNY = ROOT / "examples" / "bunny-128.obj"
+MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
 
 
 def _tree_pss_mb(pid: int) -> float:
@@ -107,6 +110,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--skip-cold", action="store_true", help="no cold rows (each compiles for about a minute)")
     ap.add_argument("--sizes", default="128,1500,5000", help="face counts of the make rows")
+    ap.add_argument("--sphere-seeds", default="1,2,3", help="noise draws of each size's sphere (a sphere each)")
+    ap.add_argument("--no-dense", action="store_true", help="leave out the Loop-subdivided bunny-348")
     a = ap.parse_args()
     rows: list[tuple[str, float, float, str]] = []
     tmp = Path(tempfile.mkdtemp(prefix="bench-start-"))
@@ -133,17 +138,30 @@ def main() -> None:
                         ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"])):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
         rows.append((label, best[0], best[1], ""))
+    meshes = []  # (label, path)
     for n in (int(s) for s in a.sizes.split(",")):
         if n == 128:
             continue
-        mesh = tmp / f"sphere-{n}.obj"
-        got = sphere_obj(mesh, n)
-        wall, mb, code = run(["make", str(mesh), "-o", str(tmp / f"make-{n}"), "-q"])
+        for seed in (int(s) for s in a.sphere_seeds.split(",")):
+            mesh = tmp / f"sphere-{n}-{seed}.obj"
+            got = sphere_obj(mesh, n, seed)
+            meshes.append((f"make noisy sphere, {got} faces, noise seed {seed}", mesh))
+    if not a.no_dense and (MODELS / "bunny-348.obj").exists():
+        sys.path.insert(0, str(ROOT / "bench"))
+        from bench_build import loop_subdivided
+
+        v, f = loop_subdivided(MODELS / "bunny-348.obj", 1)
+        mesh = tmp / "bunny-348-loop1.obj"
+        mesh.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
+                        + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
+        meshes.append((f"make bunny-348 Loop-subdivided, {len(f)} faces", mesh))
+    for k, (label, mesh) in enumerate(meshes):
+        wall, mb, code = run(["make", str(mesh), "-o", str(tmp / f"make-{k}"), "-q"])
         note = "" if code == 0 else f"exit {code}"
         if code == 0:
-            st = stages(tmp / f"make-{n}")
+            st = stages(tmp / f"make-{k}")
             note = ", ".join(f"{k} {v:.1f}" for k, v in st.items() if v > 0.05)
-        rows.append((f"make noisy sphere, {got} faces", wall, mb, note))
+        rows.append((label, wall, mb, note))
     print(f"{'what':44s} {'wall s':>8s} {'peak MB':>8s}  notes")
     for label, wall, mb, note in rows:
         print(f"{label:44s} {wall:8.2f} {mb:8.0f}  {note}")
