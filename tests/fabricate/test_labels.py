@@ -76,7 +76,8 @@ def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, 
     """`pieces._labels` places each piece on its own, in forked processes from PARALLEL_LABELS
     labels on: the sheets are the same as in one process, when every edge gets its label (the
     bunny) and when that fails and seam runs are labelled instead (the fish at 60 mm, cut to fit
-    80 mm pages: 11 pieces)."""
+    80 mm pages: 11 pieces). Asked to label by seam run at once (`by_run`, a redraw of such
+    pieces), the fish's sheets are the same again, without the failed try."""
     import shapely
 
     from polyfold.deadline import Deadline
@@ -94,10 +95,10 @@ def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, 
     fitted, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts), name)
     inputs = part_piece_inputs(mesh, fitted)
 
-    def sheet(workers: int):
+    def sheet(workers: int, by_run: bool = False):
         monkeypatch.setattr(P, "PARALLEL_LABELS", 0)
         monkeypatch.setattr("polyfold.processes.usable_cores", lambda: workers)
-        pieces, glue, stats = P.build_sheet_pieces(inputs, scale)
+        pieces, glue, stats = P.build_sheet_pieces(inputs, scale, by_run=by_run)
         for i, piece in enumerate(pieces[:len(inputs)]):  # every piece got its own labels
             assert [t.text for t in piece.texts if t.kind == "piece-label"] == [P.piece_name(i)]
         return ([(p.texts, p.leaders.tobytes(), shapely.to_wkb(p.outline), shapely.to_wkb(p.footprint)) for p in pieces],
@@ -106,4 +107,6 @@ def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, 
     one, many = sheet(1), sheet(3)
     assert len(inputs) >= 3 and sum(len(p[0]) for p in one[0]) > len(inputs)  # names and glue labels
     assert one == many
-    assert (one[2].seam_runs > 0) == (name == "fish-472")
+    assert (one[2].seam_runs > 0) == (name == "fish-472") == one[2].labels_by_run
+    if name == "fish-472":
+        assert sheet(1, by_run=True) == one

@@ -129,6 +129,7 @@ class LayoutStats:
     labels_outside: int = 0  # glue labels printed just outside their edge
     seam_runs: int = 0  # runs of several glue edges printed with one label (too dense for one per edge)
     crowded: tuple[tuple[int, float, float], ...] = ()  # (piece, x, y mm in its frame) of every small label
+    labels_by_run: bool = False  # one glue label per seam run (one beside every edge found no room, or `by_run`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -496,12 +497,15 @@ def _note_spot(side, name: str, size: float, smallest: float, taken: list) -> Te
 
 
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
-                       min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never()
-                       ) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+                       min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never(),
+                       by_run: bool = False) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
     """Draw every piece in mm and pair up their cut edges (see the module docstring). Tabs:
     `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed.
-    Labels: `labels.PieceLabels`, cap height at least `min_label_mm`. OutOfTime past `deadline`
-    (checked between pieces, tabs and labels)."""
+    Labels: `labels.PieceLabels`, cap height at least `min_label_mm`: one beside every glued edge,
+    or, when one of those finds no readable place, one per seam run (`LayoutStats.labels_by_run`);
+    by_run: per seam run at once (a redraw of pieces whose drawing needed them: the failed try
+    took a third of a dense model's drawing). OutOfTime past `deadline` (checked between pieces,
+    tabs and labels)."""
     import shapely
 
     drawn = []
@@ -516,8 +520,8 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
     g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline)
     bare = [room.copy() for room in rooms]
-    per_edge = _labels(pairs, drawn, rooms, chosen, min_label_mm, [[i] for i in range(len(pairs))], deadline,
-                       all_or_none=True)
+    per_edge = None if by_run else _labels(pairs, drawn, rooms, chosen, min_label_mm,
+                                           [[i] for i in range(len(pairs))], deadline, all_or_none=True)
     if per_edge is not None:
         placed, label_stats = per_edge
     else:
@@ -558,5 +562,6 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
                         untabbed=(), small_labels=label_stats.unplaced, open_edges=open_edges,
                         reduced_tabs=tuple(g.reduced), labels_on_tabs=label_stats.on_tabs,
                         labels_outside=label_stats.outside, seam_runs=label_stats.runs // 2,
-                        crowded=tuple((i, float(x), float(y)) for i, p in enumerate(placed) for x, y in p.crowded))
+                        crowded=tuple((i, float(x), float(y)) for i, p in enumerate(placed) for x, y in p.crowded),
+                        labels_by_run=per_edge is None)
     return pieces, g.glue, stats

@@ -207,7 +207,8 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
                     say: Callable[[str, str], None], hard: Deadline = Deadline.never()) -> PageSplit:
     """Cut creases where that puts the pieces on fewer pages (`fabricate.split`), before folding.
 
-    The pieces are drawn (tabs and labels included) and packed as they are. Then, for each page
+    The pieces are drawn (tabs and labels included) and packed as they are; when their labels had
+    to go by seam run, so do the labels of every redrawing (`build_sheet_pieces`' by_run). Then, for each page
     count from the fewest that their outlines grown by half the gap fill to at most MAX_FILL up to
     one fewer than that packing:
     `plan_pages` plans the cuts, the cut pieces are redrawn (their tabs are real now) and planned
@@ -222,10 +223,11 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     started with that drawing's time left. `deadline` ends this optional work (the label rounds
     too); a drawing stops the run at `hard` (OutOfTime)."""
     page, margin = _packer_page(box)
+    by_run = False  # the first drawing's labels went by seam run: so do the redrawings of its pieces
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
         pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm,
-                                                 deadline=hard)
+                                                 deadline=hard, by_run=by_run)
         return pieces, glue, stats
 
     def pack(pcs: list[SheetPiece], hint: list[int] | None, seconds: float) -> Packing:
@@ -236,6 +238,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     t0 = time.perf_counter()
     drawn = draw(inputs)  # lay_out's drawing when folding splits nothing: not this stage's cost
     draw_seconds = time.perf_counter() - t0
+    by_run = drawn[2].labels_by_run
     parts, inputs, drawn, label_cuts, labels_ran_out = _split_for_labels(mesh, parts, inputs, drawn, draw, say,
                                                                          deadline, draw_seconds)
     pieces = drawn[0]
@@ -353,7 +356,8 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     else:
         say("layout", f"tabs and labels for {len(folded)} pieces")
         pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
-                                                 min_label_mm=opts.min_label_mm, deadline=deadline)
+                                                 min_label_mm=opts.min_label_mm, deadline=deadline,
+                                                 by_run=planned is not None and planned.drawn[2].labels_by_run)
     unnoted = 0
     if glued_to is not None:
         pieces, unnoted = with_side_notes(list(pieces), glued_to, opts.min_label_mm)
