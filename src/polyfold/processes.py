@@ -22,6 +22,14 @@ def usable_cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
+def can_fork() -> bool:
+    """Whether work may go to processes forked from this one: on Linux (fork is unsafe on macOS),
+    outside daemonic processes (which may not have children)."""
+    import multiprocessing as mp
+
+    return sys.platform.startswith("linux") and not mp.current_process().daemon
+
+
 def _call(item: Any) -> Any:
     assert _TASK is not None
     return _TASK(item)
@@ -34,7 +42,7 @@ def _forking_pool(processes: int):
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    if not sys.platform.startswith("linux") or mp.current_process().daemon:
+    if not can_fork():
         return None
     try:
         return ProcessPoolExecutor(processes, mp_context=mp.get_context("fork"))
@@ -82,7 +90,7 @@ def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]
     run here when its process dies."""
     import multiprocessing as mp
 
-    if not sys.platform.startswith("linux") or mp.current_process().daemon:
+    if not can_fork():
         return here(), there()
     ctx = mp.get_context("fork")
     receive, send = ctx.Pipe(duplex=False)

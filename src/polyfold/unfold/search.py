@@ -405,10 +405,11 @@ def _race(first: _Stream, second: _Stream) -> tuple[tuple[_Outcome, _Outcome], l
     (NEVER: none): the earliest wins, the first on a tie, so the winner does not depend on which
     search runs faster. With two cores the second runs in a forked process (`processes.beside`)
     and each stops once the other has won a round it cannot beat (its deadline is up then, so
-    mid-step); on one core they take turns, a round each, until one wins."""
+    mid-step); on one core (or where no process can be forked) they take turns, a round each,
+    until one wins."""
     from multiprocessing import RawArray
 
-    from ..processes import beside, usable_cores
+    from ..processes import beside, can_fork, usable_cores
 
     streams, offset = (first, second), (0, first.generation)
     won = RawArray("q", [NEVER, NEVER])  # (shared with the forked process)
@@ -438,7 +439,7 @@ def _race(first: _Stream, second: _Stream) -> tuple[tuple[_Outcome, _Outcome], l
             pass
         return streams[k].outcome()
 
-    if usable_cores() >= 2:
+    if usable_cores() >= 2 and can_fork():
         outcomes = beside(lambda: run(0), lambda: run(1))
     else:
         while any([step(0), step(1)]):
