@@ -27,6 +27,11 @@ def test_or_when_is_up_once_its_test_says_so_and_shares_keep_the_test():
     for made in (d, d.within(5), d.share(2), d.before(1)):
         assert made.expired() and made.left() == 0.0
     assert Deadline(clock() - 1).or_when(lambda: False).expired()  # the clock still counts
+    outer = []
+    both = Deadline.after(100).or_when(lambda: bool(outer)).or_when(lambda: False)
+    assert not both.expired()
+    outer.append(True)
+    assert both.expired()  # the first test is kept
 
 
 def test_check_raises_out_of_time_only_when_expired():

@@ -126,8 +126,11 @@ class Deadline:
 
     def or_when(self, stop: Callable[[], bool]) -> Deadline:
         """This deadline, also up once stop() is true (a search that another has beaten; the
-        deadlines made from it keep the test)."""
-        return Deadline(self.at, stop)
+        deadlines made from it keep the test, and it keeps this one's)."""
+        if self.stop is None:
+            return Deadline(self.at, stop)
+        before = self.stop
+        return Deadline(self.at, lambda: before() or stop())
 
     def check(self, doing: str) -> None:
         """Raise OutOfTime("... while <doing>") when time is up: the check between steps of work

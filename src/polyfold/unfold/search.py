@@ -301,26 +301,25 @@ class _Stream:
     def outcome(self) -> _Outcome:
         """What the search found (picklable: a forked race returns it)."""
         if self.answer is not None:
-            return _Outcome(self.answer[0], 0.0, self.answer[1], True, False, tuple(self.counts))
+            return _Outcome(self.answer[0], 0.0, self.answer[1], False, tuple(self.counts))
         if self.finished.fallback is not None:
-            return _Outcome(self.finished.fallback, 0.0, "ga+local-search", False, True, tuple(self.counts))
+            return _Outcome(self.finished.fallback, 0.0, "ga+local-search", True, tuple(self.counts))
         best, best_fit = self.best, self.best_fit
         if len(self.fit):
             i = int(np.argmax(self.fit))
             if self.fit[i] > best_fit:
                 best, best_fit = self.pop[i].copy(), float(self.fit[i])
-        return _Outcome(best, best_fit, "ga+local-search", False, False, tuple(self.counts))
+        return _Outcome(best, best_fit, "ga+local-search", False, tuple(self.counts))
 
 
 @dataclass(frozen=True, eq=False)
 class _Outcome:
-    """A stream's result: run_memetic's tuple, whether `accept` passed the genome (solved) or it
-    is the valid net it turned down first (fallback)."""
+    """What a `_Stream` found: its answer, else the first valid net `accept` turned down
+    (`fallback`), else its fittest genome; the fitness (0 for a valid net) and how it was found."""
 
     genome: np.ndarray
     fitness: float
     origin: str
-    solved: bool
     fallback: bool
     counts: tuple[tuple[int, int, int], ...]  # (round, generations, evaluations) of each step
 
