@@ -19,7 +19,7 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
-                   "unfold.tabroom._swap_gains"):
+                   "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
 
 
@@ -161,3 +161,51 @@ def test_make_calls_ready_once_per_stage_before_its_work(tmp_path):
     # the fold stage's first message comes before any piece is planned (the first run waits there)
     fold_messages = [m for s, m in seen if s == "fold"]
     assert fold_messages[0].startswith("planning folding paths for")
+
+
+_CROWDED_LABEL_SIGNATURES = r"""
+import json, sys
+from pathlib import Path
+import polyfold.fabricate.labels as L
+from polyfold.apps.benchpaper import kernel_signatures
+from polyfold.apps.warmup import _warm_crowded_labels
+from polyfold.deadline import Deadline
+from polyfold.fabricate import pieces as P
+from polyfold.fabricate.fit import model_scale
+from polyfold.formats.meshes import load_mesh
+from polyfold.pipeline.options import MakeOptions, paper_size
+from polyfold.pipeline.parts import make_parts
+from polyfold.pipeline.sheets import fit_parts, pack_box, part_piece_inputs
+
+_warm_crowded_labels()
+before = kernel_signatures()
+calls = {"free_near": 0, "routed_near": 0}
+for name in calls:
+    def counted(*a, _f=getattr(L._Taken, name), _n=name, **k):
+        calls[_n] += 1
+        return _f(*a, **k)
+    setattr(L._Taken, name, counted)
+mesh = load_mesh(Path(sys.argv[1])).mesh
+opts = MakeOptions(size=60.0, paper="80x80mm")
+parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+scale = model_scale([mesh], opts.size)
+fitted, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts), "fish")
+P.PARALLEL_LABELS = 10**9  # (every piece here, in this process)
+P.build_sheet_pieces(part_piece_inputs(mesh, fitted), scale)
+after = kernel_signatures()
+new = {k: sorted(v - before.get(k, set())) for k, v in after.items() if v - before.get(k, set()) and k.startswith("fabricate.labels")}
+print(json.dumps({"new": new, "calls": calls}))
+"""
+
+
+def test_the_warm_up_compiles_the_kernels_of_crowded_labels(models_dir):
+    """Crowded pieces (the fish at 60 mm on 80 mm pages: labels by seam run, far from their edges)
+    call the label kernels with the signatures the warm-up compiled (a fresh process)."""
+    import json
+
+    proc = subprocess.run([sys.executable, "-c", _CROWDED_LABEL_SIGNATURES, str(models_dir / "fish-472.obj")],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    got = json.loads(proc.stdout.splitlines()[-1])
+    assert got["calls"]["free_near"] > 0 and got["calls"]["routed_near"] > 0
+    assert got["new"] == {}, f"crowded labels compile beyond the warm-up: {got['new']}"

@@ -50,7 +50,6 @@ FREE_CELL_MM = 0.2  # cell of the raster of what is taken on a piece, which find
 ELSEWHERE_TRIES = 40  # most spots checked exactly per label (nearest first)
 LEADER_STEP_MM = 0.4  # a leader is looked up in the raster at points this far apart
 LEADER_TRIES = 1000  # most spots whose leader is checked against the raster (nearest first)
-LEADER_BATCH = 200  # spots whose leaders are checked at once
 ELSEWHERE_GIVE_UP = 20  # a piece where this many labels found no spot is too crowded to look further
 TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
 
@@ -270,6 +269,33 @@ def _grid_bfs(free, sr, sc, max_steps, ok, want):
     return dist, found[:n_found]
 
 
+@njit(cache=True)
+def _clear_leaders(texts, origin, inv_cell, p, centres, t, want):
+    """Indices (up to want, in order) of the centres (k, 2) whose leader from p crosses no True
+    cell of `texts` (ny, nx): the leader is looked up at the points p + t (centre - p), each in the
+    cell (column, row) = int((point - origin) inv_cell), clipped to the raster (as
+    `_Taken._cells`), and given up at its first taken point."""
+    ny, nx = texts.shape
+    out = np.empty(min(want, len(centres)), dtype=np.int64)
+    n = 0
+    for i in range(len(centres)):
+        if n == want:
+            break
+        clear = True
+        for j in range(len(t)):
+            c = np.int32((p[0] + t[j] * (centres[i, 0] - p[0]) - origin[0]) * inv_cell)
+            r = np.int32((p[1] + t[j] * (centres[i, 1] - p[1]) - origin[1]) * inv_cell)
+            c = min(max(c, 0), nx - 1)
+            r = min(max(r, 0), ny - 1)
+            if texts[r, c]:
+                clear = False
+                break
+        if clear:
+            out[n] = i
+            n += 1
+    return out[:n]
+
+
 class _Taken:
     """A raster (FREE_CELL_MM cells) of what a label may not touch on one piece, for finding free
     spots fast: every face side (outline, creases and the sides inside flat polygons alike),
@@ -417,17 +443,10 @@ class _Taken:
             near = near[np.argpartition(d2[near], LEADER_TRIES)[:LEADER_TRIES]]
         centres = centres[near[np.argsort(d2[near], kind="stable")]]
         # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
-        # most) are free; looked at in batches, nearest first, until `want` are found
+        # most) are free; nearest first, until `want` are found
         t = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
-        found = []
-        for k in range(0, len(centres), LEADER_BATCH):
-            batch = centres[k:k + LEADER_BATCH]
-            ij = self._cells((p + t[None, :, None] * (batch - p)[:, None, :]).reshape(-1, 2))
-            crossed = self.texts[ij[:, 1], ij[:, 0]].reshape(len(batch), len(t)).any(axis=1)
-            found.append(batch[~crossed])
-            if sum(len(f) for f in found) >= want:
-                break
-        return np.concatenate(found)[:want] if found else np.zeros((0, 2))
+        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, np.asarray(p, dtype=np.float64),
+                                      centres, t, want)]
 
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
