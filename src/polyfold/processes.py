@@ -35,21 +35,6 @@ def _call(item: Any) -> Any:
     return _TASK(item)
 
 
-def _forking_pool(processes: int):
-    """A ProcessPoolExecutor of `processes` processes forked from this one (when first given
-    work), or None where work must run here: other systems than Linux, a daemonic process (which
-    may not have children), or no pool to be had (its queues' locks need /dev/shm)."""
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
-
-    if not can_fork():
-        return None
-    try:
-        return ProcessPoolExecutor(processes, mp_context=mp.get_context("fork"))
-    except OSError:  # (an error raised by the work is not caught here)
-        return None
-
-
 def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list[Any]:
     """[fn(x) for x in items], in that order, run by up to `workers` processes forked from this
     one, which take the items one at a time (put the longest first). fn and whatever it reads are
@@ -59,12 +44,17 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     other systems than Linux, in a daemonic process (which may not have children), or when no
     pool can be made (no /dev/shm for its locks); when a worker dies (killed, out of memory) the
     items are done here instead of waiting for it forever."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
     global _TASK
     workers = min(workers, len(items))
-    pool = _forking_pool(workers) if workers >= 2 else None
-    if pool is None:
+    if workers < 2 or not can_fork():
+        return [fn(x) for x in items]
+    try:
+        pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"))
+    except OSError:  # its queues' locks need /dev/shm (an error raised by fn is not caught here)
         return [fn(x) for x in items]
     _TASK = fn  # (set before the workers fork: they start when the items are handed out)
     # what this process holds is no garbage the workers need look at: frozen, their collections
