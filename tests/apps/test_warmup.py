@@ -19,7 +19,9 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
-                   "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs"):
+                   "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs",
+                   "fabricate.overlap_kernels.overlap_area", "fabricate.overlap_kernels.offset_bounds",
+                   "fabricate.overlap_kernels.is_convex"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
 
 

@@ -1,0 +1,170 @@
+"""Compiled areas of overlap between one convex polygon and a piece's obstacles (`tabs.Room`).
+
+Polygons are rings of points (k, 2), not closed (the first point is not repeated), either
+orientation. An obstacle is one or more rings in a shared table: `pts` (P, 2) the points of every
+ring, ring r being pts[ring_ptr[r]:ring_ptr[r + 1]] with `ring_sign[r]` +1 (an outer ring) or -1
+(a hole), obstacle o being rings obs_ptr[o] to obs_ptr[o + 1] - 1. Its area within a convex
+polygon C is the sum over its rings of sign * area(ring clipped to C): Sutherland-Hodgman clipping
+by a convex window gives a ring (degenerate where the subject is not convex) whose shoelace area
+is the area of the subject within the window, for any simple subject ring.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _orientation(ring: np.ndarray) -> float:
+    """Twice the signed area of a ring (k, 2): positive counter-clockwise (y up)."""
+    s = 0.0
+    n = ring.shape[0]
+    for i in range(n):
+        j = (i + 1) % n
+        s += ring[i, 0] * ring[j, 1] - ring[j, 0] * ring[i, 1]
+    return s
+
+
+@njit(cache=True)
+def _area(bufs: np.ndarray, b: int, n: int) -> float:
+    """Area (positive) of the ring bufs[b, :n]; 0 under 3 points."""
+    if n < 3:
+        return 0.0
+    s = 0.0
+    for i in range(n):
+        j = (i + 1) % n
+        s += bufs[b, i, 0] * bufs[b, j, 1] - bufs[b, j, 0] * bufs[b, i, 1]
+    return abs(s) / 2.0
+
+
+@njit(cache=True)
+def is_convex(ring: np.ndarray, tol: float) -> bool:
+    """Whether a ring (k, 2) turns one way only at every corner (turns below `tol` x the two
+    sides' lengths are straight: a buffer's arcs)."""
+    n = ring.shape[0]
+    pos, neg = False, False
+    for i in range(n):
+        a, b, c = ring[i], ring[(i + 1) % n], ring[(i + 2) % n]
+        ux, uy, vx, vy = b[0] - a[0], b[1] - a[1], c[0] - b[0], c[1] - b[1]
+        cross = ux * vy - uy * vx
+        scale = np.hypot(ux, uy) * np.hypot(vx, vy)
+        if cross > tol * scale:
+            pos = True
+        elif cross < -tol * scale:
+            neg = True
+    return not (pos and neg)
+
+
+@njit(cache=True)
+def _clip(bufs: np.ndarray, src: int, n: int, window: np.ndarray, sign: float) -> tuple[int, int]:
+    """The ring bufs[src, :n] clipped to the convex `window` (k, 2), whose orientation is `sign`
+    (+1 counter-clockwise), clipping back and forth between bufs[src] and bufs[1 - src]:
+    (the buffer holding the result, its length; -1 when the buffers are too small)."""
+    cur, m = src, n
+    k = window.shape[0]
+    size = bufs.shape[1]
+    for e in range(k):
+        if m == 0:
+            break
+        if 2 * m > size:  # (a half-plane at most doubles a ring: no room, no answer)
+            return cur, -1
+        ax, ay = window[e, 0], window[e, 1]
+        ex, ey = window[(e + 1) % k, 0] - ax, window[(e + 1) % k, 1] - ay
+        if ex == 0.0 and ey == 0.0:
+            continue
+        out = 1 - cur
+        cnt = 0
+        for i in range(m):
+            j = (i + 1) % m
+            px, py = bufs[cur, i, 0], bufs[cur, i, 1]
+            qx, qy = bufs[cur, j, 0], bufs[cur, j, 1]
+            dp = sign * (ex * (py - ay) - ey * (px - ax))
+            dq = sign * (ex * (qy - ay) - ey * (qx - ax))
+            if dp >= 0.0:
+                bufs[out, cnt, 0], bufs[out, cnt, 1] = px, py
+                cnt += 1
+            if (dp >= 0.0) != (dq >= 0.0):
+                t = dp / (dp - dq)
+                bufs[out, cnt, 0], bufs[out, cnt, 1] = px + t * (qx - px), py + t * (qy - py)
+                cnt += 1
+        cur, m = out, cnt
+    return cur, m
+
+
+@njit(cache=True)
+def overlap_area(window: np.ndarray, discs: np.ndarray, pts: np.ndarray, ring_ptr: np.ndarray,
+                 ring_sign: np.ndarray, obs_ptr: np.ndarray, obstacles: np.ndarray) -> float:
+    """Area of the obstacles (indices into the table: see the module docstring) within the convex
+    ring `window` (k, 2) and outside every one of `discs` (d, m, 2: convex rings, at most two);
+    nan when a clipped ring outgrows the work arrays."""
+    longest = 0
+    for o in obstacles:
+        for r in range(obs_ptr[o], obs_ptr[o + 1]):
+            longest = max(longest, ring_ptr[r + 1] - ring_ptr[r])
+    size = 4 * (longest + window.shape[0] + discs.shape[1]) + 16
+    hit = np.empty((2, size, 2))  # the ring within the window
+    part = np.empty((2, size, 2))  # that within a disc, or both
+    s_window = 1.0 if _orientation(window) >= 0 else -1.0
+    s_disc = np.empty(discs.shape[0])
+    for k in range(discs.shape[0]):
+        s_disc[k] = 1.0 if _orientation(discs[k]) >= 0 else -1.0
+    total = 0.0
+    for o in obstacles:
+        for r in range(obs_ptr[o], obs_ptr[o + 1]):
+            n = ring_ptr[r + 1] - ring_ptr[r]
+            for i in range(n):
+                hit[0, i, 0], hit[0, i, 1] = pts[ring_ptr[r] + i, 0], pts[ring_ptr[r] + i, 1]
+            h, m = _clip(hit, 0, n, window, s_window)
+            if m < 0:
+                return np.nan
+            if m < 3:
+                continue
+            area = _area(hit, h, m)
+            for k in range(discs.shape[0]):  # minus the discs (inclusion-exclusion over the two)
+                for i in range(m):
+                    part[0, i, 0], part[0, i, 1] = hit[h, i, 0], hit[h, i, 1]
+                p, m1 = _clip(part, 0, m, discs[k], s_disc[k])
+                if m1 < 0:
+                    return np.nan
+                area -= _area(part, p, m1)
+                for k2 in range(k + 1, discs.shape[0]):
+                    if m1 >= 3:
+                        p2, m2 = _clip(part, p, m1, discs[k2], s_disc[k2])
+                        if m2 < 0:
+                            return np.nan
+                        area += _area(part, p2, m2)
+            total += ring_sign[r] * area
+    return total
+
+
+@njit(cache=True)
+def offset_bounds(ring: np.ndarray, dist: float) -> tuple[np.ndarray, np.ndarray]:
+    """Two convex rings between which every round-joined buffer of the convex `ring` by `dist`
+    lies whose arcs are polylines with their corners on the circle (GEOS's, any quad_segs): the
+    bevelled one (each edge moved out by dist, consecutive ones joined by a chord: inside it) and
+    the mitred one (consecutive moved edges extended to meet: around it). Same orientation as ring."""
+    n = ring.shape[0]
+    sign = 1.0 if _orientation(ring) >= 0 else -1.0
+    normals = np.zeros((n, 2))
+    edges = np.empty(n, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        j = (i + 1) % n
+        ex, ey = ring[j, 0] - ring[i, 0], ring[j, 1] - ring[i, 1]
+        length = np.sqrt(ex * ex + ey * ey)
+        if length > 1e-12:  # outward: to the right of a counter-clockwise edge
+            normals[i, 0], normals[i, 1] = sign * ey / length, -sign * ex / length
+            edges[m] = i
+            m += 1
+    bevel = np.empty((2 * m, 2))
+    mitre = np.empty((m, 2))
+    for q in range(m):
+        i, h = edges[q], edges[(q + m - 1) % m]  # edge i starts at ring[i]; edge h ends there
+        hx, hy, ix, iy = normals[h, 0], normals[h, 1], normals[i, 0], normals[i, 1]
+        vx, vy = ring[i, 0], ring[i, 1]
+        bevel[2 * q, 0], bevel[2 * q, 1] = vx + dist * hx, vy + dist * hy
+        bevel[2 * q + 1, 0], bevel[2 * q + 1, 1] = vx + dist * ix, vy + dist * iy
+        f = dist / max(1.0 + hx * ix + hy * iy, 1e-12)
+        mitre[q, 0], mitre[q, 1] = vx + f * (hx + ix), vy + f * (hy + iy)
+    return bevel, mitre

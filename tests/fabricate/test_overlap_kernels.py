@@ -1,0 +1,121 @@
+"""fabricate/overlap_kernels.py and the `tabs.Room.blocked` built on it: areas of overlap and the
+blocked answers are checked against shapely's overlays (GEOS), an independent implementation, on
+random scenes: convex windows against non-convex obstacles with holes, near contact included."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import Polygon
+
+from polyfold.fabricate.overlap_kernels import is_convex, offset_bounds, overlap_area
+from polyfold.fabricate.tabs import OVERLAP_MM2, TAB_CLEAR_MM, Room, _Obstacles
+
+
+def _convex(rng: np.random.Generator, centre: np.ndarray, size: float) -> np.ndarray:
+    hull = shapely.convex_hull(shapely.multipoints(centre + rng.normal(0.0, size, (rng.integers(3, 9), 2))))
+    ring = np.asarray(hull.exterior.coords)[:-1]
+    return ring if rng.random() < 0.5 else ring[::-1].copy()
+
+
+def _obstacle(rng: np.random.Generator, centre: np.ndarray, size: float):
+    """A star-shaped (non-convex) polygon, sometimes with a hole, or a triangle."""
+    if rng.random() < 0.3:
+        return Polygon(centre + rng.normal(0.0, size, (3, 2))).buffer(0)
+    k = int(rng.integers(5, 12))
+    angle = (np.arange(k) + rng.uniform(0.0, 0.9, k)) * 2 * np.pi / k  # gaps under pi: a simple ring
+    radius = size * rng.uniform(0.3, 1.2, k)
+    outer = centre + np.stack([np.cos(angle), np.sin(angle)], axis=1) * radius[:, None]
+    holes = [centre + 0.15 * size * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])] if rng.random() < 0.3 else []
+    poly = Polygon(outer, holes)
+    assert Polygon(outer).is_valid
+    return poly if poly.is_valid else Polygon(outer)
+
+
+def _table(geoms) -> _Obstacles:
+    return _Obstacles(np.array(geoms, dtype=object))
+
+
+def test_overlap_area_matches_shapely_on_random_scenes():
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for _ in range(300):
+        window = _convex(rng, np.zeros(2), 2.0)
+        geoms = [_obstacle(rng, rng.normal(0.0, 2.0, 2), 1.5) for _ in range(int(rng.integers(1, 6)))]
+        discs = shapely.buffer(shapely.points(window[:2]), 1.0, quad_segs=16)
+        disc_rings = shapely.get_coordinates(discs).reshape(2, -1, 2)[:, :-1].copy()
+        t = _table(geoms)
+        ids = np.arange(len(geoms), dtype=np.int64)
+        win = Polygon(window)
+        plain = overlap_area(window, np.zeros((0, 1, 2)), t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, ids)
+        expect = sum(shapely.intersection(win, g).area for g in geoms)
+        worst = max(worst, abs(plain - expect))
+        outside = overlap_area(window, disc_rings, t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, ids)
+        expect = sum(shapely.difference(shapely.intersection(win, g), shapely.union_all(discs)).area for g in geoms)
+        worst = max(worst, abs(outside - expect))
+    assert worst < 1e-9
+
+
+def test_the_offset_rings_hold_shapelys_buffer_between_them():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        ring = _convex(rng, np.zeros(2), 3.0)
+        assert is_convex(ring, 1e-9)
+        within, around = offset_bounds(ring, 0.5)
+        for quad_segs in (1, 2, 8):
+            grown = Polygon(ring).buffer(0.5, quad_segs=quad_segs)
+            assert shapely.difference(Polygon(within), grown).area < 1e-9
+            assert shapely.difference(grown, Polygon(around)).area < 1e-9
+    star = np.array([[0, 0], [4, 0], [1, 1], [0, 4]], dtype=float)
+    assert not is_convex(star, 1e-9)
+
+
+def _blocked_by_shapely(room: Room, poly, skip_face, clear, keep_free) -> bool:
+    """Room.blocked as shapely's overlays alone (what it was before the kernels)."""
+    grown = poly.buffer(clear, quad_segs=2) if clear else poly
+    near = room.obstacles(grown, skip_face)
+    if not near:
+        return False
+    others = np.array(near, dtype=object)
+    if shapely.area(shapely.intersection(poly, others)).sum() > OVERLAP_MM2:
+        return True
+    if not clear:
+        return False
+    hit = shapely.intersection(grown, others)
+    if keep_free is not None:
+        hit = shapely.difference(hit, shapely.union_all(shapely.polygons(keep_free())))
+    return bool(shapely.area(hit).sum() > OVERLAP_MM2)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_blocked_gives_shapelys_answers_near_contact(seed):
+    # tabs (trapezoids) beside faces and extras that come within 0 to 1 mm of them: most answers
+    # are decided by the chord- and mitre-joined rings, the rest by the buffer itself
+    rng = np.random.default_rng(seed)
+    answers = []
+    for _ in range(400):
+        edge = rng.uniform(3.0, 15.0)
+        depth = min(6.0, 0.4 * edge)
+        tab = np.array([[0.0, 0.0], [depth, -depth], [edge - depth, -depth], [edge, 0.0]])
+        face = np.array([[0.0, 0.0], [edge, 0.0], [edge / 2, edge]])
+        centre = tab.mean(axis=0)
+        others = [face]
+        for _ in range(int(rng.integers(1, 4))):
+            # a thin triangle pointing at the tab from 0.8 mm away to 0.1 mm inside it
+            around = Polygon(tab).buffer(rng.uniform(-0.1, 0.8), quad_segs=8).exterior
+            tip = np.asarray(around.interpolate(rng.uniform(0.0, around.length)).coords[0])
+            away = (tip - centre) / max(np.linalg.norm(tip - centre), 1e-9)
+            side = np.array([-away[1], away[0]])
+            others.append(np.array([tip, tip + 3.0 * away + side, tip + 3.0 * away - side]))
+        room = Room(np.array([Polygon(o) for o in others], dtype=object))
+        if rng.random() < 0.5:
+            room.add([Polygon(others[-1] + [0.0, -4.0])])
+        discs = shapely.get_coordinates(shapely.buffer(shapely.points(tab[[0, 3]]), 2 * TAB_CLEAR_MM,
+                                                       quad_segs=16)).reshape(2, -1, 2)[:, :-1].copy()
+        poly = Polygon(tab)
+        for clear, keep in ((TAB_CLEAR_MM, lambda: discs), (TAB_CLEAR_MM, None), (0.0, None)):
+            got = room.blocked(poly, 0, clear, keep)
+            assert got == _blocked_by_shapely(room, poly, 0, clear, keep)
+            answers.append(got)
+    assert 0.2 < np.mean(answers) < 0.8  # both answers are tested
