@@ -284,6 +284,8 @@ class Room:
 
 
 _NO_DISCS = np.zeros((0, 1, 2))
+# a unit circle as shapely's Point.buffer draws it (16 segments a quarter, from angle 0 clockwise)
+_CIRCLE = np.stack([np.cos(np.arange(64) * -np.pi / 32), np.sin(np.arange(64) * -np.pi / 32)], axis=1)
 
 
 def _fold_of(part, side: CutSide) -> np.ndarray | None:
@@ -349,16 +351,13 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
     """The tab of a glued pair: the first of TAB_VARIANTS that fits on either side (the first side
     first), else the larger clipped tab of the two sides; None when nothing fits (see the module
     docstring). A tab may touch the faces beside its fold line at the corners, nothing else."""
-    import shapely
     from shapely.geometry import Polygon
 
     # where a tab's fold line meets the neighbouring faces: near contact expected there (the discs
     # around a side's ends, made the first time a tab on that side comes near something)
     @functools.cache
     def corners(s: int) -> np.ndarray:
-        ends = shapely.points([sides[s].p0, sides[s].p1])
-        discs = shapely.buffer(ends, 2 * TAB_CLEAR_MM, quad_segs=16)  # (Point.buffer's 16)
-        return shapely.get_coordinates(discs).reshape(2, -1, 2)[:, :-1].copy()
+        return np.stack([sides[s].p0, sides[s].p1])[:, None, :] + 2 * TAB_CLEAR_MM * _CIRCLE
 
     for depth_kind, side_deg, reason in TAB_VARIANTS:
         for s, side in enumerate(sides):
