@@ -20,8 +20,7 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
                    "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs",
-                   "fabricate.overlap_kernels.overlap_area", "fabricate.overlap_kernels.offset_bounds",
-                   "fabricate.overlap_kernels.is_convex"):
+                   "fabricate.overlap_kernels.blocked_by"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
 
 
@@ -170,7 +169,7 @@ import json, sys
 from pathlib import Path
 import polyfold.fabricate.labels as L
 from polyfold.apps.benchpaper import kernel_signatures
-from polyfold.apps.warmup import _warm_crowded_labels
+from polyfold.apps.warmup import SECTIONS, _warm_crowded_labels
 from polyfold.deadline import Deadline
 from polyfold.fabricate import pieces as P
 from polyfold.fabricate.fit import model_scale
@@ -180,6 +179,13 @@ from polyfold.pipeline.parts import make_parts
 from polyfold.pipeline.sheets import fit_parts, pack_box, part_piece_inputs
 
 _warm_crowded_labels()
+SECTIONS["tabs"][1](None)  # (a first run's second process compiles it)
+import polyfold.fabricate.overlap_kernels as K
+overlap = {"calls": 0}
+def counted_overlap(*a, _f=K.blocked_by):
+    overlap["calls"] += 1
+    return _f(*a)
+K.blocked_by = counted_overlap
 before = kernel_signatures()
 calls = {"free_near": 0, "routed_near": 0}
 for name in calls:
@@ -195,14 +201,15 @@ fitted, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts
 P.PARALLEL_LABELS = 10**9  # (every piece here, in this process)
 P.build_sheet_pieces(part_piece_inputs(mesh, fitted), scale)
 after = kernel_signatures()
-new = {k: sorted(v - before.get(k, set())) for k, v in after.items() if v - before.get(k, set()) and k.startswith("fabricate.labels")}
-print(json.dumps({"new": new, "calls": calls}))
+new = {k: sorted(v - before.get(k, set())) for k, v in after.items() if v - before.get(k, set()) and k.startswith(("fabricate.labels", "fabricate.overlap_kernels"))}
+print(json.dumps({"new": new, "calls": calls, "overlap_calls": overlap["calls"]}))
 """
 
 
 def test_the_warm_up_compiles_the_kernels_of_crowded_labels(models_dir):
     """Crowded pieces (the fish at 60 mm on 80 mm pages: labels by seam run, far from their edges)
-    call the label kernels with the signatures the warm-up compiled (a fresh process)."""
+    call the label kernels with the signatures the warm-up compiled, and their tabs and labels the
+    overlap test with those of the `tabs` section (a fresh process)."""
     import json
 
     proc = subprocess.run([sys.executable, "-c", _CROWDED_LABEL_SIGNATURES, str(models_dir / "fish-472.obj")],
@@ -211,3 +218,4 @@ def test_the_warm_up_compiles_the_kernels_of_crowded_labels(models_dir):
     got = json.loads(proc.stdout.splitlines()[-1])
     assert got["calls"]["free_near"] > 0 and got["calls"]["routed_near"] > 0
     assert got["new"] == {}, f"crowded labels compile beyond the warm-up: {got['new']}"
+    assert got["overlap_calls"] > 0

@@ -137,6 +137,20 @@ def _star_tree():
     return pattern, thickness, opts
 
 
+def _warm_tabs(mesh) -> None:
+    """The layout's overlap kernel (`tabs.Room.blocked`), with the argument types tabs and labels
+    give it: a tab beside a face, its corner discs kept free."""
+    from shapely.geometry import Polygon
+
+    from ..fabricate.tabs import TAB_CLEAR_MM, CutSide, Room, choose_tab
+
+    tri = np.array([[0.0, 0.0], [10.0, 0.0], [5.0, 8.0]])
+    room = Room(np.array([Polygon(tri), Polygon(tri * [1.0, -1.0] + [0.0, -7.0])], dtype=object))
+    side = CutSide(0, 0, 0, tri[0], tri[1], tri)
+    choose_tab((side, side), [room])
+    room.blocked(Polygon(tri + [0.0, -1.0]), None, TAB_CLEAR_MM)
+
+
 def _warm_fold_plan(mesh) -> None:
     """make's fold stage without the check of the paths: the tree, the collision test, a plan."""
     from ..fold.plan import plan_fold
@@ -185,6 +199,7 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "segment": ("segmentation", _warm_segment),
     "inflate": ("inflation", _warm_inflate),
     # a first run's `Beside` (make has them both)
+    "tabs": ("make's layout: the tabs' overlap test", _warm_tabs),
     "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
     "fold-check": ("make's fold stage: the path check", _warm_fold_check),
 }
@@ -198,8 +213,9 @@ BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section
 
 class Beside:
     """Warm-up sections compiled in a second Python process while this one works on, for the
-    stage that needs them: a first run's `make` (nothing in numba's cache) starts the fold stage's
-    planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
+    stage that needs them: a first run's `make` (nothing in numba's cache) starts the layout's
+    overlap test (`tabs`: 2.5 s, in the cache long before this process lays out) and the fold
+    stage's planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
     path check (`fold-check`) itself if the planners are still compiling, then waits for them, and
     loads both from the cache instead of compiling them. The fold stage's kernels are the largest
     share of a first run's compiling (about 31 of 57 s for the bunny here) and share little with the
@@ -245,7 +261,7 @@ def compile_beside() -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
     `kernels_cached()` False); else None."""
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
-        return Beside(("fold-plan",), ("fold-check",), "fold")
+        return Beside(("tabs", "fold-plan"), ("fold-check",), "fold")
     return None
 
 
@@ -266,7 +282,7 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 
     say = progress or (lambda line: None)
     # (make's fold-stage sections bring their own net: no trimesh sphere to build for them)
-    mesh = Mesh(*bumpy_sphere()) if set(names) - {"fold-plan", "fold-check"} else None
+    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check"} else None
     seconds: dict[str, float] = {}
     for name in names:
         what, run = SECTIONS[name]

@@ -168,3 +168,36 @@ def offset_bounds(ring: np.ndarray, dist: float) -> tuple[np.ndarray, np.ndarray
         f = dist / max(1.0 + hx * ix + hy * iy, 1e-12)
         mitre[q, 0], mitre[q, 1] = vx + f * (hx + ix), vy + f * (hy + iy)
     return bevel, mitre
+
+
+@njit(cache=True)
+def blocked_by(poly: np.ndarray, clear: float, discs: np.ndarray, exact: np.ndarray, least: float, pts: np.ndarray,
+               ring_ptr: np.ndarray, ring_sign: np.ndarray, obs_ptr: np.ndarray, obstacles: np.ndarray) -> int:
+    """Whether the obstacles (see the module docstring) cover more than `least` of the convex
+    ring `poly`, or of poly grown by `clear` outside the `discs` (d, m, 2): 1 yes, 0 no; 2 when
+    the grown poly's shape decides and is not given (`exact` with no points; see
+    `offset_bounds`), to be asked again with it; -1 when this cannot say (poly not convex, or
+    a clipped ring outgrew the work arrays)."""
+    if not is_convex(poly, 1e-9):
+        return -1
+    none = np.zeros((0, 1, 2))
+    inside = overlap_area(poly, none, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
+    if np.isnan(inside):
+        return -1
+    if inside > least:
+        return 1
+    if clear <= 0.0:
+        return 0
+    if exact.shape[0] >= 3:
+        near = overlap_area(exact, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
+        return -1 if np.isnan(near) else int(near > least)
+    within, around = offset_bounds(poly, clear)
+    low = overlap_area(within, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
+    if np.isnan(low):
+        return -1
+    if low > least:
+        return 1
+    high = overlap_area(around, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
+    if np.isnan(high):
+        return -1
+    return 0 if high <= least else 2
