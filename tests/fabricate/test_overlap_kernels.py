@@ -119,3 +119,38 @@ def test_blocked_gives_shapelys_answers_near_contact(seed):
             assert got == _blocked_by_shapely(room, poly, 0, clear, keep)
             answers.append(got)
     assert 0.2 < np.mean(answers) < 0.8  # both answers are tested
+
+
+def test_grown_box_meets_gives_shapelys_answers():
+    # label boxes against boxes and leader strips placed 0-1 mm from their grown outline
+    from polyfold.fabricate.labels import LABEL_PAD_MM, _grown_box_hits, text_box
+    from polyfold.fabricate.overlap_kernels import grown_box_meets
+
+    rng = np.random.default_rng(5)
+    answers = []
+    for _ in range(600):
+        turn = rng.uniform(0, 2 * np.pi)
+        box = text_box(rng.normal(0.0, 20.0, 2), np.array([np.cos(turn), np.sin(turn)]), str(rng.integers(1, 999)), 2.5)
+        grown = Polygon(box).buffer(LABEL_PAD_MM, quad_segs=1)
+        edge = grown.exterior
+        tip = np.asarray(edge.interpolate(rng.uniform(0.0, edge.length)).coords[0])
+        away = tip - box.mean(axis=0)
+        away /= np.linalg.norm(away)
+        gap = rng.choice([0.0, rng.uniform(-0.3, 1.0)])
+        if rng.random() < 0.5:  # another label box, a corner towards this one
+            spin = rng.uniform(0, 2 * np.pi)
+            other = text_box(np.zeros(2), np.array([np.cos(spin), np.sin(spin)]), "88", 2.5)
+            corner = other[np.argmin(other @ away)]
+            other = other - corner + tip + gap * away
+        else:  # a leader strip, bent
+            a = tip + gap * away
+            other = np.asarray(shapely.LineString([a, a + 4 * away, a + 4 * away + rng.normal(0, 3, 2)])
+                               .buffer(0.15).exterior.coords)[:-1]
+        near = [(Polygon(other), np.ascontiguousarray(other))]
+        expect = bool(shapely.intersects(grown, Polygon(other)))
+        assert _grown_box_hits(box, near) == expect
+        quick = grown_box_meets(box, LABEL_PAD_MM, near[0][1], np.array([0, len(other)], dtype=np.int64))
+        assert quick in (-1, int(expect))
+        answers.append(quick)
+    answers = np.array(answers)
+    assert (answers == 1).mean() > 0.2 and (answers == 0).mean() > 0.2 and (answers == -1).mean() < 0.3

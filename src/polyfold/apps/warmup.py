@@ -138,11 +138,17 @@ def _star_tree():
 
 
 def _warm_tabs(mesh) -> None:
-    """The layout's overlap kernel (`tabs.Room.blocked`), with the argument types tabs and labels
-    give it: a tab beside a face, its corner discs kept free."""
+    """The layout's overlap kernels, with the argument types tabs and labels give them: a tab
+    beside a face, its corner discs kept free (`tabs.Room.blocked`), and a label box beside
+    another (`labels._Boxes.hits`)."""
     from shapely.geometry import Polygon
 
+    from ..fabricate.labels import _Boxes, text_box
     from ..fabricate.tabs import TAB_CLEAR_MM, CutSide, Room, choose_tab
+
+    boxes = _Boxes()
+    boxes.add(text_box(np.zeros(2), np.array([1.0, 0.0]), "12", 2.0))
+    boxes.hits(text_box(np.array([0.0, 1.0]), np.array([0.0, 1.0]), "3", 2.0))
 
     tri = np.array([[0.0, 0.0], [10.0, 0.0], [5.0, 8.0]])
     room = Room(np.array([Polygon(tri), Polygon(tri * [1.0, -1.0] + [0.0, -7.0])], dtype=object))
@@ -199,7 +205,7 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "segment": ("segmentation", _warm_segment),
     "inflate": ("inflation", _warm_inflate),
     # a first run's `Beside` (make has them both)
-    "tabs": ("make's layout: the tabs' overlap test", _warm_tabs),
+    "tabs": ("make's layout: the overlap tests of tabs and labels", _warm_tabs),
     "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
     "fold-check": ("make's fold stage: the path check", _warm_fold_check),
 }
@@ -214,7 +220,7 @@ BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section
 class Beside:
     """Warm-up sections compiled in a second Python process while this one works on, for the
     stage that needs them: a first run's `make` (nothing in numba's cache) starts the layout's
-    overlap test (`tabs`: 2.5 s, in the cache long before this process lays out) and the fold
+    overlap tests (`tabs`: 3 s, in the cache long before this process lays out) and the fold
     stage's planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
     path check (`fold-check`) itself if the planners are still compiling, then waits for them, and
     loads both from the cache instead of compiling them. The fold stage's kernels are the largest

@@ -29,6 +29,8 @@ when a label per edge does not fit): consecutive sides of one copy, the label be
 
 from __future__ import annotations
 
+import functools
+import itertools
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -70,6 +72,7 @@ def piece_name(i: int) -> str:
     return s
 
 
+@functools.lru_cache(maxsize=4096)  # (a label's spots all ask for its width)
 def text_width(text: str, size: float) -> float:
     """Printed width (mm) of `text` at font `size` (mm) in Helvetica, the font of the PDF and the
     first of the SVG's (Arial, the usual stand-in, has the same widths): the advance widths of
@@ -112,24 +115,28 @@ class _Boxes:
     count: int = 0  # boxes placed (their ids)
 
     def _keys(self, box: np.ndarray):
-        (x0, y0), (x1, y1) = box.min(axis=0) // CELL_MM, box.max(axis=0) // CELL_MM
-        return [(i, j) for i in range(int(x0), int(x1) + 1) for j in range(int(y0), int(y1) + 1)]
+        xs, ys = box[:, 0].tolist(), box[:, 1].tolist()  # (Python's min of a few floats: no numpy call)
+        x0, x1, y0, y1 = (int(v // CELL_MM) for v in (min(xs), max(xs), min(ys), max(ys)))
+        return [(i, j) for i in range(x0, x1 + 1) for j in range(y0, y1 + 1)]
 
     def at(self, corners: np.ndarray) -> list:
         """The placed geometries in the cells of the points `corners` (k, 2)' bounding box, each
         once, in the order they were placed per cell (what `hits` tests against)."""
+        return [geom for geom, _ring in self._items_at(corners)]
+
+    def _items_at(self, corners: np.ndarray) -> list:
         seen: set[int] = set()
         out = []
         for key in self._keys(corners):
-            for i, other in self.cells.get(key, ()):
+            for i, other, ring in self.cells.get(key, ()):
                 if i not in seen:
                     seen.add(i)
-                    out.append(other)
+                    out.append((other, ring))
         return out
 
     def hits(self, box: np.ndarray) -> bool:
         """True when `box` (4, 2), grown by LABEL_PAD_MM, meets a placed box."""
-        return _grown_box_hits(box, self.at(box))
+        return _grown_box_hits(box, self._items_at(box))
 
     def hits_geom(self, geom) -> bool:
         """True when a shapely geometry meets a placed box."""
@@ -142,26 +149,39 @@ class _Boxes:
     def add(self, box: np.ndarray) -> None:
         from shapely.geometry import Polygon
 
-        self.add_geom(Polygon(box))
+        self.add_geom(Polygon(box), np.array(box, dtype=float))
 
-    def add_geom(self, geom) -> None:
-        """Place a shapely geometry (a label box, a leader line's strip)."""
+    def add_geom(self, geom, ring: np.ndarray | None = None) -> None:
+        """Place a shapely geometry (a label box, a leader line's strip); `ring`: its outline
+        (k, 2) when it is one simple polygon (a strip's is read from it)."""
+        if ring is None and geom.geom_type == "Polygon" and not geom.interiors:
+            ring = np.asarray(geom.exterior.coords)[:-1]
         x0, y0, x1, y1 = geom.bounds
-        item = (self.count, geom)
+        item = (self.count, geom, ring)
         self.count += 1
         for key in self._keys(np.array([[x0, y0], [x1, y1]])):
             self.cells.setdefault(key, []).append(item)
 
 
 def _grown_box_hits(box: np.ndarray, near: list) -> bool:
-    """Whether the label box (4, 2) grown by LABEL_PAD_MM meets any of the geometries `near` (grown
-    only when there are any: most candidate spots have none around)."""
+    """Whether the label box (4, 2) grown by LABEL_PAD_MM meets any of the geometries `near`
+    ((shapely geometry, its ring or None) pairs; grown only when there are any: most candidate
+    spots have none around). Told by a compiled test (`overlap_kernels.grown_box_meets`) where it
+    can, else by shapely's buffer (quad_segs=1) and intersects."""
     if not near:
         return False
     import shapely
 
+    if all(ring is not None for _geom, ring in near):
+        from .overlap_kernels import grown_box_meets
+
+        rings = [ring for _geom, ring in near]
+        ptr = np.array([0, *itertools.accumulate(len(r) for r in rings)], dtype=np.int64)
+        answer = grown_box_meets(np.ascontiguousarray(box, dtype=float), LABEL_PAD_MM, np.concatenate(rings), ptr)
+        if answer >= 0:
+            return bool(answer)
     grown = shapely.Polygon(box).buffer(LABEL_PAD_MM, quad_segs=1)
-    return bool(shapely.intersects(grown, np.array(near, dtype=object)).any())
+    return bool(shapely.intersects(grown, np.array([geom for geom, _ring in near], dtype=object)).any())
 
 
 @dataclass
@@ -520,7 +540,7 @@ class PieceLabels:
 
     def _hits(self, box: np.ndarray) -> bool:
         """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
-        return _grown_box_hits(box, self.boxes.at(box) + self.strips.at(box))
+        return _grown_box_hits(box, self.boxes._items_at(box) + self.strips._items_at(box))
 
     def _off_faces(self, geoms: list) -> None:
         """Record what an off-face label puts on the paper (its box, its leader's stretch beyond

@@ -201,3 +201,44 @@ def blocked_by(poly: np.ndarray, clear: float, discs: np.ndarray, exact: np.ndar
     if np.isnan(high):
         return -1
     return 0 if high <= least else 2
+
+
+@njit(cache=True)
+def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.ndarray) -> int:
+    """Whether the ring `box` (k, 2), convex, grown by `pad` with its corners cut by chords
+    (shapely's buffer with quad_segs=1), meets any of the rings pts[ring_ptr[r]:ring_ptr[r + 1]]:
+    1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
+    one of its sides; -1 when neither tells (a ring touching it, or near it across a corner)."""
+    window = offset_bounds(box, pad)[0]
+    k = window.shape[0]
+    sign = 1.0 if _orientation(window) >= 0 else -1.0
+    longest = 0
+    for r in range(ring_ptr.shape[0] - 1):
+        longest = max(longest, ring_ptr[r + 1] - ring_ptr[r])
+    bufs = np.empty((2, 4 * (longest + k) + 16, 2))
+    for r in range(ring_ptr.shape[0] - 1):
+        lo, hi = ring_ptr[r], ring_ptr[r + 1]
+        apart = False
+        for e in range(k):
+            ax, ay = window[e, 0], window[e, 1]
+            ex, ey = window[(e + 1) % k, 0] - ax, window[(e + 1) % k, 1] - ay
+            length = np.sqrt(ex * ex + ey * ey)
+            if length == 0.0:
+                continue
+            beyond = True
+            for i in range(lo, hi):
+                if sign * (ex * (pts[i, 1] - ay) - ey * (pts[i, 0] - ax)) / length > -1e-9:
+                    beyond = False
+                    break
+            if beyond:
+                apart = True
+                break
+        if apart:
+            continue
+        for i in range(hi - lo):
+            bufs[0, i, 0], bufs[0, i, 1] = pts[lo + i, 0], pts[lo + i, 1]
+        b, m = _clip(bufs, 0, hi - lo, window, sign)
+        if m >= 0 and _area(bufs, b, m) > 1e-12:
+            return 1
+        return -1
+    return 0
