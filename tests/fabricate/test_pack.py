@@ -383,3 +383,23 @@ def test_points_hull_is_shapelys_hull_of_the_points():
             assert points_hull(xy).equals(want), (n, t)
             if n >= 3 and want.geom_type == "Polygon":
                 assert len(hull_corners(xy)) <= len(shapely.get_coordinates(want)) - 1 + 2
+
+
+def test_runs_of_a_mask_widest_first_ties_in_row_order():
+    from polyfold.fabricate.pack import _runs
+
+    rng = np.random.default_rng(2)
+    for _ in range(300):
+        h, w = (int(v) for v in rng.integers(1, 25, 2))
+        mask = rng.random((h, w)) < rng.random()
+        runs, row, col = _runs(mask)
+        expect = []
+        for r in range(h):
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], mask[r].astype(int), [0]])))
+            expect += [(r, a, b - 1) for a, b in zip(edges[::2], edges[1::2])]
+        expect = np.array(expect, dtype=np.int64).reshape(-1, 3)
+        expect = expect[np.argsort(expect[:, 1] - expect[:, 2], kind="stable")]
+        assert np.array_equal(runs, expect)
+        if mask.any():
+            rr, cc = np.nonzero(mask)
+            assert np.isclose(row, rr.mean()) and np.isclose(col, cc.mean())

@@ -200,7 +200,8 @@ def overlapping_pairs_between(tris: np.ndarray, parent: np.ndarray, a: np.ndarra
                     if triangles_overlap(tris[f], tris[g], tol):
                         if count == out.shape[0]:
                             grown = np.empty((2 * count, 2), dtype=np.int64)
-                            grown[:count] = out
+                            for q2 in range(count):  # (not grown[:count] = out: see local_search)
+                                grown[q2, 0], grown[q2, 1] = out[q2, 0], out[q2, 1]
                             out = grown
                         out[count, 0] = min(f, g)
                         out[count, 1] = max(f, g)

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..sorting import stable_argsort
 from .triangles import (GEO_LO, face_geometry, faces_cross, load_face, store_face, thick_collides, tri_corners,
                         triangles_collide)
 
@@ -87,9 +88,10 @@ def sort_by_lo_x(geo, sb, si):
 def _merge_sort_by_lo_x(geo, sb, si):
     """si[0] = face ids sorted by (lo x, face id) by a stable merge sort, sb[0] = their lo x (the
     rare fallback of `sort_by_lo_x`: a call, not inlined, keeps compiling fast)."""
-    si[0, :] = np.argsort(geo[:, GEO_LO], kind="mergesort")
+    idx = stable_argsort(geo[:, GEO_LO])
     for r in range(si.shape[1]):
-        sb[0, r] = geo[si[0, r], GEO_LO]
+        si[0, r] = idx[r]
+        sb[0, r] = geo[idx[r], GEO_LO]
 
 
 @njit(cache=True, inline="always")

@@ -303,10 +303,20 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, float, float]:
                 sc += k * (a + c - 1) / 2.0
             else:
                 c += 1
-    runs = runs[:n].copy()
-    # widest runs first: they are the likeliest to hit an obstacle, so a blocked position fails fast
-    order = np.argsort(runs[:, 1] - runs[:, 2], kind="mergesort")
-    return runs[order], sr / max(cnt, 1), sc / max(cnt, 1)
+    # widest runs first: they are the likeliest to hit an obstacle, so a blocked position fails
+    # fast; a stable counting sort by width (numba's argsort(kind="mergesort") compiled for 1.5 s)
+    per_width = np.zeros(w + 2, dtype=np.int64)
+    for i in range(n):
+        per_width[w - (runs[i, 2] - runs[i, 1])] += 1  # (widest: bucket 1)
+    for k in range(1, w + 2):
+        per_width[k] += per_width[k - 1]
+    out = np.empty((n, 3), dtype=np.int64)
+    for i in range(n):
+        b = w - (runs[i, 2] - runs[i, 1]) - 1
+        slot = per_width[b]
+        per_width[b] += 1
+        out[slot, 0], out[slot, 1], out[slot, 2] = runs[i, 0], runs[i, 1], runs[i, 2]
+    return out, sr / max(cnt, 1), sc / max(cnt, 1)
 
 
 class _Piece:

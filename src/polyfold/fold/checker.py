@@ -82,7 +82,8 @@ def segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, ri
     checked = 0
     for k in ks:
         if m == 0:
-            q[:] = qa
+            for i in range(qa.shape[0]):  # (not q[:] = qa: an array assignment compiles numba's
+                q[i] = qa[i]              # shape-mismatch error, 2-3 s of a first run)
         else:
             t = k / m
             for i in range(qa.shape[0]):

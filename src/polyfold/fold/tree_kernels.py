@@ -12,6 +12,7 @@ import numpy as np
 from numba import njit
 
 from ..mesh.kernels import fold_deg_to_rho
+from ..sorting import stable_argsort
 
 OK = 0
 # faces
@@ -261,7 +262,8 @@ def _crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, h
     piece[:] = -1
     axis[:] = -1
     if has_parent:
-        parent[:] = parent_in
+        for f in range(n_f):  # (element by element: an array assignment compiles numba's shape-mismatch
+            parent[f] = parent_in[f]  # error, 2-3 s of a first run)
         code = _parent_creases(parent, face_edges, cut, crease, info)
     else:
         parent[:] = -1
@@ -309,13 +311,14 @@ def _crease_tree(faces, edges, face_edges, edge_faces, kind, n_cut, parent_in, h
                 break
         return CYCLE, 0, 0
     if has_piece:
-        piece[:] = piece_in
+        for f in range(n_f):
+            piece[f] = piece_in[f]
         for f in range(n_f):
             if parent[f] >= 0 and piece[f] != piece[parent[f]]:
                 info[0] = f
                 return PARENT_PIECE, 0, 0
         roots = np.flatnonzero(parent < 0)
-        by_piece = np.argsort(piece[roots], kind="mergesort") if n_roots > 1 else roots  # a piece's roots stay ascending
+        by_piece = stable_argsort(piece[roots])  # a piece's roots stay ascending
         for r in range(1, roots.shape[0]):
             a = roots[by_piece[r - 1]]
             b = roots[by_piece[r]]

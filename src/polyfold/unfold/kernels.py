@@ -368,7 +368,9 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         # other faces, whose parents and exact coordinates do not change) and lay out only it.
         moved = sub[:n_sub]
         for f in moved:
-            saved[f] = tris[f]
+            for k in range(3):
+                saved[f, k, 0] = tris[f, k, 0]
+                saved[f, k, 1] = tris[f, k, 1]
             saved_parent[f] = parent[f]
             saved_edge[f] = parent_edge[f]
         n_rest = _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face,
@@ -393,16 +395,20 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             order, new_order = new_order, order
             if score < best:
                 best = score
-                best_crease[:] = crease
+                for e in range(crease.shape[0]):  # (element by element: an array assignment compiles
+                    best_crease[e] = crease[e]    # numba's shape-mismatch error, 3 s of a first run)
         else:
             crease[c] = True
             crease[pick] = False
             for f in moved:
-                tris[f] = saved[f]
+                for k in range(3):
+                    tris[f, k, 0] = saved[f, k, 0]
+                    tris[f, k, 1] = saved[f, k, 1]
                 parent[f] = saved_parent[f]
                 parent_edge[f] = saved_edge[f]
             face_bounds(tris, moved, xmin, xmax, ymin, ymax)
-    crease[:] = best_crease
+    for e in range(crease.shape[0]):
+        crease[e] = best_crease[e]
     return best, it
 
 
