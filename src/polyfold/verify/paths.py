@@ -441,7 +441,7 @@ def _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, goal):
         for c in range(3):
             lo[f, c] = min(T[f, 0, c], T[f, 1, c], T[f, 2, c])
             hi[f, c] = max(T[f, 0, c], T[f, 1, c], T[f, 2, c])
-    zs = np.argsort(lo[:, 2])
+    zs = np.argsort(lo[:, 2].copy())  # (contiguous: the quicksort the unfolder compiled, not another)
     m = max(thick, tol)
     feats = np.empty((16, 6))
     buf = np.empty((6, 8))
