@@ -176,8 +176,12 @@ def blocked_by(poly: np.ndarray, clear: float, discs: np.ndarray, exact: np.ndar
     """Whether the obstacles (see the module docstring) cover more than `least` of the convex
     ring `poly`, or of poly grown by `clear` outside the `discs` (d, m, 2): 1 yes, 0 no; 2 when
     the grown poly's shape decides and is not given (`exact` with no points; see
-    `offset_bounds`), to be asked again with it; -1 when this cannot say (poly not convex, or
-    a clipped ring outgrew the work arrays)."""
+    `offset_bounds`), to be asked again with it (then only the grown poly is measured: poly
+    itself was); -1 when this cannot say (poly not convex, or a clipped ring outgrew the work
+    arrays)."""
+    if exact.shape[0] >= 3:
+        near = overlap_area(exact, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
+        return -1 if np.isnan(near) else int(near > least)
     if not is_convex(poly, 1e-9):
         return -1
     none = np.zeros((0, 1, 2))
@@ -188,9 +192,6 @@ def blocked_by(poly: np.ndarray, clear: float, discs: np.ndarray, exact: np.ndar
         return 1
     if clear <= 0.0:
         return 0
-    if exact.shape[0] >= 3:
-        near = overlap_area(exact, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
-        return -1 if np.isnan(near) else int(near > least)
     within, around = offset_bounds(poly, clear)
     low = overlap_area(within, discs, pts, ring_ptr, ring_sign, obs_ptr, obstacles)
     if np.isnan(low):
@@ -208,7 +209,8 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     """Whether the ring `box` (k, 2), convex, grown by `pad` with its corners cut by chords
     (shapely's buffer with quad_segs=1), meets any of the rings pts[ring_ptr[r]:ring_ptr[r + 1]]:
     1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
-    one of its sides; -1 when neither tells (a ring touching it, or near it across a corner)."""
+    one of its sides; -1 when neither tells for some ring and none overlaps (a ring touching it,
+    or near it across a corner)."""
     window = offset_bounds(box, pad)[0]
     k = window.shape[0]
     sign = 1.0 if _orientation(window) >= 0 else -1.0
@@ -216,6 +218,7 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     for r in range(ring_ptr.shape[0] - 1):
         longest = max(longest, ring_ptr[r + 1] - ring_ptr[r])
     bufs = np.empty((2, 4 * (longest + k) + 16, 2))
+    unsure = False
     for r in range(ring_ptr.shape[0] - 1):
         lo, hi = ring_ptr[r], ring_ptr[r + 1]
         apart = False
@@ -240,5 +243,5 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
         b, m = _clip(bufs, 0, hi - lo, window, sign)
         if m >= 0 and _area(bufs, b, m) > 1e-12:
             return 1
-        return -1
-    return 0
+        unsure = True
+    return -1 if unsure else 0

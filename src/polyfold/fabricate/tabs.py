@@ -120,27 +120,25 @@ class _Obstacles:
     def __init__(self, faces: np.ndarray) -> None:
         import shapely
 
+        self.pts, self.ring_sign = np.zeros((0, 2)), np.zeros(0)
+        self.ring_ptr, self.obs_ptr = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+        self.n_pts = self.n_rings = self.n_obs = 0
         n = len(faces)
-        if n and not shapely.get_num_interior_rings(faces).any() and shapely.is_valid(faces).all() \
-                and (shapely.get_type_id(faces) == 3).all():
+        if n and (shapely.get_type_id(faces) == 3).all() and not shapely.get_num_interior_rings(faces).any() \
+                and (shapely.get_num_coordinates(faces) >= 4).all():
+            # every face one ring (the usual triangles): all at once, as `add` would put them
             xy, idx = shapely.get_coordinates(shapely.get_exterior_ring(faces), return_index=True)
             counts = np.bincount(idx, minlength=n)
-            last = np.cumsum(counts) - 1  # the repeated closing point of every ring
             keep = np.ones(len(xy), dtype=bool)
-            keep[last] = False
-            pts, lengths = xy[keep], counts - 1
-            self.ring_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+            keep[np.cumsum(counts) - 1] = False  # the repeated closing point of every ring
+            self.pts = np.ascontiguousarray(xy[keep], dtype=float)
+            self.ring_ptr = np.concatenate([[0], np.cumsum(counts - 1)]).astype(np.int64)
             self.ring_sign = np.ones(n)
             self.obs_ptr = np.arange(n + 1, dtype=np.int64)
+            self.n_pts, self.n_rings, self.n_obs = len(self.pts), n, n
         else:
-            rings = [_rings(f) for f in faces]
-            flat = [r for rs in rings for r in rs]
-            pts = np.concatenate([r for r, _ in flat]) if flat else np.zeros((0, 2))
-            self.ring_ptr = np.concatenate([[0], np.cumsum([len(r) for r, _ in flat])]).astype(np.int64)
-            self.ring_sign = np.array([sg for _, sg in flat], dtype=float)
-            self.obs_ptr = np.concatenate([[0], np.cumsum([len(rs) for rs in rings])]).astype(np.int64)
-        self.pts = np.ascontiguousarray(pts, dtype=float)
-        self.n_pts, self.n_rings, self.n_obs = len(self.pts), len(self.ring_sign), len(self.obs_ptr) - 1
+            for face in faces:
+                self.add(face)
 
     def copy(self) -> _Obstacles:
         out = copy.copy(self)

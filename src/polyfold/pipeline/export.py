@@ -184,7 +184,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
 
     # the guide and the sheets share nothing: made side by side on two cores (the bunny's 0.45 + 0.3 s,
     # a 1,280-face sphere's 2.4 + 1.3 s), the guide here (`processes.beside`): the modules and kernels
-    # it loads stay loaded for the next model a process makes (in-process, the bunny's make 1.1 -> 1.0 s)
+    # it loads stay loaded for the next model a process makes (in-process, the bunny's make 1.0-1.1 -> 0.84 s)
     if usable_cores() >= 2:
         (assembly_json, html, guide_pdf, guide_report), sheet_out = beside(guide_files, sheet_files)
     else:
