@@ -110,8 +110,11 @@ def test_pairs_between_two_sets_are_the_brute_force_pairs_across():
         face_bounds(tris, np.arange(n), *bounds)
         in_a = rng.random(n) < share
         a, b = np.flatnonzero(in_a), np.flatnonzero(~in_a)
-        got = overlapping_pairs_between(tris, parent, a, b, *bounds, 0.0)
+        got = overlapping_pairs_between(tris, parent, a, b, *bounds, 0.0, np.int64(2**62))
         assert len({tuple(p) for p in got}) == len(got)  # each pair once
         want = {(min(i, j), max(i, j)) for i in a for j in b
                 if parent[i] != j and parent[j] != i and oracle_overlap(tris[i].tolist(), tris[j].tolist())}
         assert {tuple(p) for p in got} == want and (len(want) > 0 or len(a) in (0, n))
+        for limit in (1, 3, len(want)):  # the first `limit` of them, then it stops
+            some = overlapping_pairs_between(tris, parent, a, b, *bounds, 0.0, np.int64(limit))
+            assert len(some) == min(limit, len(want)) and {tuple(p) for p in some} <= want

@@ -365,7 +365,8 @@ def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> N
     """The local search keeps its overlapping pairs across moves (re-testing only pairs across
     the moved subtree): the score it reports must equal G + 100 L counted afresh, by the plain
     sweep over every pair, on the tree it returns, for runs of several lengths from random and
-    steepest-edge trees."""
+    steepest-edge trees. A move that meets many new pairs is turned down without testing them
+    all (`SURE_REJECT`): the runs end on the same tree and score as runs that test every pair."""
     from polyfold.unfold.problem import random_weights, steepest_edge_weights
     from polyfold.unfold.search import _genome_of_tree
 
@@ -379,9 +380,16 @@ def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> N
         crease = np.zeros(topo.n_edges, dtype=np.bool_)
         crease[parent_edge[parent_edge >= 0]] = True
         for iterations in (20, 200, 1000):
-            score, _ = K.local_search(crease, problem.merged, problem.base, problem.adj_ptr, problem.adj_face,
-                                      problem.adj_edge, topo.edge_faces, mesh.faces, topo.face_edges, topo.edges,
-                                      problem.hyperbolic, problem.local, problem.tol, iterations, seed, 0.5)
+            runs = []
+            for sure_reject in (K.SURE_REJECT, 1, 2**62):  # (1: often tests every pair after all; 2**62: always)
+                tried = crease.copy()
+                runs.append((K.local_search(tried, problem.merged, problem.base, problem.adj_ptr, problem.adj_face,
+                                            problem.adj_edge, topo.edge_faces, mesh.faces, topo.face_edges, topo.edges,
+                                            problem.hyperbolic, problem.local, problem.tol, iterations, seed, 0.5,
+                                            sure_reject), tried))
+            # moves judged on a lower bound of their score: the same moves, trees and scores
+            assert all(r[0] == runs[0][0] and np.array_equal(r[1], runs[0][1]) for r in runs), (seed, iterations)
+            (score, _), crease = runs[0]
             parent, _, _, tris = problem.decode(_genome_of_tree(crease, np.random.default_rng(0)))
             pairs = find_overlaps(tris, parent, problem.tol)
             G, L = len(pairs), K.local_overlaps(pairs.astype(np.int64), topo.face_edges, topo.edges, problem.hyperbolic)

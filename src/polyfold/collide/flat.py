@@ -132,8 +132,11 @@ def face_bounds(tris: np.ndarray, faces: np.ndarray, xmin: np.ndarray, xmax: np.
 
 @njit(cache=True)
 def overlapping_pairs_between(tris: np.ndarray, parent: np.ndarray, a: np.ndarray, b: np.ndarray, xmin: np.ndarray,
-                              xmax: np.ndarray, ymin: np.ndarray, ymax: np.ndarray, tol: float) -> np.ndarray:
-    """The overlapping pairs (k, 2) (smaller index first) of one face of `a` and one of `b`.
+                              xmax: np.ndarray, ymin: np.ndarray, ymax: np.ndarray, tol: float,
+                              limit: int) -> np.ndarray:
+    """The overlapping pairs (k, 2) (smaller index first) of one face of `a` and one of `b`, or
+    the first `limit` found (k == limit: there may be more; a caller that only needs to know
+    whether there are that many stops paying for the rest).
 
     a, b: disjoint face indices; xmin..ymax (F,): the faces' bounds (`face_bounds`); crease pairs
     (f, parent[f]) skipped. The same test as `overlapping_pairs` restricted to pairs across the two
@@ -206,4 +209,6 @@ def overlapping_pairs_between(tris: np.ndarray, parent: np.ndarray, a: np.ndarra
                         out[count, 0] = min(f, g)
                         out[count, 1] = max(f, g)
                         count += 1
+                        if count >= limit:
+                            return out[:count]
     return out[:count]

@@ -211,7 +211,7 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
         score, it = K.local_search(
             crease, problem.merged, problem.base, problem.adj_ptr, problem.adj_face, problem.adj_edge, topo.edge_faces,
             mesh.faces, topo.face_edges, topo.edges, problem.hyperbolic, problem.local, problem.tol,
-            step, int(rng.integers(2**31)), temperature,
+            step, int(rng.integers(2**31)), temperature, K.SURE_REJECT,
         )
         done_iters += max(it, 1)
         if score == 0 or deadline.expired():

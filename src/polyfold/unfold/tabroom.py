@@ -178,7 +178,7 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndar
     xmin, xmax, ymin, ymax = (np.empty(n) for _ in range(4))
     face_bounds(coords, order, xmin, xmax, ymin, ymax)
     if len(overlapping_pairs_between(coords, parent, np.flatnonzero(moved), np.flatnonzero(~moved),
-                                     xmin, xmax, ymin, ymax, problem.tol)):
+                                     xmin, xmax, ymin, ymax, problem.tol, np.int64(1))):  # (any pair will do)
         return None
     count, _ = overlapping_pairs(coords, parent, problem.tol, 0)
     if count:
