@@ -361,6 +361,45 @@ def test_no_single_net_carries_the_searched_net_in_pieces(models_dir) -> None:
 
 
 @pytest.mark.parametrize("name", ["horse-302", "bunny-348"])
+def test_a_kick_draws_afresh_only_the_edges_near_the_overlaps(models_dir, name) -> None:
+    """`kick` (the memetic search's child): the edges of the faces within `rings` edge-steps of
+    an overlapping face get fresh weights, every other edge keeps its crease (light) or cut
+    (heavy) weight, so Prim's tree away from the overlaps is the tree kicked; a valid tree comes
+    back as its own genome."""
+    from polyfold.unfold.search import kick
+
+    mesh = single_component(models_dir, name)
+    topo = mesh.topology
+    problem = UnfoldProblem.from_mesh(mesh)
+    for seed in range(3):
+        genome = HEURISTICS["random-edge"](problem, np.random.default_rng(seed))
+        parent, parent_edge, _, coords = problem.decode(genome)
+        pairs = find_overlaps(coords, parent, problem.tol)
+        assert len(pairs)
+        crease = np.zeros(topo.n_edges, dtype=bool)
+        crease[parent_edge[parent_edge >= 0]] = True
+        for rings in (0, 2):
+            near = set(pairs.ravel().tolist())  # faces within `rings` steps, by a plain BFS
+            for _ in range(rings):
+                near |= {int(g) for f in near for e in topo.face_edges[f] for g in topo.edge_faces[e] if g >= 0}
+            redrawn = np.zeros(topo.n_edges, dtype=bool)
+            redrawn[topo.face_edges[sorted(near)].ravel()] = True
+            w = kick(problem, genome, np.random.default_rng(seed), rings)
+            assert ((w >= 0) & (w <= 1)).all()
+            assert (w[~redrawn & crease] == 0).all() and (w[~redrawn & ~crease] >= 0.5).all()
+            assert (w[redrawn] < 0.5).any() and (w[redrawn & ~crease] < 0.5).any()  # drawn anew
+            _, kicked_edge, _, _ = problem.decode(w)
+            kept = np.zeros(topo.n_edges, dtype=bool)
+            kept[kicked_edge[kicked_edge >= 0]] = True
+            assert (kept[~redrawn & crease]).all()  # the creases away from the overlaps stay
+        valid = unfold(mesh, seed=seed, time_limit=60)[0]
+        plain = np.zeros(topo.n_edges, dtype=bool)
+        plain[valid.parent_edge[valid.parent_edge >= 0]] = True
+        w = kick(problem, np.where(plain, 0.0, 1.0), np.random.default_rng(0), 2)
+        assert np.array_equal(w == 0, plain)
+
+
+@pytest.mark.parametrize("name", ["horse-302", "bunny-348"])
 def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> None:
     """The local search keeps its overlapping pairs across moves (re-testing only pairs across
     the moved subtree): the score it reports must equal G + 100 L counted afresh, by the plain
@@ -398,11 +437,11 @@ def test_local_search_score_is_a_full_recount_of_its_tree(models_dir, name) -> N
     assert max(scores) > 0 and len(set(scores)) > 4  # overlapping trees and moves that changed them
 
 
-@pytest.mark.parametrize("seed", [4, 34, 86])
+@pytest.mark.parametrize("seed", [4, 65, 86])
 def test_two_racing_searches_give_the_earlier_rounds_net_on_one_core_or_two(models_dir, monkeypatch, seed) -> None:
     """When the first search's first batch and generation find no net, a second search (its own
     random stream) races it in rounds of a generation: the net found in the earlier round wins,
-    the first search's on a tie. On horse-302, seed 4 ties (both in round 2), seed 34 is won by
+    the first search's on a tie. On horse-302, seed 4 ties (both in round 2), seed 65 is won by
     the second and seed 86 by the first; the winner is the one each search finds alone, and the
     net, generations and evaluations are the same on one core (turns) as on two (a fork)."""
     import polyfold.processes as processes
@@ -437,4 +476,4 @@ def test_two_racing_searches_give_the_earlier_rounds_net_on_one_core_or_two(mode
     assert np.array_equal(w1, rounds[expected[1]][1])  # the winner's net: the one it finds alone
     G, L = problem.evaluate(w1[None, :])
     assert float(search._fitness(G, L)[0]) == 0.0
-    assert {4: (2, 0), 34: (2, 1), 86: (2, 0)}[seed] == expected
+    assert {4: (2, 0), 65: (2, 1), 86: (2, 0)}[seed] == expected
