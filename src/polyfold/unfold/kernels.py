@@ -408,28 +408,24 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         limit = np.int64(gone_score + sure_reject)
         across = overlapping_pairs_between(tris, parent, moved, new_order[:n_rest], xmin, xmax, ymin, ymax, tol,
                                            limit)
-        drawn = False
-        u = 1.0
-        if across.shape[0] >= limit:
-            drawn = True
-            u = np.random.random() if temperature > 0 else 1.0
-            if _accepts(across.shape[0] - gone_score, u, temperature):  # (about 1 in 20,000 of them)
-                across = overlapping_pairs_between(tris, parent, moved, new_order[:n_rest], xmin, xmax, ymin, ymax,
-                                                   tol, np.int64(2**62))
-            else:
-                across = across[:0]  # turned down on a lower bound of its score
-        if drawn and across.shape[0] == 0:
-            new_score = score + limit - gone_score  # (a lower bound: the move is turned down)
+        drawn = across.shape[0] >= limit  # delta >= sure_reject > 0: the draw is due now
+        u = np.random.random() if drawn and temperature > 0 else 1.0
+        turned_down = drawn and not _accepts(limit - gone_score, u, temperature)
+        if turned_down:
+            new_score = score + limit - gone_score  # (a lower bound of its score)
             new_pairs = pairs
         else:
+            if drawn:  # taken even so (about 1 in 20,000 of them): every pair after all
+                across = overlapping_pairs_between(tris, parent, moved, new_order[:n_rest], xmin, xmax, ymin, ymax,
+                                                   tol, np.int64(2**62))
             new_pairs = np.concatenate((pairs[keep], across))
             new_score = score - gone_score + _score(across, across.shape[0], face_edges, edges, hyperbolic)
             if new_score == 0:  # confirmed on every pair before the search stops on it
                 new_pairs = all_overlapping_pairs(tris, parent, tol)
                 new_score = _score(new_pairs, new_pairs.shape[0], face_edges, edges, hyperbolic)
         delta = new_score - score
-        if delta > 0 and not drawn:
-            u = np.random.random() if temperature > 0 else 1.0
+        if delta > 0 and not drawn and temperature > 0:
+            u = np.random.random()
         if _accepts(delta, u, temperature):
             score = new_score
             pairs = new_pairs

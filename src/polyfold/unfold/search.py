@@ -166,6 +166,16 @@ def run_ga(
     return pop[i].copy(), float(fit[i]), generation, evaluations, str(origin[i])
 
 
+def _crease_mask(problem: UnfoldProblem, genome: np.ndarray, parent_edge: np.ndarray | None = None) -> np.ndarray:
+    """(E,) bool: the creases of the tree of `genome` (parent_edge: its decoded parent edges, if
+    at hand)."""
+    if parent_edge is None:
+        parent_edge = problem.decode(genome)[1]
+    crease = np.zeros(problem.mesh.topology.n_edges, dtype=np.bool_)
+    crease[parent_edge[parent_edge >= 0]] = True
+    return crease
+
+
 def _genome_of_tree(crease: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Weights that make Prim's algorithm rebuild exactly this tree (creases light, cuts heavy)."""
     return np.where(crease, 0.0, 0.5) + 0.5 * rng.random(len(crease)) * np.where(crease, 0.0, 1.0)
@@ -203,9 +213,7 @@ def tree_local_search(problem: UnfoldProblem, child: np.ndarray, rng: np.random.
     # iterations per kernel call: tens of milliseconds a call (an iteration costs ~40 ns per face; a
     # call starts with a full overlap test), so the time checks stay frequent
     step = max(10, LOCAL_SEARCH_CALL // mesh.n_faces)
-    parent, parent_edge, _, _ = problem.decode(child)
-    crease = np.zeros(topo.n_edges, dtype=np.bool_)
-    crease[parent_edge[parent_edge >= 0]] = True
+    crease = _crease_mask(problem, child)
     done_iters, score = 0, 0
     while done_iters < chunk_iters:
         score, it = K.local_search(
@@ -233,9 +241,7 @@ def kick(problem: UnfoldProblem, genome: np.ndarray, rng: np.random.Generator, r
     search). The tree's own genome when nothing overlaps."""
     parent, parent_edge, _, coords = problem.decode(genome)
     topo = problem.mesh.topology
-    crease = np.zeros(topo.n_edges, dtype=np.bool_)
-    crease[parent_edge[parent_edge >= 0]] = True
-    weights = _genome_of_tree(crease, rng)
+    weights = _genome_of_tree(_crease_mask(problem, genome, parent_edge), rng)
     pairs = problem.overlaps(coords, parent)
     if len(pairs) == 0:
         return weights
