@@ -41,6 +41,9 @@ from polyfold.unfold.net import Net
 from polyfold.unfold.search import unfold
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
+# a polyfold server the developer left running must not answer the tests' commands (the tests of
+# the server itself start their own, in a runtime directory of their own)
+os.environ["POLYFOLD_SERVER"] = "off"
 
 
 def models_path() -> Path | None:

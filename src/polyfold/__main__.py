@@ -1,6 +1,6 @@
 """`python -m polyfold`: the command line (`apps/cli/`)."""
 
-from .apps.cli.app import main
+from .apps.cli import main
 
 if __name__ == "__main__":
     main()

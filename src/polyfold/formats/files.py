@@ -35,6 +35,14 @@ def _default_mode() -> int:
 _FILE_MODE = _default_mode()  # read once: os.umask is process-wide, so never toggle it later
 
 
+def use_umask(mask: int) -> None:
+    """Make `mask` this process's umask and the mode new files get from it (a server's child
+    takes its client's: `apps.server`), before any writing starts."""
+    global _FILE_MODE
+    os.umask(mask)
+    _FILE_MODE = 0o666 & ~mask
+
+
 def atomic_write(path: str | os.PathLike, data: str | bytes) -> None:
     """Write `data` to `path` via a temp file in the same directory and os.replace.
 

@@ -40,8 +40,8 @@ def guard(func):
             return func(*args, **kwargs)
         except PolyfoldError as exc:
             fail(one_line(exc), exc.exit_code)
-        except KeyboardInterrupt:
-            fail("interrupted", 130)
+        except KeyboardInterrupt:  # (said by `main`, which also sees those outside a command's body)
+            raise typer.Exit(130) from None
         except typer.Exit:
             raise
         except OSError as exc:
@@ -94,8 +94,9 @@ def main() -> None:
         say(f"error: {where}: {exc.format_message()} (see {where} --help)")
         code = 2
     except (click_errors.Abort if hasattr(click_errors, "Abort") else typer.Abort, typer.Abort):
-        say("error: interrupted")
         code = 130
+    if code == 130:  # Ctrl-C: in a command (`guard`) or while typer parsed its options (typer says nothing)
+        say("error: interrupted")
     sys.exit(code if isinstance(code, int) else 0)
 
 
@@ -104,3 +105,4 @@ def main() -> None:
 from . import mesh_commands  # noqa: E402,F401,I001
 from . import net_commands  # noqa: E402,F401,I001
 from . import make_commands  # noqa: E402,F401,I001
+from . import server_commands  # noqa: E402,F401,I001

@@ -1,0 +1,257 @@
+"""apps/server.py: `polyfold server` and the commands it runs for the command line: the same
+files, output and exit codes as a command run in its own process, signals passed on, nothing
+left running, and no answer for another user or from a directory others may enter."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import CLI, REPO_ROOT, one_line
+
+BUNNY = REPO_ROOT / "examples" / "bunny-128.obj"
+
+
+def _env(runtime: Path, switch: str) -> dict:
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime), POLYFOLD_SERVER=switch)
+    return env
+
+
+def _cli(env: dict, *args, cwd: Path | None = None, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run([*CLI, *map(str, args)], capture_output=True, text=True, timeout=timeout, env=env, cwd=cwd)
+
+
+def _status(env: dict) -> dict | None:
+    code = "import json; from polyfold.apps.server import request; print(json.dumps(request('status')))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, env=env)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+@pytest.fixture(scope="module")
+def runtime():
+    """A private runtime directory (short: a Unix socket's path is at most 107 bytes) with a
+    server started in it; stopped and checked gone afterwards."""
+    d = Path(tempfile.mkdtemp(prefix="pfs"))
+    os.chmod(d, 0o700)
+    env = _env(d, "require")
+    proc = _cli(env, "server", "start", "--idle-minutes", "10")
+    assert proc.returncode == 0, proc.stderr
+    assert "server ready" in proc.stderr
+    pid = _status(env)["pid"]
+    yield d
+    stop = _cli(env, "server", "stop")
+    assert stop.returncode == 0 and "server stopping" in stop.stderr, stop.stderr
+    for _ in range(100):  # gone, its socket removed
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail("the server did not stop")
+    assert not list((d / "polyfold").glob("*.sock"))
+    shutil.rmtree(d, ignore_errors=True)
+
+
+def _tree(folder: Path) -> dict[str, str]:
+    """Hash of every file but report.json (its seconds); of a DXF, its entities (its header holds
+    the time of writing and fresh ids, whichever process writes it)."""
+
+    def content(p: Path) -> bytes:
+        data = p.read_bytes()
+        if p.suffix == ".dxf":
+            start = data.index(b"\nENTITIES\n")
+            return data[start:data.index(b"\nENDSEC\n", start)]
+        return data
+
+    return {p.relative_to(folder).as_posix(): hashlib.sha256(content(p)).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file() and p.name != "report.json"}
+
+
+def test_a_served_make_writes_what_its_own_process_writes(runtime: Path, tmp_path: Path) -> None:
+    shutil.copy(BUNNY, tmp_path / "bunny.obj")
+    before = _status(_env(runtime, "require"))["served"]
+    # a relative mesh and output: the command runs in the client's working directory
+    served = _cli(_env(runtime, "require"), "make", "bunny.obj", "-o", "served", cwd=tmp_path)
+    here = _cli(_env(runtime, "off"), "make", "bunny.obj", "-o", "here", cwd=tmp_path)
+    assert served.returncode == 0 and here.returncode == 0, served.stderr + here.stderr
+    assert _status(_env(runtime, "require"))["served"] == before + 1
+    assert _tree(tmp_path / "served") == _tree(tmp_path / "here")
+    assert len(_tree(tmp_path / "served")) > 10
+    assert served.stdout == here.stdout
+    # progress and summary lines (no terminal: one line per stage), but for the seconds and folder
+    def lines(err: str, folder: str) -> str:
+        return re.sub(r"\d+\.\d\d s", "T s", err).replace(folder, "OUT")
+
+    assert lines(served.stderr, "served") == lines(here.stderr, "here")
+
+
+def test_output_errors_and_exit_codes_come_back(runtime: Path, tmp_path: Path) -> None:
+    env = _env(runtime, "require")
+    info = _cli(env, "info", BUNNY, "--json")
+    assert info.returncode == 0 and info.stdout == _cli(_env(runtime, "off"), "info", BUNNY, "--json").stdout
+    missing = _cli(env, "info", tmp_path / "missing.obj")
+    assert missing.returncode == 2
+    assert "missing.obj" in one_line(missing.stderr)
+    usage = _cli(env, "make", BUNNY)  # no -o: a usage error, as in its own process
+    assert usage.returncode == 2 and "Traceback" not in usage.stderr
+    # the client's umask holds for what the command writes
+    out = tmp_path / "net.fold"
+    proc = subprocess.run(["sh", "-c", f"umask 077 && {' '.join(map(str, CLI))} unfold {BUNNY} -o {out} -q"],
+                          capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert out.stat().st_mode & 0o777 == 0o600
+
+
+def test_an_interrupt_reaches_the_command(runtime: Path, tmp_path: Path, models_dir: Path) -> None:
+    env = _env(runtime, "require")
+    before = _status(env)
+    out = tmp_path / "out"
+    # long enough to be interrupted (a 3,000-face mesh's make takes seconds)
+    proc = subprocess.Popen([*CLI, "make", str(models_dir / "bunny-348.obj"), "-o", str(out), "--size", "400",
+                             "--faces", "none", "--seed", "3"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    for _ in range(300):
+        if _status(env)["running"] > before["running"]:
+            break
+        time.sleep(0.02)
+    else:
+        pytest.fail("the command never ran in the server")
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines()[-1] == "polyfold: error: interrupted" and "Traceback" not in err
+    assert not out.exists()
+    for _ in range(100):
+        if _status(env)["running"] == before["running"]:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail("the interrupted command still runs in the server")
+
+
+def test_a_client_that_goes_away_stops_its_command(runtime: Path, tmp_path: Path, models_dir: Path) -> None:
+    env = _env(runtime, "require")
+    before = _status(env)
+    proc = subprocess.Popen([*CLI, "make", str(models_dir / "bunny-348.obj"), "-o", str(tmp_path / "out"),
+                             "--size", "400", "--faces", "none"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    for _ in range(300):
+        if _status(env)["running"] > before["running"]:
+            break
+        time.sleep(0.02)
+    proc.kill()
+    proc.wait()
+    for _ in range(200):
+        if _status(env)["running"] == before["running"]:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail("the command of a killed client still runs")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.skipif(os.getuid() != 0, reason="needs root to run a client as another user")
+def test_another_user_gets_no_answer(runtime: Path) -> None:
+    path = next((runtime / "polyfold").glob("*.sock"))
+    code = ("import socket, sys\n"
+            "s = socket.socket(socket.AF_UNIX)\n"
+            "try:\n    s.connect(sys.argv[1]); s.sendall(b'x'); print('answer', s.recv(10))\n"
+            "except OSError as e: print('refused', e.errno)\n")
+    python = "/usr/bin/python3"  # (the test's own may sit where that user cannot go)
+    if not os.access(python, os.X_OK):
+        pytest.skip("no system python3 to run as another user")
+    proc = subprocess.run([python, "-c", code, str(path)], capture_output=True, text=True, timeout=60, user=65534)
+    assert proc.stdout.startswith("refused 13"), proc.stdout + proc.stderr  # EACCES: not even the directory
+    # and were both opened to them, the server itself turns them down (SO_PEERCRED): no answer
+    for d in (runtime, runtime / "polyfold"):
+        os.chmod(d, 0o711)
+    os.chmod(path, 0o666)
+    try:
+        status = json.dumps({"op": "status"}).encode()
+        asking = code.replace("b'x'", repr(struct.pack("!I", len(status)) + status))
+        proc = subprocess.run([python, "-c", asking, str(path)], capture_output=True, text=True, timeout=60,
+                              user=65534)
+    finally:
+        for d in (runtime, runtime / "polyfold"):
+            os.chmod(d, 0o700)
+        os.chmod(path, 0o600)
+    # (closed with the request unread: the end of the stream, a reset or a broken pipe)
+    assert proc.stdout.strip() in ("answer b''", "refused 104", "refused 32"), proc.stdout + proc.stderr
+    assert os.stat(path).st_mode & 0o777 == 0o600
+    assert os.stat(runtime / "polyfold").st_mode & 0o777 == 0o700
+
+
+def test_a_directory_others_may_enter_is_refused(tmp_path_factory) -> None:
+    d = Path(tempfile.mkdtemp(prefix="pfo"))
+    try:
+        (d / "polyfold").mkdir(mode=0o755)
+        os.chmod(d / "polyfold", 0o755)
+        start = _cli(_env(d, "on"), "server", "start")
+        assert start.returncode == 3
+        assert "not a directory of this user's alone" in one_line(start.stderr)
+        # a command still runs, in its own process, and says why no server is used
+        info = _cli(_env(d, "on"), "info", BUNNY)
+        assert info.returncode == 0 and "bunny-128.obj" in info.stdout
+        assert "not a directory of this user's alone" in info.stderr
+        assert not list((d / "polyfold").iterdir())
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def test_a_dead_servers_socket_is_cleared(monkeypatch) -> None:
+    d = Path(tempfile.mkdtemp(prefix="pfd"))
+    try:
+        os.chmod(d, 0o700)
+        monkeypatch.setenv("XDG_RUNTIME_DIR", str(d))
+        from polyfold.apps.server import socket_path
+
+        path = socket_path()
+        left = socket.socket(socket.AF_UNIX)
+        left.bind(str(path))  # bound, never listening: what a killed server leaves
+        left.close()
+        proc = _cli(_env(d, "on"), "info", BUNNY)
+        assert proc.returncode == 0 and "bunny-128.obj" in proc.stdout, proc.stderr
+        assert not path.exists()
+        required = _cli(_env(d, "require"), "info", BUNNY)
+        assert required.returncode == 3 and "no polyfold server runs" in one_line(required.stderr)
+        stopped = _cli(_env(d, "on"), "server", "status")
+        assert stopped.returncode == 1
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def test_settings_read_at_import_get_a_server_of_their_own(monkeypatch) -> None:
+    from polyfold.apps import server
+
+    monkeypatch.delenv("NUMBA_OPT", raising=False)
+    plain = server._fingerprint()
+    monkeypatch.setenv("NUMBA_OPT", "1")
+    assert server._fingerprint() != plain
+    monkeypatch.setenv("POLYFOLD_SERVER", "require")  # the switch itself is not such a setting
+    monkeypatch.setenv("NUMBA_OPT", "1")
+    other = server._fingerprint()
+    monkeypatch.setenv("POLYFOLD_SERVER", "off")
+    assert server._fingerprint() == other
+
+
+def test_only_the_compute_verbs_are_served() -> None:
+    from polyfold.apps.server import SERVED, forward
+
+    assert SERVED == {"info", "inflate", "segment", "unfold", "fold", "cspace", "make"}
+    for argv in (["view", "x"], ["batch", "x"], ["server", "status"], ["warm-up"], []):
+        assert forward(argv) is None  # run in the client's own process, server or not
