@@ -1,6 +1,6 @@
 """Where a user waits (issue 23), not a test: the first run, start-up, and peak memory.
 
-    .venv/bin/python bench/bench_start.py [--skip-cold] [--sizes 128,1500,5000]
+    .venv/bin/python bench/bench_start.py [--skip-cold] [--sizes 128,1500,5000] [--no-server]
 
 Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-clock, with the
 peak memory of it and the processes it starts (PSS, sampled: pages they share counted once).
@@ -12,6 +12,10 @@ project's cache is left alone):
   and on one core (`taskset -c 0`: everything in one process);
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
 - warm: `--help`, `info`, `make` with the kernels cached (every later run);
+- served (`--server`, on by default): the same warm rows and make rows through `polyfold server`
+  (`apps.server`: a resident process that forks a warm child per command), started in a runtime
+  folder of its own; memory there is the server's process tree (the server, the child and its
+  workers) less nothing: the server's own pages count too;
 - make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
   faces, one per noise seed of --sphere-seeds; bunny-348 Loop-subdivided once, 1,392 faces, a
   model whose small faces crowd its labels at 150 mm), warm cache, fold on, A4 at 150 mm: seconds
@@ -59,19 +63,26 @@ def _tree_pss_mb(pid: int) -> float:
     return total
 
 
-def run(args: list[str], env: dict | None = None, prefix: list[str] = []) -> tuple[float, float, int]:
+OWN = dict(os.environ, POLYFOLD_SERVER="off")  # every row in a process of its own, server or not
+
+
+def run(args: list[str], env: dict | None = None, prefix: list[str] = [], server: int | None = None
+        ) -> tuple[float, float, int]:
     """(wall seconds, peak memory MB, exit code) of one CLI process (run under `prefix`, e.g.
     taskset). Memory: the peak of its process tree's PSS (make's forked workers included), sampled
-    every 0.1 s; where /proc cannot say, the process's own peak RSS."""
+    every 0.1 s, plus that of the process tree of the `server` that runs its command; where /proc
+    cannot say, the process's own peak RSS."""
     import threading
 
     t0 = time.perf_counter()
-    proc = subprocess.Popen(prefix + CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    proc = subprocess.Popen(prefix + CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            env=OWN if env is None else env)
     peak, done = [0.0], threading.Event()
 
     def sample() -> None:
         while not done.wait(0.1):  # (reading smaps costs: rarer samples keep it out of the times)
-            peak[0] = max(peak[0], _tree_pss_mb(proc.pid))
+            mb = _tree_pss_mb(proc.pid) + (_tree_pss_mb(server) if server else 0.0)
+            peak[0] = max(peak[0], mb)
 
     watcher = threading.Thread(target=sample, daemon=True)
     watcher.start()
@@ -112,20 +123,21 @@ def main() -> None:
     ap.add_argument("--sizes", default="128,1500,5000", help="face counts of the make rows")
     ap.add_argument("--sphere-seeds", default="1,2,3", help="noise draws of each size's sphere (a sphere each)")
     ap.add_argument("--no-dense", action="store_true", help="leave out the Loop-subdivided bunny-348")
+    ap.add_argument("--no-server", action="store_true", help="no rows through `polyfold server`")
     a = ap.parse_args()
     rows: list[tuple[str, float, float, str]] = []
     tmp = Path(tempfile.mkdtemp(prefix="bench-start-"))
     if not a.skip_cold:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
+        env = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
         wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env)
         cold_report = json.loads((tmp / "cold" / "report.json").read_text())
         rows.append(("cold make bunny-128 (bare pip install)", wall, mb,
                      "the fold stage's kernels compile in a second process meanwhile (its memory counted)"))
         if shutil.which("taskset"):  # the same on one core: one process compiles everything
-            env1 = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-cold-1"))
+            env1 = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-cold-1"))
             wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold1"), "-q"], env1, ["taskset", "-c", "0"])
             rows.append(("  the same on one core (taskset -c 0)", wall, mb, "one process"))
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "cache-setup"))
+        env = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-setup"))
         wall, mb, _ = run(["warm-up"], env)
         rows.append(("warm-up (make setup adds it)", wall, mb, ""))
         wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "after"), "-q"], env)
@@ -134,10 +146,23 @@ def main() -> None:
         rows.append(("  of it compiling, by stage (report.json)", sum(compile_s.values()), 0.0,
                      ", ".join(f"{k} {v:.1f}" for k, v in compile_s.items())))
     run(["make", str(BUNNY), "-o", str(tmp / "prime"), "-q"])  # the project's cache, as after setup
-    for label, args in (("--help", ["--help"]), ("info bunny-128", ["info", str(BUNNY)]),
-                        ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"])):
+    warm = (("info bunny-128", ["info", str(BUNNY)]),
+            ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"]))
+    for label, args in (("--help", ["--help"]), *warm):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
-        rows.append((label, best[0], best[1], ""))
+        rows.append((label, best[0], best[1], "three runs: the fastest"))
+    served, server = None, None
+    if not a.no_server:
+        runtime = Path(tempfile.mkdtemp(prefix="pfb"))  # (short: a Unix socket's path)
+        served = dict(os.environ, XDG_RUNTIME_DIR=str(runtime), POLYFOLD_SERVER="require")
+        wall, mb, code = run(["server", "start"], served)
+        status = subprocess.run([*CLI, "server", "status"], env=served, capture_output=True, text=True).stdout
+        server = int(status.split("pid ")[1].split(",")[0]) if code == 0 else None
+        rows.append(("server start (once)", wall, _tree_pss_mb(server) if server else mb,
+                     "imports and loads every kernel; memory: the server"))
+        for label, args in warm:
+            best = min((run(args, served, server=server) for _ in range(3)), key=lambda r: r[0])
+            rows.append((f"{label}, served", best[0], best[1], "three runs: the fastest"))
     meshes = []  # (label, path)
     for n in (int(s) for s in a.sizes.split(",")):
         if n == 128:
@@ -156,15 +181,21 @@ def main() -> None:
                         + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
         meshes.append((f"make bunny-348 Loop-subdivided, {len(f)} faces", mesh))
     for k, (label, mesh) in enumerate(meshes):
-        wall, mb, code = run(["make", str(mesh), "-o", str(tmp / f"make-{k}"), "-q"])
-        note = "" if code == 0 else f"exit {code}"
-        if code == 0:
-            st = stages(tmp / f"make-{k}")
-            note = ", ".join(f"{k} {v:.1f}" for k, v in st.items() if v > 0.05)
-        rows.append((label, wall, mb, note))
-    print(f"{'what':44s} {'wall s':>8s} {'peak MB':>8s}  notes")
+        for how, env in (("", None), (", served", served)):
+            if how and served is None:
+                continue
+            wall, mb, code = run(["make", str(mesh), "-o", str(tmp / f"make-{k}{how}"), "-q"], env,
+                                 server=server if how else None)
+            note = "" if code == 0 else f"exit {code}"
+            if code == 0:
+                st = stages(tmp / f"make-{k}{how}")
+                note = ", ".join(f"{k} {v:.1f}" for k, v in st.items() if v > 0.05)
+            rows.append((label + how, wall, mb, note))
+    if served is not None:
+        subprocess.run([*CLI, "server", "stop"], env=served, capture_output=True)
+    print(f"{'what':52s} {'wall s':>8s} {'peak MB':>8s}  notes")
     for label, wall, mb, note in rows:
-        print(f"{label:44s} {wall:8.2f} {mb:8.0f}  {note}")
+        print(f"{label:52s} {wall:8.2f} {mb:8.0f}  {note}")
 
 
 if __name__ == "__main__":
