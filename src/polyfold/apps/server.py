@@ -272,16 +272,40 @@ def start(idle_minutes: float = IDLE_MINUTES, wait_s: float = START_WAIT_S) -> t
 
 # ---- the server side ----------------------------------------------------------------------------
 
-def _preload() -> None:
-    """Import what the commands import and load every kernel they call (the warm-up's sections,
-    quietly; compiling them first when numba's cache is empty)."""
-    import importlib
+# each served verb once, quietly, through the command line itself, on the warm-up's bumpy sphere
+# ({mesh}) in a temporary folder ({tmp}): what a command loads on its first call (its modules, typer's
+# command tree) is then loaded in the server, not in every child
+_FIRST_CALLS = (("info", "{mesh}"), ("make", "{mesh}", "-o", "{tmp}/make", "-q"),
+                ("unfold", "{mesh}", "-o", "{tmp}/net.fold", "-q"), ("fold", "{tmp}/net.fold", "-o", "{tmp}/path.fold"),
+                ("cspace", "{tmp}/net.fold", "--samples", "20"), ("segment", "{mesh}", "-o", "{tmp}/seg", "-q"),
+                ("inflate", "{mesh}", "-o", "{tmp}/inflated.obj", "--max-steps", "5"))
 
-    from .warmup import WARM_UP, run_sections
+
+def _preload() -> None:
+    """Import what the commands import and load every kernel they call: the warm-up's sections
+    (compiling them first when numba's cache is empty), then `_FIRST_CALLS`."""
+    import contextlib
+    import io
+    import tempfile
+
+    from .cli.app import app
+    from .warmup import WARM_UP, bumpy_sphere, run_sections
 
     run_sections(list(WARM_UP))
-    for name in ("polyfold.apps.cli.app", "rich.console", "rich.progress", "rich.table", "rich.text"):
-        importlib.import_module(name)
+    v, f = bumpy_sphere()
+    with tempfile.TemporaryDirectory() as tmp:
+        mesh = os.path.join(tmp, "warm-up.obj")
+        with open(mesh, "w") as out:
+            out.write("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v.tolist())
+                      + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f.tolist()))
+        for call in _FIRST_CALLS:
+            argv = [a.format(mesh=mesh, tmp=tmp) for a in call]
+            quiet = io.StringIO()
+            with contextlib.redirect_stdout(quiet), contextlib.redirect_stderr(quiet):
+                try:
+                    app(argv, standalone_mode=False)
+                except SystemExit:
+                    pass
 
 
 def _child(conn: socket.socket, fds: list[int], req: dict) -> None:
