@@ -267,9 +267,10 @@ class _Glued:
 
 
 def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
-          rho: dict[tuple[int, int], float], deadline: Deadline) -> tuple[_Glued, list[Tab | None]]:
+          rho: dict[tuple[int, int], float], deadline: Deadline, memo: dict | None = None
+          ) -> tuple[_Glued, list[Tab | None]]:
     """Note slits (two sides of one piece that touch in the plane) and give each glued pair (label
-    = its 1-based rank) its tab (`choose_tab`); every tab joins its piece's `Room`."""
+    = its 1-based rank) its tab (`choose_tab`, with its `memo`); every tab joins its piece's `Room`."""
     from shapely.geometry import Polygon
 
     out = _Glued(len(drawn))
@@ -279,7 +280,7 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
         label = str(idx + 1)
         if o1.piece == o2.piece and np.allclose(o1.p0, o2.p1, atol=1e-6) and np.allclose(o1.p1, o2.p0, atol=1e-6):
             out.slits[o1.piece].append(np.array([o1.p0, o1.p1]))  # the two sides touch in the plane
-        tab = choose_tab((o1, o2), rooms) if tabs else None
+        tab = choose_tab((o1, o2), rooms, memo) if tabs else None
         chosen.append(tab)
         if tab is None:
             if tabs:
@@ -498,14 +499,16 @@ def _note_spot(side, name: str, size: float, smallest: float, taken: list) -> Te
 
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
                        min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never(),
-                       by_run: bool = False) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
+                       by_run: bool = False, tab_memo: dict | None = None
+                       ) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
     """Draw every piece in mm and pair up their cut edges (see the module docstring). Tabs:
     `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed.
     Labels: `labels.PieceLabels`, cap height at least `min_label_mm`: one beside every glued edge,
     or, when one of those finds no readable place, one per seam run (`LayoutStats.labels_by_run`);
     by_run: per seam run at once (a redraw of pieces whose drawing needed them: the failed try
     took a third of a dense model's drawing). OutOfTime past `deadline` (checked between pieces,
-    tabs and labels)."""
+    tabs and labels). tab_memo: `choose_tab`'s memo, one dict for all drawings of one model's
+    pieces at one scale (the same drawings with or without it)."""
     import shapely
 
     drawn = []
@@ -518,7 +521,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     # a flat polygon whose faces close a cycle keeps one edge out of its tree: both sides lie on
     # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
-    g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline)
+    g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline, tab_memo)
     bare = [room.copy() for room in rooms]
     per_edge = None if by_run else _labels(pairs, drawn, rooms, chosen, min_label_mm,
                                            [[i] for i in range(len(pairs))], deadline, all_or_none=True)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -174,10 +175,13 @@ class _Obstacles:
 @dataclass(eq=False)
 class Room:
     """What is on one piece, for the tabs and labels still to place: its face polygons (shapely,
-    in an STRtree) and the tabs and off-face label boxes placed so far (`add`, `extra`)."""
+    in an STRtree) and the tabs and off-face label boxes placed so far (`add`, `extra`). `key`: a
+    digest of all of it (the faces' coordinates in order, then every geometry added, in order):
+    equal keys, equal rooms (`choose_tab`'s memo)."""
 
     faces: np.ndarray  # shapely Polygons, one per face
     tree: object = field(init=False)
+    key: bytes = field(init=False)
     extra: list = field(default_factory=list)
     _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
     _bounds_array: np.ndarray | None = None  # _bounds as an array, made when asked (None: stale)
@@ -188,6 +192,8 @@ class Room:
 
         self.tree = shapely.STRtree(self.faces)
         self._table = _Obstacles(self.faces)
+        self.key = hashlib.blake2b(np.ascontiguousarray(shapely.get_coordinates(self.faces)).tobytes(),
+                                   digest_size=16).digest()
 
     def copy(self) -> Room:
         """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
@@ -198,10 +204,15 @@ class Room:
 
     def add(self, geoms) -> None:
         """Place shapely geometries (tabs, label boxes, leaders) on the piece."""
+        import shapely
+
+        digest = hashlib.blake2b(self.key, digest_size=16)
         for g in geoms:
             self.extra.append(g)
             self._bounds.append(g.bounds)
             self._table.add(g)
+            digest.update(shapely.to_wkb(g))
+        self.key = digest.digest()
         self._bounds_array = None
 
     def obstacles(self, region, skip_face: int | None = None) -> list:
@@ -336,10 +347,25 @@ def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
     return Tab(s, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
 
 
-def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
+def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | None = None) -> Tab | None:
     """The tab of a glued pair: the first of TAB_VARIANTS that fits on either side (the first side
     first), else the larger clipped tab of the two sides; None when nothing fits (see the module
-    docstring). A tab may touch the faces beside its fold line at the corners, nothing else."""
+    docstring). A tab may touch the faces beside its fold line at the corners, nothing else.
+
+    It depends on nothing but the two sides and what is on their pieces, so `memo` (a dict kept
+    across drawings of one model's pieces: make draws them again after cutting some) keeps it by
+    the sides' data and the two rooms' keys: a pair drawn again beside the same faces, tabs and
+    labels gets the tab found before, untested."""
+    if memo is None:
+        return _choose_tab(sides, rooms)
+    key = (tuple((s.face, s.k, s.p0.tobytes(), s.p1.tobytes(), s.tri.tobytes()) for s in sides),
+           rooms[sides[0].piece].key, rooms[sides[1].piece].key)
+    if key not in memo:
+        memo[key] = _choose_tab(sides, rooms)
+    return memo[key]
+
+
+def _choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
     from shapely.geometry import Polygon
 
     # where a tab's fold line meets the neighbouring faces: near contact expected there (the discs
