@@ -321,8 +321,8 @@ class _Placed:
 
 
 def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
-            min_label_mm: float, runs: list[list[int]], deadline: Deadline, all_or_none: bool = False
-            ) -> tuple[list[_Placed], LabelStats] | None:
+            min_label_mm: float, runs: list[list[int]], deadline: Deadline, all_or_none: bool = False,
+            memo: dict | None = None) -> tuple[list[_Placed], LabelStats] | None:
     """Every piece's name, then one glue label per copy of every run of glued pairs (a run of
     one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
     all_or_none: None when a glue label finds no readable place.
@@ -330,7 +330,9 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     A piece's labels look only at that piece (its faces, tabs, room and labels), so each piece is
     placed on its own, in the order of the runs; with PARALLEL_LABELS or more labels, pieces are
     placed in processes forked from this one (`processes.fork_map`, the most labels first): the
-    same labels in the same places whatever the number of processes."""
+    same labels in the same places whatever the number of processes. `memo` keeps every piece's
+    labels by all they depend on (its room's key, name, cut sides, font size, and its labels'
+    texts and sides with their tabs, in order): a piece met again is not placed again."""
     from multiprocessing import RawValue
 
     from ..processes import fork_map, usable_cores
@@ -357,16 +359,20 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
                 return None
         return _Placed(labels.items, labels.outside, labels.leaders, labels.crowded, labels.stats)
 
-    n_labels = sum(len(j) for j in jobs)
-    order = sorted(range(len(drawn)), key=lambda i: -len(jobs[i]))
+    keys = [None if memo is None else _labels_key(drawn[i], i, rooms[i], size, all_or_none, jobs[i])
+            for i in range(len(drawn))]
+    order = sorted((i for i in range(len(drawn)) if memo is None or keys[i] not in memo), key=lambda i: -len(jobs[i]))
+    n_labels = sum(len(jobs[i]) for i in order)
     if n_labels >= PARALLEL_LABELS:  # the free-spot rasters' module: imported here once, not in every worker
         importlib.import_module("scipy.ndimage")
     done = fork_map(place, order, usable_cores() if n_labels >= PARALLEL_LABELS else 1)
     if failed.value or any(p is None for p in done):
         return None
-    placed: list[_Placed] = [None] * len(drawn)  # type: ignore[list-item]
+    placed: list[_Placed] = [None if memo is None else memo.get(k) for k in keys]  # type: ignore[misc]
     for i, p in zip(order, done):
         placed[i] = p
+        if memo is not None:
+            memo[keys[i]] = p
     stats = LabelStats()
     for p in placed:
         stats.on_tabs += p.stats.on_tabs
@@ -374,6 +380,18 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
         stats.unplaced += p.stats.unplaced
         stats.runs += p.stats.runs
     return placed, stats
+
+
+def _labels_key(d: _Drawn, i: int, room: Room, size: float, all_or_none: bool,
+                jobs: list[tuple[str, list]]) -> tuple:
+    """All that `_labels` places piece i's labels from (see there), as a dict key."""
+    def side_key(side: CutSide) -> tuple:
+        return side.face, side.k, side.p0.tobytes(), side.p1.tobytes(), side.tri.tobytes()
+
+    copies = tuple((text, tuple((side_key(side), tuple(np.asarray(p).tobytes() for p in polys),
+                                 None if folds is None else np.asarray(folds).tobytes())
+                                for side, polys, folds in copy)) for text, copy in jobs)
+    return (room.key, piece_name(i), size, all_or_none, tuple(side_key(side) for _key, side in d.sides), copies)
 
 
 def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tuple]]:
@@ -499,7 +517,7 @@ def _note_spot(side, name: str, size: float, smallest: float, taken: list) -> Te
 
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
                        min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never(),
-                       by_run: bool = False, tab_memo: dict | None = None
+                       by_run: bool = False, memo: dict | None = None
                        ) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
     """Draw every piece in mm and pair up their cut edges (see the module docstring). Tabs:
     `tabs.choose_tab` per glued pair; pairs without one are listed in LayoutStats.untabbed.
@@ -507,8 +525,10 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     or, when one of those finds no readable place, one per seam run (`LayoutStats.labels_by_run`);
     by_run: per seam run at once (a redraw of pieces whose drawing needed them: the failed try
     took a third of a dense model's drawing). OutOfTime past `deadline` (checked between pieces,
-    tabs and labels). tab_memo: `choose_tab`'s memo, one dict for all drawings of one model's
-    pieces at one scale (the same drawings with or without it)."""
+    tabs and labels). memo: one dict for all drawings of one model's pieces at one scale (make
+    draws them again after cutting some): a glued pair's tab (`choose_tab`) and a piece's labels
+    (`_labels`) found before are taken again where all they depend on is the same; the same
+    drawings with or without it."""
     import shapely
 
     drawn = []
@@ -521,10 +541,13 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     # a flat polygon whose faces close a cycle keeps one edge out of its tree: both sides lie on
     # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
+    tab_memo = None if memo is None else memo.setdefault("tabs", {})
+    label_memo = None if memo is None else memo.setdefault("labels", {})
     g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline, tab_memo)
     bare = [room.copy() for room in rooms]
     per_edge = None if by_run else _labels(pairs, drawn, rooms, chosen, min_label_mm,
-                                           [[i] for i in range(len(pairs))], deadline, all_or_none=True)
+                                           [[i] for i in range(len(pairs))], deadline, all_or_none=True,
+                                           memo=label_memo)
     if per_edge is not None:
         placed, label_stats = per_edge
     else:
@@ -534,7 +557,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         runs = _split_at(runs, {int(label) - 1 for label in g.untabbed})
         # the shortest runs first: they sit where the mesh is densest and have the fewest places
         runs.sort(key=lambda run: sum(pairs[i][1][0].length for i in run))
-        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs, deadline)
+        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs, deadline, memo=label_memo)
         for run in runs:
             for i in run:
                 g.glue[i] = replace(g.glue[i], printed=str(min(run) + 1))

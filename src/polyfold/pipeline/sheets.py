@@ -224,11 +224,11 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     too); a drawing stops the run at `hard` (OutOfTime)."""
     page, margin = _packer_page(box)
     by_run = False  # the first drawing's labels went by seam run: so do the redrawings of its pieces
-    tab_memo: dict = {}  # (redrawn pieces beside the same faces, tabs and labels get the same tabs)
+    memo: dict = {}  # (a redrawn piece's tabs and labels found before are taken again: `build_sheet_pieces`)
 
     def draw(inputs: list[PieceInput]) -> tuple[list[SheetPiece], list[GlueEdge], LayoutStats]:
         pieces, glue, stats = build_sheet_pieces(inputs, scale, tabs=opts.tabs, min_label_mm=opts.min_label_mm,
-                                                 deadline=hard, by_run=by_run, tab_memo=tab_memo)
+                                                 deadline=hard, by_run=by_run, memo=memo)
         return pieces, glue, stats
 
     def pack(pcs: list[SheetPiece], hint: list[int] | None, seconds: float) -> Packing:
