@@ -8,7 +8,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from polyfold.fabricate.tabs import MIN_FOLD_FRAC, MIN_GLUE_FRAC, TAB_CLEAR_MM, TAB_VARIANTS, CutSide, Room, choose_tab, full_depth
+from polyfold.fabricate.tabs import (MIN_FOLD_FRAC, MIN_GLUE_FRAC, TAB_CLEAR_MM, TAB_VARIANTS, CutSide, Room, choose_tab,
+                                     full_depth)
 
 
 def _rooms(*faces_per_piece):
@@ -72,3 +73,47 @@ def test_a_clipped_tab_hinged_on_a_stub_is_no_tab():
     assert tab is not None and tab.reason == "tapered"
     hinged = sum(float(np.linalg.norm(f[1] - f[0])) for f in tab.folds)
     assert MIN_FOLD_FRAC * 20.0 <= hinged < 20.0 - 8.0
+
+
+def test_a_rooms_key_says_what_is_on_it_in_order() -> None:
+    """Equal faces and additions in the same order: equal keys (choose_tab's memo takes a tab
+    found before for them); another addition, another order or other faces: other keys."""
+    faces = np.array([Polygon([(0, 0), (10, 0), (0, 10)]), Polygon([(10, 0), (10, 10), (0, 10)])])
+    tab_a, tab_b = Polygon([(0, 0), (10, 0), (8, -3), (2, -3)]), Polygon([(10, 0), (10, 10), (13, 8), (13, 2)])
+    one, two = Room(faces.copy()), Room(faces.copy())
+    assert one.key == two.key
+    one.add([tab_a])
+    assert one.key != two.key
+    two.add([tab_a])
+    assert one.key == two.key
+    copied = one.copy()
+    assert copied.key == one.key
+    copied.add([tab_b])
+    assert copied.key != one.key  # (the copy's additions are its own)
+    a_then_b, b_then_a = Room(faces.copy()), Room(faces.copy())
+    a_then_b.add([tab_a, tab_b])
+    b_then_a.add([tab_b])
+    b_then_a.add([tab_a])
+    assert a_then_b.key != b_then_a.key
+    moved = Room(np.array([shapely.affinity.translate(f, 1e-9, 0) for f in faces]))
+    assert moved.key != Room(faces.copy()).key
+
+
+def test_a_memo_gives_the_tab_choose_tab_gives() -> None:
+    """With a memo, a pair met again beside the same room gets the very tab found before; beside
+    a room with more on it, the tab is chosen again (and may differ)."""
+    faces = np.array([Polygon([(0, 0), (20, 0), (0, 20)])])
+    tri = np.array([[0.0, 0.0], [20.0, 0.0], [0.0, 20.0]])
+    side = CutSide(0, 0, 0, tri[0], tri[1], tri)
+    other = Room(np.array([Polygon([(0, -40), (20, -40), (20, -60)])]))
+    memo: dict = {}
+    rooms = [Room(faces.copy()), other]
+    first = choose_tab((side, side), rooms, memo)
+    assert first is not None and len(memo) == 1
+    again = choose_tab((side, side), [Room(faces.copy()), other], memo)
+    assert again is first and len(memo) == 1
+    crowded = Room(faces.copy())
+    crowded.add([Polygon([(-5, -1), (25, -1), (25, -30), (-5, -30)])])  # the tab's place is taken
+    blocked = choose_tab((side, side), [crowded, other], memo)
+    assert len(memo) == 2
+    assert blocked is None and choose_tab((side, side), [crowded, other]) is None

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+
 import pytest
 
 from conftest import check_sheet, read_sheet
@@ -102,3 +104,40 @@ def test_same_seed_same_pages(models_dir, tmp_path):
     for sa, sb in zip(sorted((tmp_path / "a").glob("sheet-*.svg")), sorted((tmp_path / "b").glob("sheet-*.svg"))):
         assert sa.read_text() == sb.read_text()
     assert a.report.stages.layout.pages == b.report.stages.layout.pages
+
+
+def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_afresh(models_dir):
+    """split_for_pages draws a model's pieces again after cutting some, with one memo: what it
+    takes from the memo (a pair's tab, a piece's labels) is what drawing afresh gives."""
+    from polyfold.fabricate.split import PagePlan
+    from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
+
+    mesh = load_mesh(models_dir / "bunny-348.obj").mesh
+    opts = MakeOptions(fold=False, guide=False)
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    w, h = paper_size(opts.paper)
+    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "bunny-348")
+    before = part_piece_inputs(mesh, fitted)
+    memo: dict = {}
+    first, _, _ = build_sheet_pieces(before, scale, memo=memo)
+    # cut the last piece along one crease near the middle of its tree (the pieces before it keep
+    # their names and glue numbers: their labels can be taken again)
+    big = len(before) - 1
+    net = before[big].net
+    creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
+    cuts = tuple(np.array([creases[len(creases) // 2]] if i == big else [], dtype=np.int64) for i in range(len(before)))
+    after = part_piece_inputs(mesh, _cut_plan(fitted, before, PagePlan(cuts, (), 0))[0])
+    assert len(after) == len(before) + 1
+    tabs_before, labels_before = len(memo["tabs"]), len(memo["labels"])
+    taken, glue_taken, stats_taken = build_sheet_pieces(after, scale, memo=memo)
+    fresh, glue_fresh, stats_fresh = build_sheet_pieces(after, scale)
+    # the memo was used: fewer new entries than pairs and pieces drawn
+    assert len(memo["tabs"]) - tabs_before < stats_fresh.glue_edges
+    assert len(memo["labels"]) - labels_before < len(after)
+    assert glue_taken == glue_fresh and stats_taken == stats_fresh
+    for p, q in zip(taken, fresh, strict=True):
+        assert p.outline.equals_exact(q.outline, 0.0) and p.footprint.equals_exact(q.footprint, 0.0)
+        assert p.texts == q.texts
+        assert len(p.tabs) == len(q.tabs) and all(np.array_equal(a, b) for a, b in zip(p.tabs, q.tabs))
+        assert np.array_equal(p.leaders, q.leaders) and np.array_equal(p.tab_folds, q.tab_folds)
