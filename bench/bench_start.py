@@ -3,7 +3,9 @@
     .venv/bin/python bench/bench_start.py [--skip-cold] [--sizes 128,1500,5000] [--no-server]
 
 Every row is a fresh `polyfold` process (the CLI as a user runs it), timed wall-clock, with the
-peak memory of it and the processes it starts (PSS, sampled: pages they share counted once).
+peak memory of it and the processes it starts (PSS, sampled: pages they share counted once) from
+a second run of the same command (sampling costs CPU time: the timed run is not sampled; the cold
+rows and `server start`, which cannot run twice alike, are timed while sampled).
 Cold rows use an empty numba cache of their own ($NUMBA_CACHE_DIR in a temporary folder, so the
 project's cache is left alone):
 
@@ -68,10 +70,21 @@ OWN = dict(os.environ, POLYFOLD_SERVER="off")  # every row in a process of its o
 
 def run(args: list[str], env: dict | None = None, prefix: list[str] = [], server: int | None = None
         ) -> tuple[float, float, int]:
-    """(wall seconds, peak memory MB, exit code) of one CLI process (run under `prefix`, e.g.
-    taskset). Memory: the peak of its process tree's PSS (make's forked workers included), sampled
-    every 0.1 s, plus that of the process tree of the `server` that runs its command; where /proc
-    cannot say, the process's own peak RSS."""
+    """(wall seconds, peak memory MB, exit code) of a CLI command (run under `prefix`, e.g.
+    taskset), run twice: timed alone, then with its memory sampled (reading /proc costs CPU
+    time: tens of ms a sample for a process of hundreds of MB, and a served command has two
+    process trees to read). Memory: the peak of its process tree's PSS (make's forked workers
+    included), sampled every 0.1 s, plus that of the process tree of the `server` that runs its
+    command; where /proc cannot say, the process's own peak RSS."""
+    t0 = time.perf_counter()
+    proc = subprocess.run(prefix + CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                          env=OWN if env is None else env)
+    wall = time.perf_counter() - t0
+    _, mb, code = _sampled(args, env, prefix, server)
+    return wall, mb, code if proc.returncode == 0 else proc.returncode
+
+
+def _sampled(args: list[str], env: dict | None, prefix: list[str], server: int | None) -> tuple[float, float, int]:
     import threading
 
     t0 = time.perf_counter()
@@ -129,16 +142,17 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench-start-"))
     if not a.skip_cold:
         env = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
-        wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env)
+        wall, mb, _ = _sampled(["make", str(BUNNY), "-o", str(tmp / "cold"), "-q"], env, [], None)
         cold_report = json.loads((tmp / "cold" / "report.json").read_text())
         rows.append(("cold make bunny-128 (bare pip install)", wall, mb,
                      "the fold stage's kernels compile in a second process meanwhile (its memory counted)"))
         if shutil.which("taskset"):  # the same on one core: one process compiles everything
             env1 = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-cold-1"))
-            wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "cold1"), "-q"], env1, ["taskset", "-c", "0"])
+            wall, mb, _ = _sampled(["make", str(BUNNY), "-o", str(tmp / "cold1"), "-q"], env1, ["taskset", "-c", "0"],
+                                   None)
             rows.append(("  the same on one core (taskset -c 0)", wall, mb, "one process"))
         env = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-setup"))
-        wall, mb, _ = run(["warm-up"], env)
+        wall, mb, _ = _sampled(["warm-up"], env, [], None)
         rows.append(("warm-up (make setup adds it)", wall, mb, ""))
         wall, mb, _ = run(["make", str(BUNNY), "-o", str(tmp / "after"), "-q"], env)
         rows.append(("make bunny-128 after warm-up", wall, mb, ""))
@@ -155,7 +169,7 @@ def main() -> None:
     if not a.no_server:
         runtime = Path(tempfile.mkdtemp(prefix="pfb"))  # (short: a Unix socket's path)
         served = dict(os.environ, XDG_RUNTIME_DIR=str(runtime), POLYFOLD_SERVER="require")
-        wall, mb, code = run(["server", "start"], served)
+        wall, mb, code = _sampled(["server", "start"], served, [], None)
         status = subprocess.run([*CLI, "server", "status"], env=served, capture_output=True, text=True).stdout
         server = int(status.split("pid ")[1].split(",")[0]) if code == 0 else None
         rows.append(("server start (once)", wall, _tree_pss_mb(server) if server else mb,
