@@ -41,6 +41,15 @@ def _status(env: dict) -> dict | None:
     return json.loads(proc.stdout)
 
 
+def _wait_running(env: dict, count: int, what: str, seconds: float = 10.0) -> None:
+    """Until the server runs `count` commands; fails saying `what` after `seconds`."""
+    end = time.monotonic() + seconds
+    while _status(env)["running"] != count:
+        if time.monotonic() > end:
+            pytest.fail(what)
+        time.sleep(0.02)
+
+
 @pytest.fixture(scope="module")
 def runtime():
     """A private runtime directory (short: a Unix socket's path is at most 107 bytes) with a
@@ -121,27 +130,17 @@ def test_an_interrupt_reaches_the_command(runtime: Path, tmp_path: Path, models_
     env = _env(runtime, "require")
     before = _status(env)
     out = tmp_path / "out"
-    # long enough to be interrupted (a 3,000-face mesh's make takes seconds)
+    # long enough to be interrupted (bunny-348 at 400 mm: dozens of pieces, seconds of work)
     proc = subprocess.Popen([*CLI, "make", str(models_dir / "bunny-348.obj"), "-o", str(out), "--size", "400",
                              "--faces", "none", "--seed", "3"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    for _ in range(300):
-        if _status(env)["running"] > before["running"]:
-            break
-        time.sleep(0.02)
-    else:
-        pytest.fail("the command never ran in the server")
+    _wait_running(env, before["running"] + 1, "the command never ran in the server")
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert err.strip().splitlines()[-1] == "polyfold: error: interrupted" and "Traceback" not in err
     assert not out.exists()
-    for _ in range(100):
-        if _status(env)["running"] == before["running"]:
-            break
-        time.sleep(0.05)
-    else:
-        pytest.fail("the interrupted command still runs in the server")
+    _wait_running(env, before["running"], "the interrupted command still runs in the server")
 
 
 def test_a_client_that_goes_away_stops_its_command(runtime: Path, tmp_path: Path, models_dir: Path) -> None:
@@ -150,18 +149,10 @@ def test_a_client_that_goes_away_stops_its_command(runtime: Path, tmp_path: Path
     proc = subprocess.Popen([*CLI, "make", str(models_dir / "bunny-348.obj"), "-o", str(tmp_path / "out"),
                              "--size", "400", "--faces", "none"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
-    for _ in range(300):
-        if _status(env)["running"] > before["running"]:
-            break
-        time.sleep(0.02)
+    _wait_running(env, before["running"] + 1, "the command never ran in the server")
     proc.kill()
     proc.wait()
-    for _ in range(200):
-        if _status(env)["running"] == before["running"]:
-            break
-        time.sleep(0.05)
-    else:
-        pytest.fail("the command of a killed client still runs")
+    _wait_running(env, before["running"], "the command of a killed client still runs")
     assert not (tmp_path / "out").exists()
 
 

@@ -77,7 +77,9 @@ def _fingerprint() -> str:
 
 def runtime_dir() -> Path:
     """This user's private directory for server sockets (see the module docstring), made when
-    missing; ServerError when it is not private."""
+    missing; ServerError when it is not private, or not on Linux."""
+    if not sys.platform.startswith("linux"):
+        raise ServerError("the server needs Linux (fork, SO_PEERCRED, pidfd); every command runs in its own process")
     base = os.environ.get("XDG_RUNTIME_DIR")
     uid = os.getuid()
     # (a Unix socket's path holds at most 107 bytes: the socket's name and a temporary suffix fit)
@@ -210,8 +212,13 @@ def _run_there(sock: socket.socket, argv: list[str]) -> int | None:
         finally:
             for fd in opened:
                 os.close(fd)
-        if sock.recv(1) != _ACCEPTED:  # turned down before anything ran (or gone): run here
+        try:
+            accepted = sock.recv(1)
+        except OSError:
+            accepted = b""
+        if accepted != _ACCEPTED:  # turned down before anything ran (or gone): run here
             return None
+
         def send_on(signum: int, _frame) -> None:
             try:
                 sock.send(bytes([signum]))
@@ -220,7 +227,10 @@ def _run_there(sock: socket.socket, argv: list[str]) -> int | None:
 
         for name in _FORWARDED:
             signal.signal(getattr(signal, name), send_on)
-        code = _recv_exact(sock, _CODE.size)
+        try:
+            code = _recv_exact(sock, _CODE.size)
+        except OSError:
+            code = b""
         if len(code) < _CODE.size:
             print("polyfold: error: the polyfold server stopped while it ran this command", file=sys.stderr)
             return 3
@@ -256,7 +266,7 @@ def start(idle_minutes: float = IDLE_MINUTES, wait_s: float = START_WAIT_S) -> t
     with open(log, "wb") as err:
         proc = subprocess.Popen([sys.executable, "-m", "polyfold.apps.server", "--idle-minutes", str(idle_minutes)],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err,
-                                start_new_session=True)
+                                start_new_session=True, cwd="/")  # (holds no directory of the caller's)
     t0 = time.monotonic()
     while time.monotonic() - t0 < wait_s:
         if proc.poll() is not None:

@@ -40,16 +40,22 @@ def start(idle_minutes: float = IDLE) -> None:
         say(f"server already running: {_describe(status)}")
 
 
+def _ask(op: str) -> dict | None:
+    """The server's answer to `op` (`apps.server.request`), None when none runs; one line and
+    exit 3 when the socket's directory is not private."""
+    from ..server import ServerError, request
+
+    try:
+        return request(op)
+    except ServerError as exc:
+        fail(f"server: {exc}", 3)
+
+
 @server_app.command("stop")
 @guard
 def stop() -> None:
     """Stop this installation's server (commands it runs finish first)."""
-    from ..server import ServerError, request
-
-    try:
-        status = request("stop")
-    except ServerError as exc:
-        fail(f"server: {exc}", 3)
+    status = _ask("stop")
     say("no server running" if status is None else f"server stopping: {_describe(status)}")
 
 
@@ -57,12 +63,7 @@ def stop() -> None:
 @guard
 def status() -> None:
     """Whether this installation's server runs (exit 1 when not), and what it has done."""
-    from ..server import ServerError, request
-
-    try:
-        answer = request("status")
-    except ServerError as exc:
-        fail(f"server: {exc}", 3)
+    answer = _ask("status")
     if answer is None:
         fail("no server running (`polyfold server start`)", 1)
     print(f"polyfold server: {_describe(answer)}")
@@ -72,11 +73,11 @@ def status() -> None:
 @guard
 def run(idle_minutes: float = IDLE) -> None:
     """Run the server in this process, in the foreground (Ctrl-C stops it)."""
-    from ..server import ServerError, request, serve
+    from ..server import ServerError, serve
 
+    if _ask("status") is not None:
+        fail("a server already runs for this installation (`polyfold server status`)", 1)
     try:
-        if request("status") is not None:
-            fail("a server already runs for this installation (`polyfold server status`)", 1)
         say("server: loading kernels ...")
         serve(idle_minutes, ready=lambda path: say(f"server ready, listening on {path} (Ctrl-C stops it)"))
     except ServerError as exc:
