@@ -23,7 +23,7 @@ id (SO_PEERCRED). It runs the SERVED verbs and nothing else. Staleness: the sock
 the Python interpreter, polyfold's source files (paths, sizes, mtimes) and the environment
 settings read at import time (NUMBA_*, OMP_*, PYTHON*...), so an edited or reinstalled polyfold,
 or a client with other such settings, never gets an answer from the wrong code: it runs in its
-own process, and the old server stops when idle (`IDLE_MINUTES`).
+own process, and the old server stops within a minute, when no command of its runs.
 
 Linux only (fork, SO_PEERCRED, pidfd). This module imports only the standard library at the top:
 the client side runs before anything else in every `polyfold` process.
@@ -413,6 +413,11 @@ class _Server:
         except OSError:
             return False
 
+    def current(self) -> bool:
+        """Whether this server's code is still polyfold's: its sources unchanged since it started
+        (a client of edited or reinstalled sources looks for another socket's name)."""
+        return _fingerprint() == self.path.stem
+
     def loop(self) -> None:
         import selectors
 
@@ -421,8 +426,8 @@ class _Server:
             if self.stop and self.listener.fileno() >= 0:  # no new commands; the running ones finish
                 self.sel.unregister(self.listener)
                 self.close()
-            if not self.running and (self.stop or idle >= self.idle_s or not self.ours()):
-                return
+            if not self.running and (self.stop or idle >= self.idle_s or not self.ours() or not self.current()):
+                return  # (asked to, idle, or of no use: its name taken, or its sources changed)
             timeout = None if self.running else max(0.0, min(self.idle_s - idle, 60.0))
             for key, _ in self.sel.select(timeout):
                 if key.fileobj is self.listener:
@@ -531,6 +536,10 @@ def serve(idle_minutes: float = IDLE_MINUTES, ready: Callable[[str], None] | Non
         pass
     finally:
         server.close()
+    try:  # a clean end: the log `start` made for it says nothing worth keeping
+        path.with_suffix(".log").unlink()
+    except OSError:
+        pass
 
 
 if __name__ == "__main__":  # `polyfold server start` runs this in the background
