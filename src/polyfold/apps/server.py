@@ -51,6 +51,7 @@ _FORWARDED = ("SIGINT", "SIGTERM", "SIGHUP")
 _ACCEPTED = b"\x01"
 _HEADER = struct.Struct("!I")
 _CODE = struct.Struct("!i")
+_LONGEST = 1 << 24  # bytes of a request: arguments and environment (a longer one is turned down)
 START_WAIT_S = 900.0  # `server start` waits this long for a server that compiles its kernels first
 
 
@@ -149,7 +150,7 @@ def _recv(sock: socket.socket, max_fds: int = 0) -> tuple[dict | None, list[int]
     else:
         head = sock.recv(_HEADER.size)
     head += _recv_exact(sock, _HEADER.size - len(head)) if head else b""
-    if len(head) < _HEADER.size:
+    if len(head) < _HEADER.size or _HEADER.unpack(head)[0] > _LONGEST:
         return None, fds
     data = _recv_exact(sock, _HEADER.unpack(head)[0])
     return json.loads(data.decode()), fds

@@ -192,8 +192,10 @@ class Room:
 
         self.tree = shapely.STRtree(self.faces)
         self._table = _Obstacles(self.faces)
-        self.key = hashlib.blake2b(np.ascontiguousarray(shapely.get_coordinates(self.faces)).tobytes(),
-                                   digest_size=16).digest()
+        digest = hashlib.blake2b(np.ascontiguousarray(shapely.get_num_coordinates(self.faces)).tobytes(),
+                                 digest_size=16)
+        digest.update(np.ascontiguousarray(shapely.get_coordinates(self.faces)).tobytes())
+        self.key = digest.digest()
 
     def copy(self) -> Room:
         """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
