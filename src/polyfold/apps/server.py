@@ -352,15 +352,19 @@ def _child(conn: socket.socket, fds: list[int], req: dict) -> None:
         except (OSError, ValueError):
             pass
 
+        passed_on = {int(getattr(signal, name)) for name in _FORWARDED}
+
         def listen() -> None:  # signals the client was sent; its going away interrupts the command
             while True:
                 try:
                     b = conn.recv(1)
                 except OSError:
                     b = b""
-                os.kill(os.getpid(), b[0] if b else signal.SIGINT)
                 if not b:
+                    os.kill(os.getpid(), signal.SIGINT)
                     return
+                if b[0] in passed_on:
+                    os.kill(os.getpid(), b[0])
 
         threading.Thread(target=listen, daemon=True).start()
         sys.argv = ["polyfold", *req["argv"]]
