@@ -246,3 +246,16 @@ def test_only_the_compute_verbs_are_served() -> None:
     assert SERVED == {"info", "inflate", "segment", "unfold", "fold", "cspace", "make"}
     for argv in (["view", "x"], ["batch", "x"], ["server", "status"], ["warm-up"], []):
         assert forward(argv) is None  # run in the client's own process, server or not
+
+
+def test_a_client_with_other_import_time_settings_runs_in_its_own_process(runtime: Path) -> None:
+    """NUMBA_* (and the like) are read when modules are imported: a server started without the
+    client's setting must not answer it; the command runs in the client's process."""
+    env = _env(runtime, "on")
+    before = _status(env)["served"]
+    other = dict(env, NUMBA_OPT="0")
+    proc = _cli(other, "info", BUNNY)
+    assert proc.returncode == 0 and "bunny-128.obj" in proc.stdout, proc.stderr
+    assert _status(env)["served"] == before
+    required = _cli(dict(other, POLYFOLD_SERVER="require"), "info", BUNNY)
+    assert required.returncode == 3 and "no polyfold server runs" in one_line(required.stderr)
