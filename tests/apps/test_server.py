@@ -259,3 +259,17 @@ def test_a_client_with_other_import_time_settings_runs_in_its_own_process(runtim
     assert _status(env)["served"] == before
     required = _cli(dict(other, POLYFOLD_SERVER="require"), "info", BUNNY)
     assert required.returncode == 3 and "no polyfold server runs" in one_line(required.stderr)
+
+
+def test_without_a_server_a_command_writes_nothing_for_one() -> None:
+    """A user who never starts a server: the commands look for one without making its folder."""
+    d = Path(tempfile.mkdtemp(prefix="pfn"))
+    try:
+        os.chmod(d, 0o700)
+        info = _cli(_env(d, "on"), "info", BUNNY)
+        status = _cli(_env(d, "on"), "server", "status")
+        assert info.returncode == 0 and info.stderr == "", info.stderr
+        assert status.returncode == 1 and "no server running" in one_line(status.stderr)
+        assert list(d.iterdir()) == []
+    finally:
+        shutil.rmtree(d, ignore_errors=True)

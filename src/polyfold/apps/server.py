@@ -76,9 +76,10 @@ def _fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
-def runtime_dir() -> Path:
+def runtime_dir(create: bool = True) -> Path | None:
     """This user's private directory for server sockets (see the module docstring), made when
-    missing; ServerError when it is not private, or not on Linux."""
+    missing (else None: no server was ever started there, and a command's start-up writes
+    nothing); ServerError when it is not private, or not on Linux."""
     if not sys.platform.startswith("linux"):
         raise ServerError("the server needs Linux (fork, SO_PEERCRED, pidfd); every command runs in its own process")
     base = os.environ.get("XDG_RUNTIME_DIR")
@@ -89,7 +90,10 @@ def runtime_dir() -> Path:
     else:
         d = Path("/tmp") / f"polyfold-{uid}"
     try:
-        d.mkdir(mode=0o700, exist_ok=True)
+        if create:
+            d.mkdir(mode=0o700, exist_ok=True)
+        elif not os.path.lexists(d):
+            return None
         st = os.lstat(d)
     except OSError as exc:
         raise ServerError(f"{d}: {exc.strerror or exc}") from None
@@ -101,14 +105,17 @@ def runtime_dir() -> Path:
     return d
 
 
-def socket_path() -> Path:
-    """Where the server for this polyfold and these settings listens."""
-    return runtime_dir() / f"{_fingerprint()}.sock"
+def socket_path(create: bool = True) -> Path | None:
+    """Where the server for this polyfold and these settings listens (None: see `runtime_dir`)."""
+    d = runtime_dir(create)
+    return None if d is None else d / f"{_fingerprint()}.sock"
 
 
-def _connect(path: Path) -> socket.socket | None:
+def _connect(path: Path | None) -> socket.socket | None:
     """A connection to the server at `path`; None when none listens there (a socket left by a
     server that died is removed)."""
+    if path is None:
+        return None
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
         sock.connect(str(path))
@@ -179,7 +186,7 @@ def forward(argv: list[str]) -> int | None:
     if not argv or argv[0] not in SERVED or switch == "off" or not sys.platform.startswith("linux"):
         return None
     try:
-        sock = _connect(socket_path())
+        sock = _connect(socket_path(create=False))
     except ServerError as exc:
         print(f"polyfold: warning: {exc}", file=sys.stderr)
         sock = None
@@ -240,7 +247,7 @@ def _run_there(sock: socket.socket, argv: list[str]) -> int | None:
 
 def request(op: str) -> dict | None:
     """Ask this polyfold's server `op` ("status" or "stop"); its answer, or None when none runs."""
-    sock = _connect(socket_path())
+    sock = _connect(socket_path(create=False))
     if sock is None:
         return None
     with sock:
@@ -293,22 +300,21 @@ _FIRST_CALLS = (("info", "{mesh}"), ("make", "{mesh}", "-o", "{tmp}/make", "-q")
 
 
 def _preload() -> None:
-    """Import what the commands import and load every kernel they call: the warm-up's sections
-    (compiling them first when numba's cache is empty), then `_FIRST_CALLS`."""
+    """Import what the commands import and load every kernel they call (compiling them first when
+    numba's cache is empty): `_FIRST_CALLS` (their make stands for the warm-up's make section),
+    then the warm-up's other sections and make's label kernels for crowded pieces."""
     import contextlib
     import io
     import tempfile
 
+    from ..formats.meshes import obj_text
     from .cli.app import app
     from .warmup import WARM_UP, bumpy_sphere, run_sections
 
-    run_sections(list(WARM_UP))
-    v, f = bumpy_sphere()
     with tempfile.TemporaryDirectory() as tmp:
         mesh = os.path.join(tmp, "warm-up.obj")
         with open(mesh, "w") as out:
-            out.write("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v.tolist())
-                      + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f.tolist()))
+            out.write(obj_text(*bumpy_sphere()))
         for call in _FIRST_CALLS:
             argv = [a.format(mesh=mesh, tmp=tmp) for a in call]
             quiet = io.StringIO()
@@ -317,6 +323,7 @@ def _preload() -> None:
                     app(argv, standalone_mode=False)
                 except SystemExit:
                     pass
+    run_sections([name for name in WARM_UP if name != "make"] + ["labels"])
 
 
 def _child(conn: socket.socket, fds: list[int], req: dict) -> None:

@@ -204,6 +204,8 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "fold": ("the unfolder's local search and the folding planners", _warm_fold),
     "segment": ("segmentation", _warm_segment),
     "inflate": ("inflation", _warm_inflate),
+    # (make's own: a `polyfold server` makes its sphere through the command line instead)
+    "labels": ("make's label kernels for crowded pieces", lambda mesh: _warm_crowded_labels()),
     # a first run's `Beside` (make has them both)
     "tabs": ("make's layout: the overlap tests of tabs and labels", _warm_tabs),
     "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
@@ -288,7 +290,7 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 
     say = progress or (lambda line: None)
     # (make's fold-stage sections bring their own net: no trimesh sphere to build for them)
-    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check"} else None
+    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check", "labels"} else None
     seconds: dict[str, float] = {}
     for name in names:
         what, run = SECTIONS[name]

@@ -385,13 +385,10 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
 def _labels_key(d: _Drawn, i: int, room: Room, size: float, all_or_none: bool,
                 jobs: list[tuple[str, list]]) -> tuple:
     """All that `_labels` places piece i's labels from (see there), as a dict key."""
-    def side_key(side: CutSide) -> tuple:
-        return side.face, side.k, side.p0.tobytes(), side.p1.tobytes(), side.tri.tobytes()
-
-    copies = tuple((text, tuple((side_key(side), tuple(np.asarray(p).tobytes() for p in polys),
+    copies = tuple((text, tuple((side.key(), tuple(np.asarray(p).tobytes() for p in polys),
                                  None if folds is None else np.asarray(folds).tobytes())
                                 for side, polys, folds in copy)) for text, copy in jobs)
-    return (room.key, piece_name(i), size, all_or_none, tuple(side_key(side) for _key, side in d.sides), copies)
+    return (room.key, piece_name(i), size, all_or_none, tuple(side.key() for _key, side in d.sides), copies)
 
 
 def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tuple]]:

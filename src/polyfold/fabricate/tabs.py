@@ -68,6 +68,10 @@ class CutSide:
         n = np.array([-u[1], u[0]])
         return -n if np.dot(self.tri.mean(axis=0) - self.p0, n) > 0 else n
 
+    def key(self) -> tuple:
+        """All of the side, as a dict key (but its piece's index: the memos key rooms by content)."""
+        return self.face, self.k, self.p0.tobytes(), self.p1.tobytes(), self.tri.tobytes()
+
 
 @dataclass(frozen=True, eq=False)
 class Tab:
@@ -360,8 +364,7 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | N
     labels gets the tab found before, untested."""
     if memo is None:
         return _choose_tab(sides, rooms)
-    key = (tuple((s.face, s.k, s.p0.tobytes(), s.p1.tobytes(), s.tri.tobytes()) for s in sides),
-           rooms[sides[0].piece].key, rooms[sides[1].piece].key)
+    key = (sides[0].key(), sides[1].key(), rooms[sides[0].piece].key, rooms[sides[1].piece].key)
     if key not in memo:
         memo[key] = _choose_tab(sides, rooms)
     return memo[key]

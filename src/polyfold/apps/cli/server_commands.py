@@ -26,8 +26,7 @@ def _describe(status: dict) -> str:
 def start(idle_minutes: float = IDLE) -> None:
     """Start the server in the background (once its kernels are loaded: a few seconds, or about a
     minute the first time, when it compiles them); later commands use it."""
-    from ..server import ServerError
-    from ..server import start as run
+    from ..server import ServerError, start as run
 
     t0 = time.perf_counter()
     try:
