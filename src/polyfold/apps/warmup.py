@@ -3,9 +3,9 @@ real command does not wait for them.
 
 numba compiles a kernel the first time a process calls it and keeps the machine code in its cache
 (`__pycache__` beside the sources, or $NUMBA_CACHE_DIR); later processes load it in milliseconds.
-Without this step a fresh install spends its first `polyfold make` compiling: about 28 s of a
-bunny's 31 s on a 2-core machine (57 s of compiling shared by two processes). `make setup` runs
-it once (README "Set-up").
+Without this step a fresh install spends its first `polyfold make` compiling: about 16.5 s of a
+bunny's 18 s on a 2-core machine (33 s of compiling shared by two processes, `Beside`). `make
+setup` runs it once (README "Set-up").
 
 In: nothing (generated bumpy spheres of 80 and 320 faces, seeded, so no file is needed). Out:
 seconds per stage. Every stage of `make` runs once (load, check, segment, unfold, fold, sheets,
@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..processes import usable_cores
+from ..processes import can_fork, usable_cores
 
 if TYPE_CHECKING:
     import subprocess
@@ -182,6 +182,18 @@ def _warm_fold_check(mesh) -> None:
     verify_written(pattern, path, opts, thickness)
 
 
+def _warm_guide(mesh) -> None:
+    """make's assembly guide: a folded pose (`fold_positions`) and a face-id picture (`face_ids`)
+    of `star_net`'s crease tree (whose kernels the fold stage compiled before)."""
+    from ..fold.tree import FoldTree, fold_positions
+    from ..guide.pictures import face_ids, fit_camera
+
+    pattern, _, opts = _star_tree()
+    tree = FoldTree.from_pattern(pattern, opts.contact_tol)
+    tris = fold_positions(tree, np.zeros(tree.n_edges))
+    face_ids(fit_camera(tris, np.eye(3), 8, 8), tris)
+
+
 def _warm_segment(mesh) -> None:
     from ..segment.segment import segment
 
@@ -210,13 +222,14 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "tabs": ("make's layout: the overlap tests of tabs and labels", _warm_tabs),
     "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
     "fold-check": ("make's fold stage: the path check", _warm_fold_check),
+    "guide": ("make's assembly guide: folded poses and pictures", _warm_guide),
 }
 WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs (the rest: in make's)
 # run beside the others in a second process when there are two cores: segmentation's and
 # inflation's kernels share little with make's, so the two halves take about as long (a fresh
 # machine: 61 + 10 s against 32 + 7 s; 110 s in one process)
 SECOND_PROCESS = ("segment", "inflate")
-BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section takes 25-30 s here)
+BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its sections take 15-17 s here)
 
 
 class Beside:
@@ -224,52 +237,115 @@ class Beside:
     stage that needs them: a first run's `make` (nothing in numba's cache) starts the layout's
     overlap tests (`tabs`: 3 s, in the cache long before this process lays out) and the fold
     stage's planners (`fold-plan`) at once; when its own fold stage begins (`ready`) it compiles the
-    path check (`fold-check`) itself if the planners are still compiling, then waits for them, and
-    loads both from the cache instead of compiling them. The fold stage's kernels are the largest
-    share of a first run's compiling (about 31 of 57 s for the bunny here) and share little with the
-    stages before it, which this process compiles meanwhile. If the second process fails, this
-    one compiles what it needs as usual. Use as a context manager (the process is stopped on the
-    way out)."""
+    path check (`fold-check`) and the guide's kernels (`guide`) itself if the planners are still
+    compiling, then waits for them, and loads them from the cache instead of compiling them. The
+    fold stage's kernels are the largest share of a first run's compiling (about half of the
+    bunny's 33 s here) and share little with the stages before it, which this process compiles
+    meanwhile: the two processes end within half a second of each other. If the second process
+    fails, this one compiles what it needs as usual. Use as a context manager (the process is
+    stopped on the way out)."""
 
     def __init__(self, beside: tuple[str, ...], here: tuple[str, ...], stage: str) -> None:
         self.stage, self.here = stage, here
-        self.proc: "subprocess.Popen | None" = start_sections(beside, capture=False)
+        self.proc: "_Sections | None" = _Sections(beside)
 
     def ready(self, stage: str) -> None:
         """Called as `stage` starts (make's `ready`): when the second process compiles for it, do
         `here` meanwhile and wait for it."""
         if stage != self.stage or self.proc is None:
             return
-        import subprocess
-
         from ..deadline import compiling_elsewhere
 
-        if self.proc.poll() is None:
+        if self.proc.running():
             for name in self.here:
                 SECTIONS[name][1](None)
         with compiling_elsewhere():  # (no deadline runs on while the kernels are made)
-            try:
-                self.proc.wait(timeout=BESIDE_WAIT_S)
-            except subprocess.TimeoutExpired:  # stuck: this process compiles what it needs itself
+            if not self.proc.wait(BESIDE_WAIT_S):  # stuck: this process compiles what it needs itself
                 self.proc.kill()
-                self.proc.wait()
         self.proc = None
 
     def __enter__(self) -> "Beside":
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.proc is not None and self.proc.poll() is None:  # its stage never came (--no-fold, an error)
+        if self.proc is not None:  # its stage never came (--no-fold, an error)
             self.proc.kill()
-            self.proc.wait()
         self.proc = None
+
+
+class _Sections:
+    """Warm-up sections running in a second process, quiet: forked from this one where processes
+    may fork (`processes.can_fork`: a copy of this process starts at once, with polyfold, numba
+    and numpy imported, where a fresh interpreter spends 0.5-0.7 s importing them), else a fresh
+    Python (`start_sections`). Forked by os.fork itself: a multiprocessing Process forked the same
+    way took 2-3 s more of system time on a first run here (four times the page faults)."""
+
+    def __init__(self, names: tuple[str, ...]) -> None:
+        import os
+
+        self.pid = 0
+        self.returncode: int | None = None  # once it has ended (negative: the signal that ended it)
+        self.spawned: "subprocess.Popen | None" = None
+        if not can_fork():
+            self.spawned = start_sections(names, capture=False)
+            return
+        # the child holds the pipe's write end: the read end sees end of file when it is gone
+        self.ended, ending = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: never returns into the caller's code
+            code = 1
+            try:
+                os.close(self.ended)
+                null = os.open(os.devnull, os.O_WRONLY)  # (numba's warnings would land among the
+                os.dup2(null, 1)                         # parent's progress lines)
+                os.dup2(null, 2)
+                run_sections(list(names))
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(ending)
+        self.pid = pid
+
+    def running(self) -> bool:
+        return not self.wait(0.0)
+
+    def wait(self, timeout: float) -> bool:
+        """Whether it has ended, waiting up to timeout seconds."""
+        if self.spawned is not None:
+            import subprocess
+
+            try:
+                self.returncode = self.spawned.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                return False
+            return True
+        import os
+        import select
+
+        if self.pid and select.select([self.ended], [], [], timeout)[0]:
+            self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
+            os.close(self.ended)
+            self.pid = 0
+        return self.pid == 0
+
+    def kill(self) -> None:
+        """Ends it if it runs, and waits for it."""
+        if self.spawned is not None:
+            self.spawned.kill()
+            self.returncode = self.spawned.wait()
+        elif self.pid:
+            import os
+            import signal
+
+            os.kill(self.pid, signal.SIGKILL)
+            self.wait(BESIDE_WAIT_S)
 
 
 def compile_beside() -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
     `kernels_cached()` False); else None."""
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
-        return Beside(("tabs", "fold-plan"), ("fold-check",), "fold")
+        return Beside(("tabs", "fold-plan"), ("fold-check", "guide"), "fold")
     return None
 
 
@@ -290,7 +366,7 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 
     say = progress or (lambda line: None)
     # (make's fold-stage sections bring their own net: no trimesh sphere to build for them)
-    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check", "labels"} else None
+    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check", "guide", "labels"} else None
     seconds: dict[str, float] = {}
     for name in names:
         what, run = SECTIONS[name]
@@ -329,4 +405,7 @@ if __name__ == "__main__":  # the second process of warm_up: sections named on t
     import json
     import sys
 
+    from ..processes import collect_less
+
+    collect_less()
     print(json.dumps(run_sections(sys.argv[1:])))

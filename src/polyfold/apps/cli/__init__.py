@@ -25,6 +25,8 @@ def main() -> None:
     code = forward(sys.argv[1:])
     if code is not None:
         sys.exit(code)
+    from ...processes import collect_less
     from .app import main as run_here
 
+    collect_less()
     run_here()
