@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from polyfold.apps.benchpaper import kernel_signatures
 from polyfold.apps.warmup import bumpy_sphere, kernels_cached, warm_up
@@ -104,6 +105,41 @@ def test_the_sections_beside_compile_every_kernel_of_makes_fold_stage():
     assert got["new"] == {}, f"make's fold stage compiles beyond the first run's sections: {got['new']}"
 
 
+_AFTER_THE_WAIT = r"""
+import json, sys, tempfile
+from pathlib import Path
+from polyfold.apps.benchpaper import kernel_signatures
+from polyfold.apps.warmup import SECTIONS
+from polyfold.pipeline.make import make
+from polyfold.pipeline.options import MakeOptions
+
+for name in ("fold-plan", "fold-check", "guide"):
+    SECTIONS[name][1](None)
+before = kernel_signatures()
+with tempfile.TemporaryDirectory() as out:
+    make(Path(sys.argv[1]), out, MakeOptions())
+after = kernel_signatures()
+late = ("fold.", "verify.", "guide.", "formats.")  # what make calls from its fold stage on
+new = {k: sorted(v - before.get(k, set())) for k, v in after.items()
+       if k.startswith(late) and v - before.get(k, set())}
+print(json.dumps(new))
+"""
+
+
+def test_what_make_compiles_after_its_wait_is_in_the_sections_of_the_wait():
+    """A first run's make compiles nothing from its fold stage on that `Beside`'s sections (the
+    second process's `fold-plan`, this one's `fold-check` and `guide`) did not: the bunny's make
+    after them calls no new signature of a fold, path check, guide or file-format kernel."""
+    import json
+    from pathlib import Path
+
+    bunny = Path(__file__).resolve().parents[2] / "examples" / "bunny-128.obj"
+    proc = subprocess.run([sys.executable, "-c", _AFTER_THE_WAIT, str(bunny)], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[-1]) == {}
+
+
 def test_star_net_is_a_flat_net_that_folds_to_its_tetrahedron():
     from shapely.geometry import Polygon
 
@@ -133,8 +169,12 @@ def test_star_net_is_a_flat_net_that_folds_to_its_tetrahedron():
     assert report.pieces == 1 and report.verified == 1
 
 
-def test_beside_waits_for_its_stage_only_and_stops_a_process_left_over():
+@pytest.mark.parametrize("forked", [True, False])
+def test_beside_waits_for_its_stage_only_and_stops_a_process_left_over(forked, monkeypatch):
+    from polyfold.apps import warmup
     from polyfold.apps.warmup import Beside
+
+    monkeypatch.setattr(warmup, "can_fork", lambda: forked)  # (False: a fresh Python, as on macOS)
 
     with Beside(("fold-check",), (), "fold") as beside:
         beside.ready("layout")

@@ -55,7 +55,8 @@ def make(
     first_run = kernels_cached() is False
     beside = compile_beside() if first_run and fold else None
     if not quiet and first_run:
-        say("first run: compiling polyfold's kernels (about a minute, once; `polyfold warm-up` does it ahead)"
+        say("first run: compiling polyfold's kernels (once: about 20 s with two cores, 40 s with one; "
+            "`polyfold warm-up` does it ahead)"
             + ("; the folding stage's in a second process" if beside is not None else ""))
     t0 = time.perf_counter()
     with options.make_progress(say, quiet, "polyfold make") as progress, beside or nullcontext():
@@ -355,7 +356,7 @@ def bench_paper(
 @app.command("warm-up")
 @guard
 def warm_up() -> None:
-    """Compile the numba kernels into numba's cache now (about a minute, once per install), so the
+    """Compile the numba kernels into numba's cache now (under a minute, once per install), so the
     first real command does not wait for them; `make setup` runs it."""
     from ..warmup import warm_up as run
 
