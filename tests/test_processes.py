@@ -1,6 +1,7 @@
 """processes.py: `fork_map` runs a function over items in forked processes, in order, and raises
 what it raises; `beside` runs one function in a forked process while another runs here;
-`usable_cores` counts this process's cores."""
+`Forked` waits for, polls and kills a forked process as Popen does a spawned one; `usable_cores`
+counts this process's cores."""
 
 from __future__ import annotations
 
@@ -113,3 +114,28 @@ def test_beside_ends_the_forked_work_when_here_raises() -> None:
     with pytest.raises(KeyboardInterrupt):
         beside(interrupted, slow)
     assert time.monotonic() - t0 < 10
+
+
+def test_forked_reports_how_its_work_ended_as_popen_would(tmp_path) -> None:
+    import subprocess
+    import time
+
+    from polyfold.processes import Forked
+
+    mark = tmp_path / "ran"
+    done = Forked(lambda: mark.write_text("yes"))
+    assert done.wait(timeout=30) == 0 and done.returncode == 0
+    assert mark.read_text() == "yes"  # (the work ran in the child, which shares this file system)
+
+    def fail() -> None:
+        raise RuntimeError("in the child")
+
+    assert Forked(fail).wait(timeout=30) == 1
+
+    slow = Forked(lambda: time.sleep(60))
+    assert slow.poll() is None
+    with pytest.raises(subprocess.TimeoutExpired):
+        slow.wait(timeout=0.05)
+    slow.kill()
+    assert slow.wait(timeout=30) == -9 and slow.poll() == -9
+    slow.kill()  # (ended and reaped: nothing to do)

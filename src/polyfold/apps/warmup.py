@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..processes import can_fork, usable_cores
+from ..processes import Forked, can_fork, usable_cores
 
 if TYPE_CHECKING:
     import subprocess
@@ -247,99 +247,50 @@ class Beside:
 
     def __init__(self, beside: tuple[str, ...], here: tuple[str, ...], stage: str) -> None:
         self.stage, self.here = stage, here
-        self.proc: "_Sections | None" = _Sections(beside)
+        # forked where it may be (it starts with polyfold, numba and numpy imported, where a fresh
+        # interpreter spends 0.5-0.7 s importing them), else a fresh Python (macOS)
+        self.proc: "Forked | subprocess.Popen | None" = (
+            Forked(lambda: _quiet_sections(beside)) if can_fork() else start_sections(beside, capture=False))
 
     def ready(self, stage: str) -> None:
         """Called as `stage` starts (make's `ready`): when the second process compiles for it, do
         `here` meanwhile and wait for it."""
         if stage != self.stage or self.proc is None:
             return
+        import subprocess
+
         from ..deadline import compiling_elsewhere
 
-        if self.proc.running():
+        if self.proc.poll() is None:
             for name in self.here:
                 SECTIONS[name][1](None)
         with compiling_elsewhere():  # (no deadline runs on while the kernels are made)
-            if not self.proc.wait(BESIDE_WAIT_S):  # stuck: this process compiles what it needs itself
+            try:
+                self.proc.wait(timeout=BESIDE_WAIT_S)
+            except subprocess.TimeoutExpired:  # stuck: this process compiles what it needs itself
                 self.proc.kill()
+                self.proc.wait()
         self.proc = None
 
     def __enter__(self) -> "Beside":
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.proc is not None:  # its stage never came (--no-fold, an error)
+        if self.proc is not None and self.proc.poll() is None:  # its stage never came (--no-fold, an error)
             self.proc.kill()
+            self.proc.wait()
         self.proc = None
 
 
-class _Sections:
-    """Warm-up sections running in a second process, quiet: forked from this one where processes
-    may fork (`processes.can_fork`: a copy of this process starts at once, with polyfold, numba
-    and numpy imported, where a fresh interpreter spends 0.5-0.7 s importing them), else a fresh
-    Python (`start_sections`). Forked by os.fork itself: forked by a multiprocessing Process it
-    took 1.3-3 s more of system time on a first run here than spawned (0.81 M page faults against
-    0.57 M spawned and 0.22 M forked so)."""
+def _quiet_sections(names: tuple[str, ...]) -> None:
+    """`run_sections` with stdout and stderr to /dev/null (in `Beside`'s forked process: numba's
+    warnings would land among the parent's progress lines)."""
+    import os
 
-    def __init__(self, names: tuple[str, ...]) -> None:
-        import os
-
-        self.pid = 0
-        self.returncode: int | None = None  # once it has ended (negative: the signal that ended it)
-        self.spawned: "subprocess.Popen | None" = None
-        if not can_fork():
-            self.spawned = start_sections(names, capture=False)
-            return
-        # the child holds the pipe's write end: the read end sees end of file when it is gone
-        self.ended, ending = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the child: never returns into the caller's code
-            code = 1
-            try:
-                os.close(self.ended)
-                null = os.open(os.devnull, os.O_WRONLY)  # (numba's warnings would land among the
-                os.dup2(null, 1)                         # parent's progress lines)
-                os.dup2(null, 2)
-                run_sections(list(names))
-                code = 0
-            finally:
-                os._exit(code)
-        os.close(ending)
-        self.pid = pid
-
-    def running(self) -> bool:
-        return not self.wait(0.0)
-
-    def wait(self, timeout: float) -> bool:
-        """Whether it has ended, waiting up to timeout seconds."""
-        if self.spawned is not None:
-            import subprocess
-
-            try:
-                self.returncode = self.spawned.wait(timeout=timeout)
-            except subprocess.TimeoutExpired:
-                return False
-            return True
-        import os
-        import select
-
-        if self.pid and select.select([self.ended], [], [], timeout)[0]:
-            self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
-            os.close(self.ended)
-            self.pid = 0
-        return self.pid == 0
-
-    def kill(self) -> None:
-        """Ends it if it runs, and waits for it."""
-        if self.spawned is not None:
-            self.spawned.kill()
-            self.returncode = self.spawned.wait()
-        elif self.pid:
-            import os
-            import signal
-
-            os.kill(self.pid, signal.SIGKILL)
-            self.wait(BESIDE_WAIT_S)
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.dup2(null, 2)
+    run_sections(list(names))
 
 
 def compile_beside() -> "Beside | None":
