@@ -126,6 +126,38 @@ def test_output_errors_and_exit_codes_come_back(runtime: Path, tmp_path: Path) -
     assert out.stat().st_mode & 0o777 == 0o600
 
 
+_INTERRUPT_AT_ONCE = r"""
+import os, sys
+from polyfold.apps import server
+out, err_path, mesh = sys.argv[1:]
+sock = server._connect(server.socket_path(create=False))
+null = os.open(os.devnull, os.O_RDWR)
+err = os.open(err_path, os.O_WRONLY | os.O_CREAT)
+server._send(sock, {"op": "run", "argv": ["make", mesh, "-o", out], "cwd": os.getcwd(), "env": dict(os.environ),
+                    "umask": 0o022, "affinity": sorted(os.sched_getaffinity(0))}, [null, null, err])
+assert sock.recv(1) == server._ACCEPTED
+sock.send(bytes([2]))  # SIGINT passed on at once: it waits in the socket until the child listens
+print(server._CODE.unpack(server._recv_exact(sock, server._CODE.size))[0])
+"""
+
+
+def test_an_interrupt_passed_on_before_the_command_listens_is_an_interrupt(runtime: Path, tmp_path: Path) -> None:
+    """A signal the client passes on as soon as the server takes the command lands in the child
+    at once, before or after the command's own handling begins: exit 130 and "interrupted"
+    either way (not a server error), nothing written."""
+    env = _env(runtime, "require")
+    out, err = tmp_path / "out", tmp_path / "stderr"
+    for _ in range(5):  # (where it lands varies)
+        proc = subprocess.run([sys.executable, "-c", _INTERRUPT_AT_ONCE, str(out), str(err), str(BUNNY)],
+                              capture_output=True, text=True, timeout=120, env=env)
+        assert proc.returncode == 0, proc.stderr
+        assert proc.stdout.strip() == "130", err.read_text()
+        assert err.read_text().strip().splitlines()[-1] == "polyfold: error: interrupted"
+        assert not out.exists()
+        err.unlink()
+    _wait_running(env, 0, "an interrupted command still runs in the server")
+
+
 def test_an_interrupt_reaches_the_command(runtime: Path, tmp_path: Path, models_dir: Path) -> None:
     env = _env(runtime, "require")
     before = _status(env)

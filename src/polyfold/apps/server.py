@@ -373,18 +373,19 @@ def _child(conn: socket.socket, fds: list[int], req: dict) -> None:
                 if b[0] in passed_on:
                     os.kill(os.getpid(), b[0])
 
-        threading.Thread(target=listen, daemon=True).start()
         sys.argv = ["polyfold", *req["argv"]]
         from .cli.app import main
 
-        try:
-            main()
-            code = 0
-        except SystemExit as exc:
-            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        except KeyboardInterrupt:
-            print("polyfold: error: interrupted", file=sys.stderr)
-            code = 130
+        # (a signal the client passed on before this thread ran waits in the socket: it lands at
+        # once, maybe before main's own handling begins, and is an interrupt all the same)
+        threading.Thread(target=listen, daemon=True).start()
+        main()
+        code = 0
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    except KeyboardInterrupt:
+        print("polyfold: error: interrupted", file=sys.stderr)
+        code = 130
     except BaseException as exc:  # (the command's own errors are one line already: this is the server's)
         try:
             print(f"polyfold: error: server: {type(exc).__name__}: {exc}", file=sys.stderr)
