@@ -139,3 +139,34 @@ def test_forked_reports_how_its_work_ended_as_popen_would(tmp_path) -> None:
     slow.kill()
     assert slow.wait(timeout=30) == -9 and slow.poll() == -9
     slow.kill()  # (ended and reaped: nothing to do)
+
+
+_LEAVE = r"""
+import atexit, sys, tempfile, threading, time, pathlib
+from polyfold.processes import leave
+folder = tempfile.TemporaryDirectory()  # removed by an exit handler (weakref.finalize)
+pathlib.Path(sys.argv[1]).write_text(folder.name)
+atexit.register(lambda: print("exit handlers ran"))
+print("buffered output")  # (stdout is a pipe: block-buffered, written only when flushed)
+if sys.argv[2] == "thread":
+    threading.Thread(target=lambda: (time.sleep(0.5), print("the thread finished"))).start()
+leave(3)
+print("never")
+"""
+
+
+@pytest.mark.parametrize("with_thread", [False, True])
+def test_leave_ends_the_process_as_an_exit_would(tmp_path, with_thread) -> None:
+    """`leave` (the command line's end): the exit status, what was printed, the exit handlers (a
+    temporary folder removed), and a running thread that is not a daemon finished, as sys.exit."""
+    import subprocess
+    import sys
+
+    where = tmp_path / "folder.txt"
+    run = subprocess.run([sys.executable, "-c", _LEAVE, str(where), "thread" if with_thread else "-"],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 3, run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0] == "buffered output" and "exit handlers ran" in lines and "never" not in lines
+    assert ("the thread finished" in lines) == with_thread
+    assert not os.path.exists(where.read_text())

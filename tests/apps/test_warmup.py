@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from polyfold.apps.benchpaper import kernel_signatures
-from polyfold.apps.warmup import bumpy_sphere, kernels_cached, warm_up
+from polyfold.apps.warmup import bumpy_sphere, compile_bytecode, kernels_cached, warm_up
 
 
 def test_warm_up_reaches_the_kernels_of_every_stage():
     seconds = warm_up(processes=1)  # all here, so this process holds every signature
-    assert set(seconds) == {"make", "fold", "segment", "inflate"} and all(s >= 0 for s in seconds.values())
+    assert set(seconds) == {"bytecode", "make", "fold", "segment", "inflate"} and all(s >= 0 for s in seconds.values())
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
@@ -30,11 +30,38 @@ def test_warm_up_in_two_processes_runs_every_section():
     entry point `python -m polyfold.apps.warmup SECTION...` prints their seconds as JSON)."""
     import json
 
-    assert set(warm_up(processes=2)) == {"make", "fold", "segment", "inflate"}
+    assert set(warm_up(processes=2)) == {"bytecode", "make", "fold", "segment", "inflate"}
     proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "segment", "inflate"], capture_output=True,
                           text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert set(json.loads(proc.stdout.splitlines()[-1])) == {"segment", "inflate"}
+
+
+def test_warm_up_writes_the_bytecode_of_every_module_even_where_python_would_not():
+    """An editable install under PYTHONDONTWRITEBYTECODE (as on this machine) never gets
+    `__pycache__/*.pyc` for polyfold's modules; after compile_bytecode a fresh process under that
+    setting loads every polyfold module `make` imports from its bytecode (`python -v` says which
+    file each code object came from)."""
+    from pathlib import Path
+
+    import polyfold
+
+    package = Path(polyfold.__file__).parent
+    for pyc in package.rglob("__pycache__/*.pyc"):  # as a fresh editable install has them: none
+        pyc.unlink()
+
+    def code_objects_from() -> list[str]:
+        run = subprocess.run([sys.executable, "-v", "-c", "import polyfold.pipeline.make"], capture_output=True,
+                             text=True, timeout=120, env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"})
+        assert run.returncode == 0, run.stderr[-2000:]
+        return [line.split("code object from ")[1].strip("'") for line in run.stderr.splitlines()
+                if "code object from" in line and str(package) in line]
+
+    before = code_objects_from()
+    assert len(before) > 50 and all(f.endswith(".py") for f in before)  # compiled from source, every time
+    assert compile_bytecode() is True
+    after = code_objects_from()
+    assert len(after) == len(before) and all(f.endswith(".pyc") for f in after), [f for f in after if f.endswith(".py")]
 
 
 def test_bumpy_sphere_is_closed_and_seeded():
