@@ -58,6 +58,21 @@ def test_info_plain(models_dir: Path) -> None:
     assert "genus" in proc.stdout
 
 
+def test_info_into_a_pipe_nobody_reads_stops_quietly(models_dir: Path) -> None:
+    """`polyfold info M --json | head -1` where head has gone before info writes: no "internal
+    error" line, the status a process killed by SIGPIPE has in the shell (141)."""
+    import os
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run([*CLI, "info", str(models_dir / "bunny-128.obj"), "--json"], stdout=write_end,
+                              stderr=subprocess.PIPE, text=True, timeout=120, env={**os.environ, "POLYFOLD_SERVER": "off"})
+    finally:
+        os.close(write_end)
+    assert proc.returncode == 141 and proc.stderr == "", (proc.returncode, proc.stderr)
+
+
 def test_info_imports_no_numba(models_dir: Path) -> None:
     """`info` starts fast (issue 23): it compiles nothing, so numba (about 0.35 s to import and
     start loading kernels) is not imported, on a plain mesh nor on a textured one."""

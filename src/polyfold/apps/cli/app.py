@@ -29,6 +29,18 @@ def fail(message: str, code: int) -> None:
     raise typer.Exit(code)
 
 
+def _stdout_gone() -> bool:
+    """Whether stdout is a pipe whose reading end is closed (poll says POLLERR)."""
+    import select
+
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), 0)
+        return any(events & select.POLLERR for _fd, events in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # no poll here, or no stdout to ask
+        return False
+
+
 def guard(func):
     """Run a command body; turn known errors into one line + exit code, never a traceback."""
 
@@ -44,6 +56,15 @@ def guard(func):
             raise typer.Exit(130) from None
         except typer.Exit:
             raise
+        except BrokenPipeError as exc:
+            if not _stdout_gone():
+                fail(one_line(exc), 3)
+            # what it printed is read no more (`polyfold info M --json | head -1`): stop quietly,
+            # as `cat` would, killed by SIGPIPE (the shell's 141); nothing left to flush there
+            import os
+
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            raise typer.Exit(141) from None
         except OSError as exc:
             if exc.filename is None:
                 fail(one_line(exc), 3)
