@@ -39,11 +39,11 @@ def collect_less() -> None:
 
 def leave(code: int) -> None:
     """End this process now with exit status `code`, as `sys.exit` would but without the
-    interpreter's teardown: the standard streams are flushed and the exit handlers run (they end
-    pools, remove temporary folders), then `os._exit`. For the command line when its command is
-    done: tearing down what a make loaded (hundreds of modules, its kernels' machine code) costs
-    0.2-0.4 s that nobody waits for. While a thread other than this one and not a daemon still runs, or where
-    the exit handlers cannot be run from here, it is a plain `sys.exit` (which waits for them)."""
+    interpreter's teardown: the exit handlers run (they end pools, remove temporary folders), the
+    standard streams are flushed, then `os._exit`. For the command line when its command is done:
+    tearing down what a make loaded (hundreds of modules, its kernels' machine code) costs 0.2-0.4 s
+    that nobody waits for. While a thread other than this one and not a daemon still runs, or
+    where the exit handlers cannot be run from here, it is a plain `sys.exit` (which waits)."""
     import atexit
     import threading
 
