@@ -13,7 +13,9 @@ project's cache is left alone):
   runs (two or more cores: the fold stage's kernels compile in a second process, `warmup.Beside`)
   and on one core (`taskset -c 0`: everything in one process);
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
-- warm: `--help`, `info`, `make` with the kernels cached (every later run);
+- warm: `--help`, `info`, `make` with the kernels cached (every later run), and where the warm
+  make's time goes: until its first progress line (start-up: imports; it reads the mesh next),
+  until its summary line, and until the process has ended;
 - served (`--server`, on by default): the same warm rows and make rows through `polyfold server`
   (`apps.server`: a resident process that forks a warm child per command), started in a runtime
   folder of its own; memory there is the server's process tree (the server, the child and its
@@ -110,6 +112,19 @@ def _sampled(args: list[str], env: dict | None, prefix: list[str], server: int |
     return wall, peak[0] or usage.ru_maxrss / 1024.0, proc.returncode
 
 
+def timeline(args: list[str], env: dict | None = None) -> tuple[float, float, float]:
+    """(first progress line, last line, exit) in seconds from the start of a CLI command run with
+    its progress on: how long it starts (imports, until it reads the mesh), works, and ends."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(CLI + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            env=OWN if env is None else env)
+    assert proc.stderr is not None
+    stamps = [time.perf_counter() - t0 for _line in proc.stderr]
+    proc.wait()
+    end = time.perf_counter() - t0
+    return (stamps[0], stamps[-1], end) if stamps else (end, end, end)
+
+
 def stages(out: Path) -> dict[str, float]:
     report = json.loads((out / "report.json").read_text())
     return {k: float(v["seconds"]) for k, v in report.get("stages", {}).items()
@@ -165,6 +180,11 @@ def main() -> None:
     for label, args in (("--help", ["--help"]), *warm):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
         rows.append((label, best[0], best[1], "three runs: the fastest"))
+    first, last, end = min((timeline(["make", str(BUNNY), "-o", str(tmp / "timeline")]) for _ in range(3)),
+                           key=lambda t: t[2])
+    rows.append(("  of it: start-up, make, end", end, 0.0,
+                 f"{first:.2f} until the mesh is read, {last - first:.2f} making it, {end - last:.2f} after the summary"
+                 " (progress lines stamped; fastest of three)"))
     served, server = None, None
     if not a.no_server:
         runtime = Path(tempfile.mkdtemp(prefix="pfb"))  # (short: a Unix socket's path)
