@@ -33,6 +33,37 @@ def test_cli_import_is_light() -> None:
     assert proc.stdout.strip() == "False"
 
 
+def test_a_command_imports_no_pydantic(models_dir: Path) -> None:
+    """typer 0.29 made pydantic a requirement and imports it in every command (0.05 s of each
+    start); polyfold pins typer below it (pyproject.toml): a command runs without it."""
+    probe = ("import atexit, sys, runpy; sys.argv = ['polyfold'] + sys.argv[1:]\n"
+             "atexit.register(lambda: print('pydantic' if 'pydantic' in sys.modules else 'no pydantic'))\n"
+             "runpy.run_module('polyfold', run_name='__main__')\n")
+    proc = subprocess.run([CLI[0], "-c", probe, "info", str(models_dir / "bunny-128.obj"), "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip().splitlines()[-1] == "no pydantic", proc.stderr[-500:]
+
+
+def test_a_line_on_stderr_is_one_write(monkeypatch) -> None:
+    """`say` writes its line and newline at once: a Ctrl-C between print's two writes left the
+    "interrupted" line on the end of the progress line before it."""
+    from polyfold.apps.cli.app import say
+
+    writes: list[str] = []
+
+    class Recorder:
+        def write(self, text: str) -> int:
+            writes.append(text)
+            return len(text)
+
+        def flush(self) -> None:
+            pass
+
+    monkeypatch.setattr(sys, "stderr", Recorder())
+    say("layout: fitting pieces to the page")
+    assert writes == ["polyfold: layout: fitting pieces to the page\n"]
+
+
 # ----------------------------------------------------------------------------------------------
 # Bad inputs, as bad/expected.json says
 

@@ -19,8 +19,11 @@ app.add_typer(bench_app, name="bench")
 
 
 def say(line: str) -> None:
-    """One line on stderr, prefixed `polyfold:`."""
-    print(f"polyfold: {line}", file=sys.stderr, flush=True)
+    """One line on stderr, prefixed `polyfold:`, in one write: print writes the text and its
+    newline apart, and a Ctrl-C between the two left the next line (the "interrupted") on the end
+    of this one."""
+    sys.stderr.write(f"polyfold: {line}\n")
+    sys.stderr.flush()
 
 
 def fail(message: str, code: int) -> None:
