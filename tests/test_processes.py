@@ -170,3 +170,16 @@ def test_leave_ends_the_process_as_an_exit_would(tmp_path, with_thread) -> None:
     assert lines[0] == "buffered output" and "exit handlers ran" in lines and "never" not in lines
     assert ("the thread finished" in lines) == with_thread
     assert not os.path.exists(where.read_text())
+
+
+def test_exit_status_is_the_interpreters() -> None:
+    """`exit_status`: the status `sys.exit(code)` gives a process (None 0, an int itself, a
+    message 1), for the command line's `leave` and the server's children."""
+    import subprocess
+    import sys
+
+    from polyfold.processes import exit_status
+
+    for code in (None, 0, 3, 141, "a message"):
+        run = subprocess.run([sys.executable, "-c", f"import sys; sys.exit({code!r})"], capture_output=True, timeout=60)
+        assert exit_status(SystemExit(code)) == run.returncode, code

@@ -2,7 +2,7 @@
 use; `fork_map`, which runs independent pieces of work in processes forked from this one,
 `beside`, which runs one piece of work in a forked process while this one does another,
 `Forked`, a forked process to poll, wait for or kill, as `subprocess.Popen` would a spawned one,
-and the command line's process settings (`collect_less`, `leave`).
+and the command line's process settings (`collect_less`, `exit_status`, `leave`).
 
 Forked, not spawned: a child starts as a copy of this process (its modules, kernels and data), so
 nothing but the items and the results is pickled and a pool costs milliseconds to start, not the
@@ -35,6 +35,11 @@ def collect_less() -> None:
     """Set `GC_THRESHOLD` for this process: for the command line and its helper processes, never
     on import (a program that imports polyfold keeps its own settings)."""
     gc.set_threshold(*GC_THRESHOLD)
+
+
+def exit_status(done: SystemExit) -> int:
+    """The exit status a process ending with `done` has: its code, 0 for None, 1 for a message."""
+    return done.code if isinstance(done.code, int) else (0 if done.code is None else 1)
 
 
 def leave(code: int) -> None:

@@ -333,6 +333,8 @@ def _child(conn: socket.socket, fds: list[int], req: dict) -> None:
     import signal
     import threading
 
+    from ..processes import exit_status
+
     signal.signal(signal.SIGINT, signal.default_int_handler)
     for name in ("SIGTERM", "SIGHUP", "SIGCHLD"):
         signal.signal(getattr(signal, name), signal.SIG_DFL)
@@ -382,7 +384,7 @@ def _child(conn: socket.socket, fds: list[int], req: dict) -> None:
         main()
         code = 0
     except SystemExit as exc:
-        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        code = exit_status(exc)
     except KeyboardInterrupt:
         print("polyfold: error: interrupted", file=sys.stderr)
         code = 130

@@ -25,13 +25,11 @@ def main() -> None:
     code = forward(sys.argv[1:])
     if code is not None:
         sys.exit(code)
-    from ...processes import collect_less, leave
+    from ...processes import collect_less, exit_status, leave
     from .app import main as run_here
 
     collect_less()
     try:
         run_here()
-    except SystemExit as done:  # how `main` ends, with its exit code
-        if done.code is not None and not isinstance(done.code, int):
-            raise  # a message to print: the interpreter's way
-        leave(done.code or 0)
+    except SystemExit as done:  # how `main` ends (always with an int code: its errors are said already)
+        leave(exit_status(done))
