@@ -70,7 +70,8 @@ def test_clock_stops_while_numba_compiles():
     assert abs(sum_sines(np.ones(3)) - 3 * math.sin(1.0) * math.cos(1.0)) < 1e-12
     wall = time.perf_counter() - wall0
     compiled = compiled_seconds() - compiled0
-    assert 0.05 < compiled <= wall  # the call was mostly compiling...
+    # the call was mostly compiling (20-200 ms, by the machine), ten times the tolerance below...
+    assert 0.5 * wall < compiled <= wall and compiled > 0.01
     assert left0 - d.left() <= wall - compiled + 1e-3  # ...and the deadline did not count it
     assert clock() <= time.perf_counter() - compiled
     by_stage = tally.by_stage()
