@@ -13,9 +13,11 @@ project's cache is left alone):
   runs (two or more cores: the fold stage's kernels compile in a second process, `warmup.Beside`)
   and on one core (`taskset -c 0`: everything in one process);
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
-- warm: `--help`, `info`, `make` with the kernels cached (every later run), and where the warm
-  make's time goes: until its first progress line (start-up: imports; it reads the mesh next),
-  until its summary line, and until the process has ended;
+- warm: `--help`, `info`, `make` with the kernels cached (every later run; ahead of time where
+  `polyfold warm-up` built them, `polyfold.jit`), the make again just in time (POLYFOLD_AHEAD=off:
+  numba's dispatchers from its cache), and where the warm make's time goes: until its first
+  progress line (start-up: imports; it reads the mesh next), until its summary line, and until
+  the process has ended;
 - served (`--server`, on by default): the same warm rows and make rows through `polyfold server`
   (`apps.server`: a resident process that forks a warm child per command), started in a runtime
   folder of its own; memory there is the server's process tree (the server, the child and its
@@ -177,9 +179,16 @@ def main() -> None:
     run(["make", str(BUNNY), "-o", str(tmp / "prime"), "-q"])  # the project's cache, as after setup
     warm = (("info bunny-128", ["info", str(BUNNY)]),
             ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"]))
+    ahead = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
+                           env=OWN, capture_output=True, text=True).stdout.strip() == "True"
     for label, args in (("--help", ["--help"]), *warm):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
-        rows.append((label, best[0], best[1], "three runs: the fastest"))
+        how = "" if label == "--help" else ("; kernels ahead of time (no numba)" if ahead
+                                            else "; no ahead-of-time kernels for this code: run `polyfold warm-up`")
+        rows.append((label, best[0], best[1], "three runs: the fastest" + how))
+    best = min((run(warm[1][1], dict(OWN, POLYFOLD_AHEAD="off")) for _ in range(3)), key=lambda r: r[0])
+    rows.append(("  the same just in time (POLYFOLD_AHEAD=off)", best[0], best[1],
+                 "numba imported, kernels loaded from its cache; three runs: the fastest"))
     first, last, end = min((timeline(["make", str(BUNNY), "-o", str(tmp / "timeline")]) for _ in range(3)),
                            key=lambda t: t[2])
     rows.append(("  of it: start-up, make, end", end, 0.0,

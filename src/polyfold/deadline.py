@@ -19,6 +19,7 @@ in every later run. `compiled_seconds()` says how long compiling took (the make 
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -29,9 +30,11 @@ from .errors import OutOfTime
 _compiling = {"depth": 0, "since": 0.0, "total": 0.0, "watching": False}
 
 
-def _watch_compiles() -> None:
-    """Listen to numba's compile events (once per process): nested compiles (a kernel's callees)
-    count once, in the outermost."""
+def watch_compiles() -> None:
+    """Listen to numba's compile events (once per process; `jit` calls it when it first needs
+    numba): nested compiles (a kernel's callees) count once, in the outermost."""
+    if _compiling["watching"]:
+        return
     from numba.core import event
 
     class _Tally(event.Listener):
@@ -71,8 +74,8 @@ def compiling_elsewhere() -> Iterator[None]:
 def clock() -> float:
     """`time.perf_counter()` less the seconds spent compiling: the clock every Deadline runs on.
     (Process-wide: while one thread compiles, every thread's deadlines wait.)"""
-    if not _compiling["watching"]:
-        _watch_compiles()
+    if not _compiling["watching"] and "numba" in sys.modules:  # (numba not imported: nothing compiles)
+        watch_compiles()
     return time.perf_counter() - compiled_seconds()
 
 

@@ -12,10 +12,14 @@ import pytest
 
 from polyfold.apps.benchpaper import kernel_signatures
 from polyfold.apps.warmup import bumpy_sphere, compile_bytecode, kernels_cached, warm_up
+from polyfold.jit import SWITCH
+
+# a first run's process has no ahead-of-time kernels (`jit`): the signature tests below run without them
+JUST_IN_TIME = {**os.environ, SWITCH: "off"}
 
 
 def test_warm_up_reaches_the_kernels_of_every_stage():
-    seconds = warm_up(processes=1)  # all here, so this process holds every signature
+    seconds = warm_up(processes=1, ahead=False)  # all here, so this process holds every signature
     assert set(seconds) == {"bytecode", "make", "fold", "segment", "inflate"} and all(s >= 0 for s in seconds.values())
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
@@ -30,7 +34,7 @@ def test_warm_up_in_two_processes_runs_every_section():
     entry point `python -m polyfold.apps.warmup SECTION...` prints their seconds as JSON)."""
     import json
 
-    assert set(warm_up(processes=2)) == {"bytecode", "make", "fold", "segment", "inflate"}
+    assert set(warm_up(processes=2, ahead=False)) == {"bytecode", "make", "fold", "segment", "inflate"}
     proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "segment", "inflate"], capture_output=True,
                           text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
@@ -72,13 +76,20 @@ def test_bumpy_sphere_is_closed_and_seeded():
 
 
 def test_cli_warm_up_says_what_it_did():
+    """...and builds make's kernels ahead of time (`jit`; this machine has a C compiler): a fresh
+    process then finds them."""
     proc = subprocess.run([sys.executable, "-m", "polyfold", "warm-up"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "kernels compiled and cached" in proc.stderr
+    ahead = [line for line in proc.stderr.splitlines() if "warm-up: ahead of time: " in line]
+    assert len(ahead) == 1 and " kernels compiled, " in ahead[0], proc.stderr
+    ready = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
+                           capture_output=True, text=True, timeout=120)
+    assert ready.stdout.strip() == "True", ready.stderr
 
 
 def test_kernels_cached_tells_a_cold_cache_from_a_warm_one(tmp_path):
-    warm_up()
+    warm_up(ahead=False)
     assert kernels_cached() is True
     cold = subprocess.run([sys.executable, "-c", "from polyfold.apps.warmup import kernels_cached; print(kernels_cached())"],
                           capture_output=True, text=True, timeout=120,
@@ -125,7 +136,7 @@ def test_the_sections_beside_compile_every_kernel_of_makes_fold_stage():
 
     bunny = Path(__file__).resolve().parents[2] / "examples" / "bunny-128.obj"
     proc = subprocess.run([sys.executable, "-c", _FOLD_STAGE_SIGNATURES, str(bunny)], capture_output=True, text=True,
-                          timeout=600)
+                          timeout=600, env=JUST_IN_TIME)
     assert proc.returncode == 0, proc.stderr
     got = json.loads(proc.stdout.splitlines()[-1])
     assert got["pieces"] >= 1 and got["verified"] == got["pieces"]
@@ -162,7 +173,7 @@ def test_what_make_compiles_after_its_wait_is_in_the_sections_of_the_wait():
 
     bunny = Path(__file__).resolve().parents[2] / "examples" / "bunny-128.obj"
     proc = subprocess.run([sys.executable, "-c", _AFTER_THE_WAIT, str(bunny)], capture_output=True, text=True,
-                          timeout=600)
+                          timeout=600, env=JUST_IN_TIME)
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout.splitlines()[-1]) == {}
 
@@ -280,7 +291,7 @@ def test_the_warm_up_compiles_the_kernels_of_crowded_labels(models_dir):
     import json
 
     proc = subprocess.run([sys.executable, "-c", _CROWDED_LABEL_SIGNATURES, str(models_dir / "fish-472.obj")],
-                          capture_output=True, text=True, timeout=600)
+                          capture_output=True, text=True, timeout=600, env=JUST_IN_TIME)
     assert proc.returncode == 0, proc.stderr
     got = json.loads(proc.stdout.splitlines()[-1])
     assert got["calls"]["free_near"] > 0 and got["calls"]["routed_near"] > 0

@@ -5,7 +5,7 @@ normal, each over all triangles of two hulls)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 
 @njit(cache=True)

@@ -287,7 +287,7 @@ def kernel_signatures() -> dict[str, set[str]]:
     runs means timed compilation."""
     import sys
 
-    from numba.core.registry import CPUDispatcher
+    from ..jit import Kernel
 
     root = __package__.partition(".")[0]  # polyfold (this module is in polyfold.apps)
     out: dict[str, set[str]] = {}
@@ -295,8 +295,8 @@ def kernel_signatures() -> dict[str, set[str]]:
         if module is None or not module_name.startswith(f"{root}."):
             continue
         for name, obj in vars(module).items():
-            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module_name:
-                out[f"{module_name.removeprefix(root + '.')}.{name}"] = {str(s) for s in obj.signatures}
+            if isinstance(obj, Kernel) and obj.py_func.__module__ == module_name:
+                out[f"{module_name.removeprefix(root + '.')}.{name}"] = {str(s) for s in obj.jit_signatures()}
     return out
 
 

@@ -62,14 +62,10 @@ class ServerError(Exception):
 def _fingerprint() -> str:
     """Hash of what a server's answers depend on besides the request (see the module docstring)."""
     # the interpreter and the environment (a venv's python and python3 are one interpreter)
+    from ..sources import hash_sources
+
     h = hashlib.sha256(f"{os.path.realpath(sys.executable)}\n{sys.prefix}\n".encode())
-    root = Path(__file__).resolve().parents[1]  # the polyfold package
-    for dirpath, dirnames, filenames in os.walk(root):
-        dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
-        for name in sorted(filenames):
-            if name.endswith(".py"):
-                st = os.stat(os.path.join(dirpath, name))
-                h.update(f"{dirpath}/{name}:{st.st_size}:{st.st_mtime_ns}\n".encode())
+    hash_sources(h)
     for key in sorted(os.environ):
         if key.startswith(_IMPORT_TIME_ENV) and key != SWITCH:
             h.update(f"{key}={os.environ[key]}\n".encode())
@@ -301,13 +297,14 @@ _FIRST_CALLS = (("info", "{mesh}"), ("make", "{mesh}", "-o", "{tmp}/make", "-q")
 
 def _preload() -> None:
     """Import what the commands import and load every kernel they call (compiling them first when
-    numba's cache is empty): `_FIRST_CALLS` (their make stands for the warm-up's make section),
-    then the warm-up's other sections and make's label kernels for crowded pieces."""
+    numba's cache is empty): `_FIRST_CALLS`, then the warm-up's sections and make's label kernels
+    for crowded pieces just in time."""
     import contextlib
     import io
     import tempfile
 
     from ..formats.meshes import obj_text
+    from ..jit import just_in_time
     from .cli.app import app
     from .warmup import WARM_UP, bumpy_sphere, run_sections
 
@@ -323,7 +320,10 @@ def _preload() -> None:
                     app(argv, standalone_mode=False)
                 except SystemExit:
                     pass
-    run_sections([name for name in WARM_UP if name != "make"] + ["labels"])
+    # and numba's dispatchers too (the calls above ran ahead of time where `polyfold warm-up` built
+    # them): loaded here once, not in each child whose call has types the ahead-of-time module lacks
+    with just_in_time():
+        run_sections(list(WARM_UP) + ["labels"])
 
 
 def _child(conn: socket.socket, fds: list[int], req: dict) -> None:

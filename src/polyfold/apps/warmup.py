@@ -22,6 +22,7 @@ and both inflation modes (`make --inflate`).
 from __future__ import annotations
 
 import math
+import os
 import tempfile
 import time
 from typing import TYPE_CHECKING, Callable
@@ -46,9 +47,12 @@ def compile_bytecode() -> bool:
 
 def kernels_cached() -> bool | None:
     """Whether numba's cache holds the planners' main kernel (a first run compiles when not):
-    True or False, or None when this numba keeps its cache where this cannot look."""
-    import os
+    True or False, or None when this numba keeps its cache where this cannot look. True without
+    looking when the kernels run ahead of time (`jit.ahead_ready`: numba is not imported)."""
+    from ..jit import ahead_ready
 
+    if ahead_ready():
+        return True
     try:
         from ..fold.checker import segment_free
 
@@ -300,8 +304,6 @@ class Beside:
 def _quiet_sections(names: tuple[str, ...]) -> None:
     """`run_sections` with stdout and stderr to /dev/null (in `Beside`'s forked process: numba's
     warnings would land among the parent's progress lines)."""
-    import os
-
     null = os.open(os.devnull, os.O_WRONLY)
     os.dup2(null, 1)
     os.dup2(null, 2)
@@ -344,12 +346,17 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
     return seconds
 
 
-def warm_up(progress: Callable[[str], None] | None = None, processes: int | None = None) -> dict[str, float]:
-    """Call every compiled kernel a command can reach once; seconds per section. processes: 1 runs
-    every section here; 2 (the default with two or more cores) runs SECOND_PROCESS in a second Python
-    process at the same time (numba compiles in one thread; its cache is written file by file, a
-    temporary file renamed, so two processes may fill it together)."""
+def warm_up(progress: Callable[[str], None] | None = None, processes: int | None = None,
+            ahead: bool = True) -> dict[str, float]:
+    """Call every compiled kernel a command can reach once, just in time (into numba's cache);
+    then, with `ahead`, compile the calls of make's kernels ahead of time (`compile_ahead`);
+    seconds per section ("ahead": that step). processes: 1 runs every section here; 2 (the default
+    with two or more cores) runs SECOND_PROCESS in a second Python process at the same time (numba
+    compiles in one thread; its cache is written file by file, a temporary file renamed, so two
+    processes may fill it together)."""
     import json
+
+    from ..jit import just_in_time
 
     t0 = time.perf_counter()
     compiled = compile_bytecode()
@@ -363,14 +370,59 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
         if progress:
             progress(f"warm-up: {' and '.join(SECTIONS[n][0] for n in SECOND_PROCESS)}, in a second process")
     here = [n for n in WARM_UP if beside is None or n not in SECOND_PROCESS]
-    seconds = run_sections(here, progress)
-    if beside is not None:
-        out, err = beside.communicate()
-        if beside.returncode == 0:
-            seconds.update(json.loads(out.splitlines()[-1]))
-        else:  # whatever went wrong there, compile them here
-            seconds.update(run_sections(list(SECOND_PROCESS), progress))
-    return {"bytecode": bytecode_s, **seconds}
+    with just_in_time():
+        seconds = run_sections(here, progress)
+        if beside is not None:
+            out, err = beside.communicate()
+            if beside.returncode == 0:
+                seconds.update(json.loads(out.splitlines()[-1]))
+            else:  # whatever went wrong there, compile them here
+                seconds.update(run_sections(list(SECOND_PROCESS), progress))
+    seconds = {"bytecode": bytecode_s, **seconds}
+    if ahead:
+        t0 = time.perf_counter()
+        said = compile_ahead(progress)
+        if progress:
+            progress(f"warm-up: ahead of time: {said}")
+        seconds["ahead"] = time.perf_counter() - t0
+    return seconds
+
+
+AHEAD = ("make", "fold")  # the sections whose kernel calls are compiled ahead of time
+
+
+def compile_ahead(progress: Callable[[str], None] | None = None) -> str:
+    """Compile the kernels the AHEAD sections call from Python ahead of time (`jit.build_ahead`), in
+    a Python process of its own: it runs them just in time (from numba's cache, which the
+    sections before filled), on one core so that no forked worker makes a call unrecorded. Returns
+    its one-line account."""
+    import json
+    import subprocess
+    import sys
+
+    from ..jit import SWITCH
+
+    if progress:
+        progress(f"warm-up: compiling the kernel calls of {' and '.join(SECTIONS[n][0] for n in AHEAD)} ahead of "
+                 "time (a warm command then starts without numba)")
+    proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "--ahead", *AHEAD],
+                          capture_output=True, text=True, env={**os.environ, SWITCH: "off"})
+    lines = proc.stdout.strip().splitlines()
+    if proc.returncode != 0 or not lines:
+        last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        return f"not built: its process ended with {proc.returncode} ({last})"
+    return json.loads(lines[-1])["ahead"]
+
+
+def _record_and_build(names: list[str]) -> str:
+    """The process of `compile_ahead`: the sections with their kernel calls recorded, then the build."""
+    from ..jit import build_ahead, record_calls
+
+    if hasattr(os, "sched_setaffinity"):
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})  # (usable_cores() 1: nothing forked)
+    calls = record_calls()
+    run_sections(names)
+    return build_ahead(calls)
 
 
 if __name__ == "__main__":  # the second process of warm_up: sections named on the command line
@@ -380,4 +432,10 @@ if __name__ == "__main__":  # the second process of warm_up: sections named on t
     from ..processes import collect_less
 
     collect_less()
-    print(json.dumps(run_sections(sys.argv[1:])))
+    from ..jit import just_in_time
+
+    if sys.argv[1:2] == ["--ahead"]:
+        print(json.dumps({"ahead": _record_and_build(sys.argv[2:])}))
+    else:
+        with just_in_time():
+            print(json.dumps(run_sections(sys.argv[1:])))

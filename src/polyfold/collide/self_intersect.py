@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..mesh.mesh import Mesh
 from .sweep import NO_LIMIT, sweep_pairs

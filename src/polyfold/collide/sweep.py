@@ -20,7 +20,7 @@ fixed) and degenerate faces (which `triangles_collide` finds never collide).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..sorting import stable_argsort
 from .triangles import (GEO_LO, face_geometry, faces_cross, load_face, store_face, thick_collides, tri_corners,

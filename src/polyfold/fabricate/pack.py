@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 import shapely
-from numba import njit
+from ..jit import njit
 from shapely import MultiPolygon, Polygon
 
 from ..deadline import clock

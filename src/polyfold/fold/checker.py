@@ -20,7 +20,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..collide.sweep import fill_face_geometry, gather_boxes, largest_group, sort_by_lo_x, sweep_collides
 from ..collide.tolerance import EXEMPT_REACH

@@ -9,7 +9,7 @@ half the resolution.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..deadline import Deadline
 from .checker import ValidityChecker, first_blocked_segment, shortcut

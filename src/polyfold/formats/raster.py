@@ -11,7 +11,7 @@ import colorsys
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 
 def part_colors(n: int, saturation: float = 0.65, value: float = 0.92) -> np.ndarray:

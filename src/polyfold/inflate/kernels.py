@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from ..jit import njit
 
 from ..mesh.geometry import HYPERBOLIC_EPS
 

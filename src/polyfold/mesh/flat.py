@@ -22,7 +22,7 @@ CCW as the region's faces were.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .geometry import FLAT_REGION_RAD
 from .mesh import Mesh

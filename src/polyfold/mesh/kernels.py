@@ -11,7 +11,7 @@ sqrt); dot products (einsum) and atan2 stay in numpy, whose SIMD loops round dif
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from . import geometry
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex
 HULL_FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .memo_kernels import bucket, memo_grown, memo_lookup, pow2, union_eval
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .hull_kernels import HULL_FLAT_EPS, convex_hull, copy_row, denoise, max_depth
 

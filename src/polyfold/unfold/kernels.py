@@ -7,7 +7,7 @@ evaluated in one call.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..collide.flat import all_overlapping_pairs, face_bounds, overlapping_pairs, overlapping_pairs_between
 

@@ -7,7 +7,7 @@ rounds as np.degrees), so the pattern is bitwise the one numpy's formulas gave.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..mesh.kernels import rho_to_fold_deg
 
@@ -169,10 +169,10 @@ def net_edges(corner_v, n_v, coords, offsets, piece, face_edges, parent, parent_
         ev[j, 1] = corner_v[f, (k + 1) % 3] + v_off
         e = face_edges[f, k]
         em[j] = e + e_off
-        r = fold_angles[e]
+        rho = fold_angles[e]  # (not r, the bucket loop's index: compiled ahead of time, numba types them as one)
         if crease[e]:
-            kind[j] = 1 if abs(r) < flat_eps else (2 if r > 0 else 3)
+            kind[j] = 1 if abs(rho) < flat_eps else (2 if rho > 0 else 3)
         if kind[j] >= 2:
-            angle[j] = rho_to_fold_deg(r)
+            angle[j] = rho_to_fold_deg(rho)
         j += 1
     return xy, faces, piece_out, parent_out, ev, em, angle, kind

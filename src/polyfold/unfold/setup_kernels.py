@@ -10,7 +10,7 @@ products and atan2 are left to numpy (see `mesh.kernels`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 
 @njit(cache=True, error_model="numpy")  # degenerate input gives nan / inf as numpy does

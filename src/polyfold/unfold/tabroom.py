@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..collide.flat import face_bounds, overlapping_pairs, overlapping_pairs_between
 from ..deadline import Deadline

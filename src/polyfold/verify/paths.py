@@ -5,7 +5,8 @@ word "verified" is written anywhere, the path as it is written (FOLD degrees, va
 checked again here by a second implementation that shares no code with them: its own crease tree
 (breadth-first from the lowest face of each piece), its own forward kinematics, its own broad
 phase (sweep on z) and its own triangle tests (edge piercing and clipped-slab overlap, not the
-planners' separating-axis test). Nothing here imports the rest of polyfold.
+planners' separating-axis test). Nothing here imports the rest of polyfold but its kernel
+decorator (`jit.njit`: numba's, compiled ahead of time where it can be).
 
 The physical model (README "Paper thickness"): faces are rigid plates of thickness `thickness`
 (absolute, in the file's units). Two faces of one piece that are not the two faces of a crease
@@ -40,7 +41,8 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from ..jit import njit
 
 # faces sharing a point may come within the thickness this many thicknesses from it (the same
 # rule as the planners' collide.tolerance.EXEMPT_REACH, stated here again: nothing is imported)

@@ -1,0 +1,362 @@
+"""polyfold's numba kernels, called from Python without numba where they were compiled ahead of
+time: `njit`, the decorator every kernel module uses in place of numba's, and `build_ahead`, which
+`polyfold warm-up` runs.
+
+Why: before a warm process runs its first kernel, numba costs it about 0.4 s: importing numba
+(0.14 s), its target's registries on the first call (which import scipy.linalg, 0.09 s) and
+loading each kernel from numba's cache (3-9 ms each; a bunny's make calls 35). `build_ahead`
+compiles the kernels polyfold's Python calls, for the argument types the warm-up gave them, into
+one extension module (numba's `pycc`, machine code for the CPU family, not this CPU model); a
+process with that module calls them without importing numba at all.
+
+Each exported function is a wrapper that calls the kernel's own numba dispatcher, so the kernel is
+compiled as numba's just-in-time compiler compiles it: its options (`error_model`, `inline`), its
+typing, the same machine-independent optimisation. Called from Python, a `Kernel` takes the
+ahead-of-time function whose argument types match its arguments exactly (a numpy array's dtype,
+dimensions, C order and writeable; int64 as Python int or np.int64, float64 as float or
+np.float64, bool as bool or np.bool_; tuples of these), and numba's dispatcher otherwise, made at
+the first need, from numba's cache, as before. So do all kernels when the module is missing,
+stale (a polyfold source, numba or numpy changed since it was built: their sizes and modification
+times are its stamp), or switched off (POLYFOLD_AHEAD=off). Inside other kernels numba types a
+Kernel as its dispatcher (`_typeof_kernel`), so kernels call kernels as before.
+
+The module and its table live where numba keeps its cache: $NUMBA_CACHE_DIR when set, else the
+package's `__pycache__`. It needs a C compiler to build (pycc links with the system's); without
+one `build_ahead` says so and every kernel stays just-in-time.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+SWITCH = "POLYFOLD_AHEAD"  # "off": never call ahead-of-time code (the build itself, tests)
+TABLE = "polyfold_ahead.json"  # beside the module: {"stamp", "module", "file", "kernels": {name: [[export, specs]]}}
+
+# numba's scalar type names -> (the numpy scalar type, the Python type numba gives the same type)
+_SCALARS: dict[str, tuple[type, ...]] = {
+    "int64": (np.int64, int), "float64": (np.float64, float), "bool": (np.bool_, bool),
+    "int32": (np.int32,), "int16": (np.int16,), "int8": (np.int8,), "uint64": (np.uint64,),
+    "uint32": (np.uint32,), "uint16": (np.uint16,), "uint8": (np.uint8,), "float32": (np.float32,),
+}
+_INT64 = 2 ** 63
+_ARRAY_DTYPES = ("bool", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64",
+                 "float32", "float64")
+
+
+class Kernel:
+    """A numba kernel: `py_func` with `numba.njit`'s options (`targetoptions`). Called from Python
+    it runs the ahead-of-time function whose argument types match (see the module docstring),
+    else numba's dispatcher (`dispatcher`, made at the first need). Other attributes are the
+    dispatcher's (`signatures`, `overloads`, ...: numba is imported for them)."""
+
+    def __init__(self, py_func: Callable, options: dict[str, Any]) -> None:
+        self.py_func = py_func
+        self.targetoptions = {"nopython": True, **options}  # (as numba's: the inliner reads it)
+        self._dispatcher = None
+        self._ahead: tuple[tuple[tuple, Callable], ...] | None = None  # None: not looked up yet
+        for name in ("__module__", "__name__", "__qualname__", "__doc__"):
+            setattr(self, name, getattr(py_func, name, None))
+        self.__wrapped__ = py_func
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        ahead = self._ahead
+        if ahead is None:
+            ahead = self._ahead = _ahead_functions(self)
+        if ahead and not kwargs and not _only_jit:
+            for specs, fn in ahead:
+                if len(specs) == len(args) and all(map(_fits, specs, args)):
+                    return fn(*args)
+        if _recorded is not None:
+            _record(self, args, kwargs)
+        return self.dispatcher(*args, **kwargs)
+
+    @property
+    def dispatcher(self) -> Any:
+        """numba's dispatcher of py_func (numba imported, and its cache read, at the first need)."""
+        if self._dispatcher is None:
+            with _lock:
+                if self._dispatcher is None:
+                    import numba
+
+                    _prepare_numba()
+                    self._dispatcher = numba.njit(**{k: v for k, v in self.targetoptions.items()
+                                                     if k != "nopython"})(self.py_func)
+        return self._dispatcher
+
+    def jit_signatures(self) -> list:
+        """The argument types numba's dispatcher holds compiled in this process (none before it is
+        made: a kernel only ever called ahead of time has none)."""
+        return [] if self._dispatcher is None else list(self._dispatcher.signatures)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("_dispatcher", "_ahead", "py_func", "targetoptions"):
+            raise AttributeError(name)  # (not yet set, or a protocol numba's dispatcher has no say in)
+        return getattr(self.dispatcher, name)
+
+    def __repr__(self) -> str:
+        return f"<polyfold kernel {self.__module__}.{self.__qualname__}>"
+
+
+def njit(fn: Callable | None = None, **options: Any) -> Any:
+    """`numba.njit` for polyfold's kernels: `@njit(cache=True)` or `njit(cache=True)(fn)` gives a
+    Kernel (numba is not imported until a kernel needs its just-in-time compiler)."""
+    if fn is not None:
+        return Kernel(fn, options)
+    return lambda f: Kernel(f, options)
+
+
+_lock = threading.RLock()
+_numba_ready = False
+_only_jit = 0  # >0 inside `just_in_time`
+
+
+@contextmanager
+def just_in_time() -> Iterator[None]:
+    """Kernels called inside run just in time, whatever is built ahead: for the warm-up, which
+    fills numba's cache, and a server, which keeps both loaded."""
+    global _only_jit
+    with _lock:
+        _only_jit += 1
+    try:
+        yield
+    finally:
+        with _lock:
+            _only_jit -= 1
+
+
+def _prepare_numba() -> None:
+    """Once numba is needed: numba types a Kernel (a global of another kernel) as its dispatcher,
+    and the deadline clock starts counting numba's compiling."""
+    global _numba_ready
+    if _numba_ready:
+        return
+    from numba.extending import typeof_impl
+
+    from .deadline import watch_compiles
+
+    @typeof_impl.register(Kernel)
+    def _typeof_kernel(val: Kernel, c: Any) -> Any:
+        return typeof_impl(val.dispatcher, c)
+
+    watch_compiles()
+    _numba_ready = True
+
+
+# ------------------------------------------------------------------ calling ahead-of-time code
+
+def _fits(spec: Any, value: Any) -> bool:
+    """Whether numba would type `value` as `spec`: an array (dtype, ndim), a scalar (the frozenset
+    of classes it may be), a tuple (a list of specs)."""
+    kind = spec.__class__
+    if kind is frozenset:
+        cls = value.__class__
+        return cls in spec and (cls is not int or -_INT64 <= value < _INT64)  # (numba: uint64 beyond)
+    if kind is tuple:
+        if value.__class__ is not np.ndarray or value.ndim != spec[1] or value.dtype != spec[0]:
+            return False
+        flags = value.flags  # (numba's typeof ignores alignment: so does this)
+        return flags.c_contiguous and flags.writeable
+    return value.__class__ is tuple and len(value) == len(spec) and all(map(_fits, spec, value))
+
+
+def _spec_from_json(item: list) -> Any:
+    if item[0] == "array":
+        return (np.dtype(item[1]), int(item[2]))
+    if item[0] == "scalar":
+        return frozenset(_SCALARS[item[1]])
+    return [_spec_from_json(x) for x in item[1]]
+
+
+_table: dict[str, tuple[tuple[tuple, Callable], ...]] | None = None
+
+
+def _loaded_table() -> dict[str, tuple[tuple[tuple, Callable], ...]]:
+    global _table
+    if _table is None:
+        with _lock:
+            if _table is None:
+                _table = _load_table()
+    return _table
+
+
+def _ahead_functions(kernel: Kernel) -> tuple[tuple[tuple, Callable], ...]:
+    """The (argument specs, function) pairs built ahead of time for `kernel`; () when none."""
+    return _loaded_table().get(f"{kernel.py_func.__module__}.{kernel.py_func.__qualname__}", ())
+
+
+def ahead_dir() -> Path:
+    """Where the ahead-of-time module and its table are: numba's cache folder."""
+    cache = os.environ.get("NUMBA_CACHE_DIR")
+    return Path(cache) if cache else Path(__file__).resolve().parent / "__pycache__"
+
+
+def stamp() -> str:
+    """What the ahead-of-time code is built from, as a digest: this Python, numpy's and numba's
+    installs (their __init__'s size and modification time) and polyfold's sources (`sources`)."""
+    import importlib.util
+
+    from .sources import hash_sources
+
+    h = hashlib.sha256(f"{sys.version}\n{np.__version__}\n".encode())
+    spec = importlib.util.find_spec("numba")
+    for origin in (spec.origin if spec else None, np.__file__):
+        st = os.stat(origin) if origin else None
+        h.update(f"{origin}:{st.st_size}:{st.st_mtime_ns}\n".encode() if st else b"-\n")
+    hash_sources(h)
+    return h.hexdigest()
+
+
+def ahead_ready() -> bool:
+    """Whether this process calls kernels ahead of time (a fresh module is built and not switched off)."""
+    return bool(_loaded_table())
+
+
+def _load_table() -> dict[str, tuple[tuple[tuple, Callable], ...]]:
+    """The table of ahead-of-time functions by kernel name; {} when off, missing or stale."""
+    if os.environ.get(SWITCH, "").lower() == "off":
+        return {}
+    folder = ahead_dir()
+    try:
+        table = json.loads((folder / TABLE).read_text())
+        if table.get("stamp") != stamp():
+            return {}
+        module = _load_module(table["module"], folder / table["file"])
+        return {name: tuple((tuple(_spec_from_json(s) for s in specs), getattr(module, export))
+                            for export, specs in rows)
+                for name, rows in table["kernels"].items()}
+    except (OSError, ValueError, KeyError, ImportError, AttributeError, TypeError):
+        return {}  # (none built, or not by this code: the kernels run just in time)
+
+
+def _load_module(name: str, path: Path) -> Any:
+    import importlib.machinery
+    import importlib.util
+
+    if name in sys.modules:
+        return sys.modules[name]
+    loader = importlib.machinery.ExtensionFileLoader(name, str(path))
+    spec = importlib.util.spec_from_file_location(name, str(path), loader=loader)
+    module = importlib.util.module_from_spec(spec)
+    loader.exec_module(module)
+    sys.modules[name] = module
+    return module
+
+
+# ------------------------------------------------------------------ building ahead-of-time code
+
+_recorded: dict[Kernel, set[tuple]] | None = None
+
+
+def _record(kernel: Kernel, args: tuple, kwargs: dict) -> None:
+    import numba
+
+    if kwargs:
+        return  # (exported functions take positional arguments only)
+    try:
+        types = tuple(numba.typeof(a) for a in args)
+    except Exception:  # (numba raises its own for values it cannot type: the call says so)
+        return
+    _recorded.setdefault(kernel, set()).add(types)
+
+
+def record_calls() -> dict[Kernel, set[tuple]]:
+    """Start recording, in this process, the argument types of every kernel called from Python just
+    in time; the dict filled (give it to `build_ahead`)."""
+    global _recorded
+    _recorded = {}
+    return _recorded
+
+
+def _spec_to_json(t: Any) -> list | None:
+    """A numba type as a table spec; None for types the table does not match (they stay just in time)."""
+    from numba.core import types
+
+    if isinstance(t, types.Array):
+        if t.layout == "C" and t.mutable and t.aligned and str(t.dtype) in _ARRAY_DTYPES and t.ndim > 0:
+            return ["array", str(t.dtype), t.ndim]
+        return None
+    if isinstance(t, (types.Integer, types.Float, types.Boolean)) and str(t) in _SCALARS:
+        return ["scalar", str(t)]
+    if isinstance(t, (types.UniTuple, types.Tuple)) and not isinstance(t, types.BaseNamedTuple):
+        items = [_spec_to_json(x) for x in t.types]
+        return None if any(x is None for x in items) else ["tuple", items]
+    return None
+
+
+def build_ahead(calls: dict[Kernel, set[tuple]]) -> str:
+    """Compile the kernels of `calls` (`record_calls`), for the argument types recorded, into the
+    ahead-of-time module and write its table (both to a temporary name, then renamed; older
+    modules removed). Returns a one-line account (what was built, or why nothing was)."""
+    import shutil
+    import tempfile
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (pycc is pending deprecation: numba says so on import)
+            from numba.pycc import CC
+    except ImportError as exc:
+        return f"not built: this numba has no pycc ({exc})"
+    rows: dict[str, list] = {}
+    exports = []
+    for kernel in sorted(calls, key=lambda k: (k.py_func.__module__, k.py_func.__qualname__)):
+        name = f"{kernel.py_func.__module__}.{kernel.py_func.__qualname__}"
+        for types in sorted(calls[kernel], key=str):
+            specs = [_spec_to_json(t) for t in types]
+            if any(s is None for s in specs):
+                continue
+            export = f"k{len(exports)}"
+            exports.append((export, kernel, types))
+            rows.setdefault(name, []).append([export, specs])
+    if not exports:
+        return "not built: no kernel was called"
+    folder = ahead_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    digest = stamp()
+    module = f"polyfold_ahead_{digest[:16]}"
+    build = Path(tempfile.mkdtemp(prefix="polyfold-ahead-", dir=folder))
+    try:
+        cc = CC(module)
+        cc.output_dir = str(build)
+        for export, kernel, types in exports:
+            dispatcher = kernel.dispatcher
+            dispatcher.compile(types)
+            returns = dispatcher.overloads[types].signature.return_type
+            cc.export(export, returns(*types))(_calling(dispatcher, len(types)))
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                cc.compile()
+        except Exception as exc:  # (no C compiler, no Python headers: distutils' errors, each its own class)
+            return f"not built: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": ")
+        built = build / cc.output_file
+        for old in folder.glob("polyfold_ahead_*"):
+            if old.is_file() and old.name != cc.output_file:  # (the same name: replaced below)
+                old.unlink()
+        os.replace(built, folder / cc.output_file)
+        table = {"stamp": digest, "module": module, "file": cc.output_file, "kernels": rows}
+        tmp = folder / f".{TABLE}.{os.getpid()}"
+        tmp.write_text(json.dumps(table, indent=0))
+        os.replace(tmp, folder / TABLE)
+    finally:
+        shutil.rmtree(build, ignore_errors=True)
+    return f"{len(exports)} calls of {len(rows)} kernels compiled, {folder / cc.output_file}"
+
+
+def _calling(dispatcher: Any, n: int) -> Callable:
+    """def call(a0, .., an-1): return dispatcher(a0, .., an-1), for pycc to export: the kernel
+    itself is compiled by its own dispatcher (its options and typing), as just in time."""
+    params = ", ".join(f"a{i}" for i in range(n))
+    namespace = {"kernel": dispatcher}
+    exec(f"def call({params}):\n    return kernel({params})\n", namespace)
+    return namespace["call"]
