@@ -56,6 +56,65 @@ def _zfill(img, zbuf, tri, depth, colors):
                     img[py, px, 2] = colors[t, 2]
 
 
+@njit(cache=True)
+def _squared_distances(mask, far):
+    """Squared distance of every pixel of mask (H, W) bool to the nearest False pixel (0 there;
+    `far` where the image has none), exact in integers: per column the distance along it, then per
+    row the lower envelope of the parabolas (q - v)^2 + column distance (Felzenszwalb and
+    Huttenlocher, "Distance transforms of sampled functions", 2012)."""
+    h, w = mask.shape
+    col = np.empty((h, w))
+    for c in range(w):
+        last = -1  # the nearest False row above, then the nearer of above and below
+        for r in range(h):
+            if not mask[r, c]:
+                last = r
+            col[r, c] = far if last < 0 else float((r - last) * (r - last))
+        last = -1
+        for r in range(h - 1, -1, -1):
+            if not mask[r, c]:
+                last = r
+            elif last >= 0:
+                col[r, c] = min(col[r, c], float((last - r) * (last - r)))
+    out = np.empty((h, w))
+    v = np.empty(w, dtype=np.int64)  # the parabolas of the envelope, left to right
+    z = np.empty(w + 1)  # where each starts to be the lowest
+    for r in range(h):
+        f = col[r]
+        k = 0
+        v[0] = 0
+        z[0], z[1] = -np.inf, np.inf
+        for q in range(1, w):
+            s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]))
+            while s <= z[k]:
+                k -= 1
+                s = ((f[q] + q * q) - (f[v[k]] + v[k] * v[k])) / (2.0 * (q - v[k]))
+            k += 1
+            v[k] = q
+            z[k], z[k + 1] = s, np.inf
+        k = 0
+        for q in range(w):
+            while z[k + 1] < q:
+                k += 1
+            out[r, q] = min((q - v[k]) * (q - v[k]) + f[v[k]], far)
+    return out
+
+
+def distance_to_background(mask: np.ndarray) -> np.ndarray:
+    """(H, W) float64: each pixel's Euclidean distance (in pixels) to the nearest False pixel of
+    mask (H, W) bool, 0 on False pixels, as scipy.ndimage.distance_transform_edt gives it (a test
+    compares them), inf where the image has no False pixel. Own kernel, not scipy's: importing
+    scipy.ndimage cost 50-70 ms of every make, for the guide's label spots alone."""
+    mask = np.ascontiguousarray(mask, dtype=np.bool_)
+    if mask.size == 0:
+        return np.zeros(mask.shape)
+    far = float(mask.shape[0] ** 2 + mask.shape[1] ** 2) * 4.0 + 1.0  # beyond any distance inside
+    d2 = _squared_distances(mask, far)
+    out = np.sqrt(d2)
+    out[d2 >= far] = np.inf
+    return out
+
+
 def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> None:
     """Paint 2D pixel-space triangles (n, 3, 2) with flat colours (n, 3) into img (H, W, 3), in
     place; where triangles overlap, the first one drawn stays (a net has no overlaps to resolve)."""

@@ -13,11 +13,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-# (imported with the module, in the guide's process before its first picture: imported after
-# numba has loaded a kernel there it took 0.27 s instead of 0.07, a fifth of the bunny's guide)
-from scipy.ndimage import distance_transform_edt
 
-from ..formats.raster import _zfill, part_colors, segment_samples, view_rotation
+from ..formats.raster import _zfill, distance_to_background, part_colors, segment_samples, view_rotation
 
 BACKGROUND = (255, 255, 255)
 INSIDE_RGB = (214, 214, 214)  # the unprinted side of the paper
@@ -178,7 +175,7 @@ def label_spots(region: np.ndarray, labels: np.ndarray, min_px: int = 40) -> dic
     inner[1:-1, 1:-1] = ((region[1:-1, 1:-1] >= 0) & (region[1:-1, 1:-1] == region[:-2, 1:-1])
                          & (region[1:-1, 1:-1] == region[2:, 1:-1]) & (region[1:-1, 1:-1] == region[1:-1, :-2])
                          & (region[1:-1, 1:-1] == region[1:-1, 2:]))
-    dist = distance_transform_edt(inner)
+    dist = distance_to_background(inner)
     spots = {}
     counts = np.bincount(region[region >= 0], minlength=int(max(labels, default=-1)) + 1) if (region >= 0).any() else []
     for lab in labels:

@@ -42,9 +42,10 @@ from .report import (Assembly, AssemblyPart, AssemblyPiece, AssemblyStep, GlueRo
                      PieceReport)
 from .sheets import Sheets, pack_box
 
-# pictures from which instructions.html and guide.pdf are written side by side (a 1,280-face
-# sphere's 154: 0.24 and 0.52 s; the bunny's 60: 0.05 and 0.35 s, not worth a fork)
-PARALLEL_GUIDE_PICTURES = 100
+# pictures from which guide.pdf is written in a forked process while instructions.html is written
+# here (a 1,280-face sphere's 154: 0.24 and 0.52 s; the bunny's 69: 0.04 and 0.13 s, its make
+# 0.02-0.03 s shorter; periscope-28's 26: the fork costs what the html takes)
+PARALLEL_GUIDE_PICTURES = 40
 # every name make may write into its folder (`files.check_folder` before the run)
 OUTPUTS = ("sheets.pdf", "sheet-*.svg", "cut-*.svg", "sheet-*.dxf", "part-*.obj", "model.glb", "piece-*.fold",
            "assembly.json", "instructions.html", "guide.pdf", "report.json", "original.obj")
@@ -138,7 +139,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
     written last. inputs: the files make read (never replaced). original: the mesh a convex
     approximation (`--approximate hulls`) stands for, written as original.obj (the viewer shows
     it beside the parts); contacts: the pairs of parts glued face to face (the guide says which)."""
-    from ..processes import beside, fork_map, usable_cores
+    from ..processes import beside, usable_cores
 
     pages, printed = sheet_pages(sheets, model, opts, look)
     rows = piece_reports(folded, sheets)
@@ -166,9 +167,13 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         guide_pdf, guide_report = None, None
         if guide is None:
             html = html_file()
-        else:  # (side by side from PARALLEL_GUIDE_PICTURES pictures: the sheets' process is done by then)
-            two = usable_cores() if guide.pictures >= PARALLEL_GUIDE_PICTURES else 1
-            html, (guide_pdf, guide_pages) = fork_map(lambda k: (html_file, pdf_file)[k](), [0, 1], two)
+        elif usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
+            # side by side: guide.pdf in a forked process (the sheets' process is done by then),
+            # instructions.html here meanwhile
+            html, (guide_pdf, guide_pages) = beside(html_file, pdf_file)
+        else:
+            html, (guide_pdf, guide_pages) = html_file(), pdf_file()
+        if guide is not None:
             closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
             guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=guide.pictures,
                                        pdf_pages=guide_pages, closing_seams=closing)

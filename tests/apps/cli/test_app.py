@@ -4,6 +4,7 @@ behind. (The commands: test_mesh_commands.py, test_net_commands.py, test_make_co
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -62,6 +63,31 @@ def test_a_line_on_stderr_is_one_write(monkeypatch) -> None:
     monkeypatch.setattr(sys, "stderr", Recorder())
     say("layout: fitting pieces to the page")
     assert writes == ["polyfold: layout: fitting pieces to the page\n"]
+
+
+def test_progress_uses_rich_on_a_terminal_only(monkeypatch, tmp_path: Path) -> None:
+    """The live status line (rich) where rich would call stderr a terminal; elsewhere plain lines,
+    and rich is not even imported (it was, 11-22 ms of every make's start, to learn that)."""
+    from polyfold.apps.cli.app import terminal_console
+
+    monkeypatch.delenv("FORCE_COLOR", raising=False)
+    monkeypatch.delenv("TTY_COMPATIBLE", raising=False)
+    assert not sys.stderr.isatty() and terminal_console() is None  # (pytest's captured stderr)
+    monkeypatch.setenv("FORCE_COLOR", "1")
+    console = terminal_console()
+    assert console is not None and console.is_terminal
+    monkeypatch.setenv("TTY_COMPATIBLE", "0")  # (rich's own rule decides once rich is asked)
+    assert terminal_console() is None
+
+    probe = ("import atexit, sys, runpy; sys.argv = ['polyfold'] + sys.argv[1:]\n"
+             "atexit.register(lambda: print('rich' if 'rich' in sys.modules else 'no rich'))\n"
+             "runpy.run_module('polyfold', run_name='__main__')\n")
+    bunny = Path(__file__).resolve().parents[3] / "examples" / "bunny-128.obj"
+    env = {k: v for k, v in os.environ.items() if k not in ("FORCE_COLOR", "TTY_COMPATIBLE")}
+    proc = subprocess.run([CLI[0], "-c", probe, "make", str(bunny), "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0 and proc.stdout.strip().splitlines()[-1] == "no rich", proc.stderr[-500:]
+    assert "polyfold: layout: " in proc.stderr  # the plain progress lines
 
 
 # ----------------------------------------------------------------------------------------------

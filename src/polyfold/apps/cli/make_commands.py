@@ -271,10 +271,10 @@ def _batch_progress(quiet: bool):
     else one stderr line per finished mesh; nothing when quiet."""
     if quiet:
         return None, lambda: None
-    from rich.console import Console
+    from .app import terminal_console
 
-    console = Console(stderr=True)
-    if not console.is_terminal:
+    console = terminal_console()
+    if console is None:
         def line(row, done: int, total: int) -> None:
             detail = f": {row.error}" if row.error else f", {row.total_s:.1f} s"
             say(f"[{done}/{total}] {Path(row.mesh).name}: {row.status}{detail}")

@@ -84,10 +84,10 @@ def make_progress(say: Callable[[str], None], quiet: bool, title: str) -> Iterat
     if quiet:
         yield None
         return
-    from rich.console import Console
+    from .app import terminal_console
 
-    console = Console(stderr=True)
-    if console.is_terminal:
+    console = terminal_console()
+    if console is not None:
         with console.status(title) as status:
             yield lambda stage, msg: status.update(f"[bold]{stage}[/bold]: {msg}")
         return
