@@ -140,6 +140,15 @@ def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path):
     assert not stale["ready"] and stale["numba"] is True and stale["sums"] == got["sums"]
 
 
+def test_the_stamp_holds_the_cpu(monkeypatch):
+    """Code built for this CPU (its instruction set) is stale on another: the stamp says which."""
+    here = jit.stamp()
+    monkeypatch.setattr(jit, "_cpu", lambda: "model name : another\nflags : fpu sse2")
+    assert jit.stamp() != here
+    monkeypatch.setattr(jit, "_cpu", lambda: "")  # (no /proc/cpuinfo: built for the CPU family)
+    assert jit.stamp() != here
+
+
 def test_a_missing_or_foreign_table_means_just_in_time(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     assert jit._load_table() == {}  # none

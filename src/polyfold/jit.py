@@ -6,8 +6,8 @@ Why: before a warm process runs its first kernel, numba costs it about 0.4 s: im
 (0.14 s), its target's registries on the first call (which import scipy.linalg, 0.09 s) and
 loading each kernel from numba's cache (3-9 ms each; a bunny's make calls 35). `build_ahead`
 compiles the kernels polyfold's Python calls, for the argument types the warm-up gave them, into
-one extension module (numba's `pycc`, machine code for the CPU family, not this CPU model); a
-process with that module calls them without importing numba at all.
+one extension module (numba's `pycc`, machine code for this CPU: its model and instruction set
+are in the stamp); a process with that module calls them without importing numba at all.
 
 Each exported function is a wrapper that calls the kernel's own numba dispatcher, so the kernel is
 compiled as numba's just-in-time compiler compiles it: its options (`error_model`, `inline`), its
@@ -16,9 +16,9 @@ ahead-of-time function whose argument types match its arguments exactly (a numpy
 dimensions, C order and writeable; int64 as Python int or np.int64, float64 as float or
 np.float64, bool as bool or np.bool_; tuples of these), and numba's dispatcher otherwise, made at
 the first need, from numba's cache, as before. So do all kernels when the module is missing,
-stale (a polyfold source, numba or numpy changed since it was built: their sizes and modification
-times are its stamp), or switched off (POLYFOLD_AHEAD=off). Inside other kernels numba types a
-Kernel as its dispatcher (`_typeof_kernel`), so kernels call kernels as before.
+stale (its stamp: the sizes and modification times of polyfold's sources and of numba's and
+numpy's installs, and the CPU) or switched off (POLYFOLD_AHEAD=off). Inside other kernels numba
+types a Kernel as its dispatcher (`_typeof_kernel`), so kernels call kernels as before.
 
 The module and its table live where numba keeps its cache: $NUMBA_CACHE_DIR when set, else the
 package's `__pycache__`. It needs a C compiler to build (pycc links with the system's); without
@@ -207,13 +207,32 @@ def stamp() -> str:
 
     from .sources import hash_sources
 
-    h = hashlib.sha256(f"{sys.version}\n{np.__version__}\n".encode())
+    h = hashlib.sha256(f"{sys.version}\n{np.__version__}\n{_cpu() or 'generic'}\n".encode())
     spec = importlib.util.find_spec("numba")
     for origin in (spec.origin if spec else None, np.__file__):
         st = os.stat(origin) if origin else None
         h.update(f"{origin}:{st.st_size}:{st.st_mtime_ns}\n".encode() if st else b"-\n")
     hash_sources(h)
     return h.hexdigest()
+
+
+# the lines of /proc/cpuinfo that say which instructions a CPU has (x86, then ARM); not its clock
+_CPU_KEYS = ("vendor_id", "cpu family", "model", "model name", "stepping", "flags", "Features", "CPU implementer",
+             "CPU architecture", "CPU variant", "CPU part", "CPU revision")
+
+
+def _cpu() -> str:
+    """This machine's CPU, for code built for it alone (LLVM's "host"): the model and instruction
+    set lines of /proc/cpuinfo's first processor; "" where there is none (the code is then built
+    for the CPU family). In the stamp: a folder moved to another CPU runs just in time, never
+    code with instructions that CPU lacks."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            first = f.read().split("\n\n", 1)[0]
+    except OSError:
+        return ""
+    keep = [line for line in first.splitlines() if line.split(":", 1)[0].strip() in _CPU_KEYS]
+    return "\n".join(keep)
 
 
 def ahead_ready() -> bool:
@@ -328,6 +347,7 @@ def build_ahead(calls: dict[Kernel, set[tuple]]) -> str:
     try:
         cc = CC(module)
         cc.output_dir = str(build)
+        cc.target_cpu = "host" if _cpu() else ""  # (this CPU's instructions where the stamp can tell it)
         for export, kernel, types in exports:
             dispatcher = kernel.dispatcher
             dispatcher.compile(types)
