@@ -11,6 +11,7 @@ import colorsys
 import math
 
 import numpy as np
+
 from ..jit import njit
 
 
@@ -24,8 +25,10 @@ def part_colors(n: int, saturation: float = 0.65, value: float = 0.92) -> np.nda
 
 
 @njit(cache=True)
-def _zfill(img, zbuf, tri, depth, colors):
-    """Fill 2D pixel-space triangles with flat colours, nearest depth (smaller z) wins."""
+def _zindex(index, zbuf, tri, depth):
+    """Rasterise 2D pixel-space triangles tri (n, 3, 2) with corner depths (n, 3) (smaller is
+    nearer): where a triangle covers a pixel's centre nearer than zbuf (H, W) says, index (H, W)
+    int64 gets its number and zbuf its depth, in place (a tie keeps the triangle drawn first)."""
     H, W = zbuf.shape
     for t in range(tri.shape[0]):
         ax, ay = tri[t, 0, 0], tri[t, 0, 1]
@@ -51,9 +54,24 @@ def _zfill(img, zbuf, tri, depth, colors):
                 z = w0 * depth[t, 0] + w1 * depth[t, 1] + w2 * depth[t, 2]
                 if z < zbuf[py, px]:
                     zbuf[py, px] = z
-                    img[py, px, 0] = colors[t, 0]
-                    img[py, px, 1] = colors[t, 1]
-                    img[py, px, 2] = colors[t, 2]
+                    index[py, px] = t
+
+
+def triangle_index(shape: tuple[int, int], tris: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(index (H, W) int64, the nearest triangle at each pixel centre, -1 where none; depth (H, W),
+    inf where none) of 2D pixel-space triangles tris (n, 3, 2) with corner depths (n, 3)."""
+    index = np.full(shape, -1, dtype=np.int64)
+    zbuf = np.full(shape, np.inf)
+    if len(tris):
+        _zindex(index, zbuf, np.ascontiguousarray(tris, dtype=np.float64),
+                np.ascontiguousarray(depth, dtype=np.float64))
+    return index, zbuf
+
+
+def _paint(img: np.ndarray, index: np.ndarray, colors: np.ndarray) -> None:
+    """img[pixel] = colors[index[pixel]] where index >= 0, in place."""
+    hit = index >= 0
+    img[hit] = np.asarray(colors, dtype=np.uint8)[index[hit]]
 
 
 @njit(cache=True)
@@ -118,9 +136,9 @@ def distance_to_background(mask: np.ndarray) -> np.ndarray:
 def fill_triangles(img: np.ndarray, tris: np.ndarray, colors: np.ndarray) -> None:
     """Paint 2D pixel-space triangles (n, 3, 2) with flat colours (n, 3) into img (H, W, 3), in
     place; where triangles overlap, the first one drawn stays (a net has no overlaps to resolve)."""
-    tris = np.ascontiguousarray(tris, dtype=np.float64)
-    zbuf = np.full(img.shape[:2], np.inf)
-    _zfill(img, zbuf, tris, np.zeros(tris.shape[:2]), np.ascontiguousarray(colors, dtype=np.uint8))
+    tris = np.asarray(tris, dtype=np.float64)
+    index, _ = triangle_index(img.shape[:2], tris, np.zeros(tris.shape[:2]))
+    _paint(img, index, colors)
 
 
 def segment_samples(seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -198,6 +216,6 @@ def render_mesh(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray
     cols = np.clip(np.asarray(face_colors, dtype=np.float64) * shade[:, None], 0, 255).astype(np.uint8)
     img = np.empty((height, width, 3), dtype=np.uint8)
     img[:] = background
-    zbuf = np.full((height, width), np.inf)
-    _zfill(img, zbuf, np.ascontiguousarray(px[f]), np.ascontiguousarray(depth[f]), cols)
+    index, _ = triangle_index((height, width), px[f], depth[f])
+    _paint(img, index, cols)
     return img

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..formats.raster import _zfill, distance_to_background, part_colors, segment_samples, view_rotation
+from ..formats.raster import distance_to_background, part_colors, segment_samples, triangle_index, view_rotation
 
 BACKGROUND = (255, 255, 255)
 INSIDE_RGB = (214, 214, 214)  # the unprinted side of the paper
@@ -23,7 +23,6 @@ SEAM_RGB = (20, 20, 20)
 MOUNTAIN_RGB = (214, 40, 40)  # the sheets' mountain red and valley blue
 VALLEY_RGB = (30, 90, 220)
 LIGHT = np.array([-0.35, 0.55, 0.76]) / np.linalg.norm([-0.35, 0.55, 0.76])
-NO_FACE = 0xFFFFFF  # the background's id (white)
 
 # the six sides (elevation, azimuth in degrees about the up axis) and, for choosing a step's view,
 # the eight corners between them
@@ -82,20 +81,11 @@ def fit_camera(points: np.ndarray, rotation: np.ndarray, width: int, height: int
 
 def face_ids(cam: Camera, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(ids (H, W) int64, -1 on the background; depth (H, W)) of triangles (F, 3, 3), nearest
-    face wins: one pass of the rasteriser with each face's id as its colour (written into the
-    low three bytes of a 4-byte pixel, read back as one little-endian integer)."""
-    n = len(tris)
-    k = np.arange(n, dtype=np.int64)
-    ids_rgb = np.stack([k & 255, (k >> 8) & 255, (k >> 16) & 255], axis=1).astype(np.uint8)
-    img = np.zeros((cam.height, cam.width, 4), dtype=np.uint8)
-    img[..., :3] = 255
-    zbuf = np.full((cam.height, cam.width), np.inf)
-    if n:
-        px, depth = cam.project(tris)
-        _zfill(img, zbuf, np.ascontiguousarray(px), np.ascontiguousarray(depth), ids_rgb)
-    ids = img.view("<u4")[..., 0].astype(np.int64)
-    ids[ids == NO_FACE] = -1
-    return ids, zbuf
+    face wins: one pass of the rasteriser (`raster.triangle_index`)."""
+    if not len(tris):
+        return triangle_index((cam.height, cam.width), np.zeros((0, 3, 2)), np.zeros((0, 3)))
+    px, depth = cam.project(tris)
+    return triangle_index((cam.height, cam.width), px, depth)
 
 
 def shaded(cam: Camera, tris: np.ndarray, front: np.ndarray, back: np.ndarray | None = None) -> np.ndarray:
