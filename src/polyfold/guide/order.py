@@ -116,16 +116,14 @@ def _counts(pairs) -> dict[tuple[int, int], int]:
 def face_distances(mesh: Mesh, source: int) -> np.ndarray:
     """(F,) distance from face `source` to every face, along the surface: shortest paths
     between face centroids across shared edges (inf for faces in other components)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import dijkstra
+    from ..graphs import shortest_distances
 
     topo = mesh.topology
     inner = topo.interior
     f0, f1 = topo.edge_faces[inner, 0], topo.edge_faces[inner, 1]
     cent = mesh.vertices[mesh.faces].mean(axis=1)
     w = np.linalg.norm(cent[f0] - cent[f1], axis=1) + 1e-300
-    graph = coo_matrix((w, (f0, f1)), shape=(mesh.n_faces, mesh.n_faces)).tocsr()
-    return dijkstra(graph, directed=False, indices=source)
+    return shortest_distances(mesh.n_faces, f0, f1, w, source)
 
 
 def _lid(mesh: Mesh, faces: np.ndarray, seam_faces: np.ndarray) -> int:
@@ -222,8 +220,7 @@ def opening_rims(mesh: Mesh, piece_faces: list[np.ndarray], seams: list[Seam], s
     the open edges (a side of a placed face whose other side is not placed, or a seam not glued
     yet, counted on both copies) chained into holes. A finger or a pencil reaches the inside
     through any hole, so the largest one counts; 0 once the model is closed."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    from ..graphs import connected_components
 
     topo = mesh.topology
     edges, ef = topo.edges, topo.edge_faces
@@ -248,7 +245,6 @@ def opening_rims(mesh: Mesh, piece_faces: list[np.ndarray], seams: list[Seam], s
             if len(open_e) == 0:
                 continue
             a, b = edges[open_e, 0], edges[open_e, 1]
-            g = coo_matrix((np.ones(len(open_e)), (a, b)), shape=(mesh.n_vertices, mesh.n_vertices))
-            _, label = connected_components(g, directed=False)
+            _, label = connected_components(mesh.n_vertices, a, b)
             rim[k] = float(np.bincount(label[a], weights=length[open_e] * mult[open_e]).max())
     return rim

@@ -161,14 +161,10 @@ def edge_topology(faces: np.ndarray) -> Topology:
 def face_components(n_faces: int, topo: Topology, join: np.ndarray | None = None) -> np.ndarray:
     """Label (m,) of the edge-connected component of every face (faces joined across every
     interior edge, or only across those in the mask `join` (E,))."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    from ..graphs import connected_components
 
     inner = topo.interior if join is None else topo.interior & join
-    f0, f1 = topo.edge_faces[inner, 0], topo.edge_faces[inner, 1]
-    graph = coo_matrix((np.ones(len(f0)), (f0, f1)), shape=(n_faces, n_faces))
-    _, labels = connected_components(graph, directed=False)
-    return labels
+    return connected_components(n_faces, topo.edge_faces[inner, 0], topo.edge_faces[inner, 1])[1]
 
 
 def boundary_loops(topo: Topology) -> list[np.ndarray]:

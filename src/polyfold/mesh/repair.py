@@ -16,10 +16,9 @@ import os
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order, connected_components
 
 from ..errors import MeshError
+from ..graphs import breadth_first_predecessors, connected_components, summed_weights
 from .appearance import Appearance
 from .geometry import concavity, face_areas, signed_volumes
 from .mesh import boundary_loops, edge_topology, face_components, Mesh, Topology
@@ -154,8 +153,7 @@ def _split_fans(faces: np.ndarray, topo: Topology) -> tuple[np.ndarray, np.ndarr
     u = np.concatenate([h0, t0])
     v = np.concatenate([np.where(same, h1, t1), np.where(same, t1, h1)])
     n = len(flat)
-    graph = coo_matrix((np.ones(len(u)), (u, v)), shape=(n, n))
-    n_fans, fan = connected_components(graph, directed=False)
+    n_fans, fan = connected_components(n, u, v)
     if n_fans == len(np.unique(flat)):
         return faces, np.arange(faces.max() + 1)
     # Number the fans by (old vertex, first corner) so the order follows the old numbering.
@@ -172,8 +170,7 @@ def _vertex_components(faces: np.ndarray) -> int:
     """Number of groups of faces connected through shared vertices."""
     m, n = len(faces), int(faces.max()) + 1
     rows = np.repeat(np.arange(m), 3)
-    graph = coo_matrix((np.ones(3 * m), (rows, m + faces.reshape(-1))), shape=(m + n, m + n))
-    _, labels = connected_components(graph, directed=False)
+    _, labels = connected_components(m + n, rows, m + faces.reshape(-1))
     return len(np.unique(labels[:m]))
 
 
@@ -195,11 +192,8 @@ def _orientation_parity(faces: np.ndarray, topo: Topology) -> tuple[np.ndarray, 
     u = np.concatenate([f0, np.full(len(roots), m)])
     v = np.concatenate([f1, roots])
     w = np.concatenate([same, np.zeros(len(roots), dtype=np.int64)]) + 1  # +1: keep zeros stored
-    graph = coo_matrix((w, (u, v)), shape=(m + 1, m + 1)).tocsr()
-    graph = (graph + graph.T).tocsr()
-    _, pred = breadth_first_order(graph, m, directed=False, return_predecessors=True)
-    pred = pred[:m]
-    weight = np.asarray(graph[pred, np.arange(m)]).reshape(-1) - 1
+    pred = breadth_first_predecessors(m + 1, u, v, m)[:m]
+    weight = summed_weights(m + 1, u, v, w, pred, np.arange(m)).astype(np.int64) - 1  # (both ways, repeats summed)
     # parity = XOR of edge weights on the tree path to the root, by pointer jumping.
     parity, up = weight.copy(), pred.copy()
     while (up != m).any():
