@@ -157,7 +157,7 @@ before = kernel_signatures()
 with tempfile.TemporaryDirectory() as out:
     make(Path(sys.argv[1]), out, MakeOptions())
 after = kernel_signatures()
-late = ("fold.", "verify.", "guide.", "formats.")  # what make calls from its fold stage on
+late = ("fold.", "verify.", "guide.", "formats.", "graphs.")  # what make calls from its fold stage on
 new = {k: sorted(v - before.get(k, set())) for k, v in after.items()
        if k.startswith(late) and v - before.get(k, set())}
 print(json.dumps(new))

@@ -1,9 +1,11 @@
 """`polyfold server`: a resident process that runs the command line's compute verbs at once.
 
-Every fresh `polyfold` process imports numpy, numba, scipy, shapely and trimesh and loads a
-hundred and more compiled kernels from numba's cache before it does any work: 1.7 of the 2.6 s
-of a warm `make` of the bunny on a 2-core machine. A server pays that once: it imports
-everything and runs the warm-up's sections (every kernel loaded), then waits on a Unix socket.
+Every fresh `polyfold` process imports what its command needs (numpy, shapely, reportlab...;
+numba too where no kernel was compiled ahead of time, `jit`) and loads its kernels before it
+does any work, and its first calls build what later ones reuse: about half of a warm `make` of
+the bunny on a 2-core machine. A server pays that once: it imports everything and runs the
+warm-up's sections (every kernel loaded, ahead of time and just in time), then waits on a Unix
+socket.
 `polyfold info | inflate | segment | unfold | fold | cspace | make` (SERVED) looks for it first
 (`forward`): it hands over its arguments, working directory, environment, umask, CPU affinity and
 its stdin, stdout and stderr themselves (file descriptors, SCM_RIGHTS), and the server forks a

@@ -202,15 +202,19 @@ def _warm_fold_check(mesh) -> None:
 
 
 def _warm_guide(mesh) -> None:
-    """make's assembly guide: a folded pose (`fold_positions`) and a face-id picture (`face_ids`)
-    of `star_net`'s crease tree (whose kernels the fold stage compiled before)."""
+    """make's assembly guide: a folded pose (`fold_positions`), a face-id picture (`face_ids`) of
+    `star_net`'s crease tree (whose kernels the fold stage compiled before) and its label spots
+    (`label_spots`), and the distances along the surface that order the build steps."""
     from ..fold.tree import FoldTree, fold_positions
-    from ..guide.pictures import face_ids, fit_camera
+    from ..graphs import shortest_distances
+    from ..guide.pictures import face_ids, fit_camera, label_spots
 
     pattern, _, opts = _star_tree()
     tree = FoldTree.from_pattern(pattern, opts.contact_tol)
     tris = fold_positions(tree, np.zeros(tree.n_edges))
-    face_ids(fit_camera(tris, np.eye(3), 8, 8), tris)
+    ids, _ = face_ids(fit_camera(tris, np.eye(3), 8, 8), tris)
+    label_spots(ids, [0], min_px=1)
+    shortest_distances(3, np.array([0, 1]), np.array([1, 2]), np.ones(2), 0)
 
 
 def _warm_segment(mesh) -> None:
