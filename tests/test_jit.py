@@ -149,6 +149,16 @@ def test_the_stamp_holds_the_cpu(monkeypatch):
     assert jit.stamp() != here
 
 
+def test_without_a_c_compiler_nothing_is_built_and_nothing_breaks(tmp_path):
+    """pycc links with the system's C compiler: where there is none (CC and LDSHARED pointing at a
+    program that fails), build_ahead says so in one line and leaves no table (kernels stay just in
+    time)."""
+    said = _python(_BUILD, tmp_path, POLYFOLD_AHEAD="off", CC="/bin/false", LDSHARED="/bin/false")
+    assert said.startswith("not built: ") and "\n" not in said, said
+    assert not (tmp_path / jit.TABLE).exists() and not list(tmp_path.glob("polyfold_ahead_*"))
+    assert not list(tmp_path.glob("polyfold-ahead-*"))  # (its build folder removed)
+
+
 def test_a_missing_or_foreign_table_means_just_in_time(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     assert jit._load_table() == {}  # none

@@ -345,20 +345,22 @@ def build_ahead(calls: dict[Kernel, set[tuple]]) -> str:
     module = f"polyfold_ahead_{digest[:16]}"
     build = Path(tempfile.mkdtemp(prefix="polyfold-ahead-", dir=folder))
     try:
-        cc = CC(module)
-        cc.output_dir = str(build)
-        cc.target_cpu = "host" if _cpu() else ""  # (this CPU's instructions where the stamp can tell it)
-        for export, kernel, types in exports:
-            dispatcher = kernel.dispatcher
-            dispatcher.compile(types)
-            returns = dispatcher.overloads[types].signature.return_type
-            cc.export(export, returns(*types))(_calling(dispatcher, len(types)))
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                cc.compile()
-        except Exception as exc:  # (no C compiler, no Python headers: distutils' errors, each its own class)
-            return f"not built: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": ")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cc = CC(module)  # (its toolchain: no C compiler raises here already)
+            cc.output_dir = str(build)
+            cc.target_cpu = "host" if _cpu() else ""  # (this CPU's instructions where the stamp can tell it)
+            for export, kernel, types in exports:
+                dispatcher = kernel.dispatcher
+                dispatcher.compile(types)
+                returns = dispatcher.overloads[types].signature.return_type
+                cc.export(export, returns(*types))(_calling(dispatcher, len(types)))
+            cc.compile()
+    except Exception as exc:  # (no C compiler or Python headers: numba's and distutils' errors, each its own class)
+        shutil.rmtree(build, ignore_errors=True)
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        return f"not built: {type(exc).__name__}" + (f": {first}" if first else "")
+    try:
         built = build / cc.output_file
         for old in folder.glob("polyfold_ahead_*"):
             if old.is_file() and old.name != cc.output_file:  # (the same name: replaced below)
