@@ -10,7 +10,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[test,viewer,batch,bench]'
-	@echo "compiling polyfold's numba kernels into their cache and its modules to bytecode (about a minute, once), so the first run does not wait"
+	@echo "compiling polyfold's numba kernels into their cache, make's kernels ahead of time (with the C compiler) and its modules to bytecode (about a minute, once), so no run waits for them"
 	$(BIN)/polyfold warm-up
 	touch $(STAMP)
 
