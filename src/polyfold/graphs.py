@@ -96,35 +96,55 @@ def summed_weights(n: int, u: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.nd
 
 
 @njit(cache=True)
+def heap_push(keys, nodes, size, key, node):
+    """Push (key, node) onto the binary min-heap keys[:size], nodes[:size] (room for it is the
+    caller's); the new size."""
+    i = size
+    keys[i], nodes[i] = key, node
+    while i > 0:
+        parent = (i - 1) >> 1
+        if keys[parent] <= keys[i]:
+            break
+        keys[parent], keys[i] = keys[i], keys[parent]
+        nodes[parent], nodes[i] = nodes[i], nodes[parent]
+        i = parent
+    return size + 1
+
+
+@njit(cache=True)
+def heap_pop(keys, nodes, size):
+    """Pop the least (key, node) of the binary min-heap keys[:size], nodes[:size] (size > 0):
+    (key, node, the new size)."""
+    key, node = keys[0], nodes[0]
+    size -= 1
+    keys[0], nodes[0] = keys[size], nodes[size]
+    i = 0
+    while True:
+        c = 2 * i + 1
+        if c >= size:
+            break
+        if c + 1 < size and keys[c + 1] < keys[c]:
+            c += 1
+        if keys[i] <= keys[c]:
+            break
+        keys[i], keys[c] = keys[c], keys[i]
+        nodes[i], nodes[c] = nodes[c], nodes[i]
+        i = c
+    return key, node, size
+
+
+@njit(cache=True)
 def _dijkstra(indptr, neighbours, weights, source, n):
     """Shortest distances from source (weights >= 0 per adjacency entry); a binary heap of
-    (distance, node) with stale entries skipped."""
+    (distance, node), stale entries skipped."""
     dist = np.full(n, np.inf)
     done = np.zeros(n, dtype=np.bool_)
-    heap_d = np.empty(len(neighbours) + 1)
-    heap_n = np.empty(len(neighbours) + 1, dtype=np.int64)
-    size = 1
-    heap_d[0], heap_n[0] = 0.0, source
+    keys = np.empty(len(neighbours) + 1)
+    nodes = np.empty(len(neighbours) + 1, dtype=np.int64)
     dist[source] = 0.0
+    size = heap_push(keys, nodes, 0, 0.0, source)
     while size > 0:
-        d, node = heap_d[0], heap_n[0]
-        size -= 1
-        # the last entry sifts down from the top
-        ld, ln = heap_d[size], heap_n[size]
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= size:
-                break
-            if c + 1 < size and heap_d[c + 1] < heap_d[c]:
-                c += 1
-            if heap_d[c] < ld:
-                heap_d[i], heap_n[i] = heap_d[c], heap_n[c]
-                i = c
-            else:
-                break
-        if size > 0:
-            heap_d[i], heap_n[i] = ld, ln
+        d, node, size = heap_pop(keys, nodes, size)
         if done[node]:
             continue
         done[node] = True
@@ -133,17 +153,7 @@ def _dijkstra(indptr, neighbours, weights, source, n):
             nd = d + weights[k]
             if nd < dist[other]:
                 dist[other] = nd
-                # sift up
-                i = size
-                size += 1
-                while i > 0:
-                    p = (i - 1) // 2
-                    if heap_d[p] > nd:
-                        heap_d[i], heap_n[i] = heap_d[p], heap_n[p]
-                        i = p
-                    else:
-                        break
-                heap_d[i], heap_n[i] = nd, other
+                size = heap_push(keys, nodes, size, nd, other)
     return dist
 
 

@@ -9,9 +9,10 @@ half the resolution.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
 from ..deadline import Deadline
+from ..graphs import heap_pop, heap_push
+from ..jit import njit
 from .checker import ValidityChecker, first_blocked_segment, shortcut
 from .tree import FoldTree, crease_depth_size
 
@@ -32,29 +33,10 @@ def _astar(indptr, nbr, eid, weight, blocked, h, start, goal):
     cap = nbr.shape[0] + 1
     hk = np.empty(cap)
     hn = np.empty(cap, dtype=np.int64)
-    size = 0
     g[start] = 0.0
-    hk[0] = h[start]
-    hn[0] = start
-    size = 1
+    size = heap_push(hk, hn, 0, h[start], start)
     while size > 0:
-        # pop min
-        u = hn[0]
-        size -= 1
-        hk[0] = hk[size]
-        hn[0] = hn[size]
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= size:
-                break
-            if c + 1 < size and hk[c + 1] < hk[c]:
-                c += 1
-            if hk[i] <= hk[c]:
-                break
-            hk[i], hk[c] = hk[c], hk[i]
-            hn[i], hn[c] = hn[c], hn[i]
-            i = c
+        _, u, size = heap_pop(hk, hn, size)
         if closed[u]:
             continue
         if u == goal:
@@ -80,17 +62,7 @@ def _astar(indptr, nbr, eid, weight, blocked, h, start, goal):
                 prev[v] = u
                 if size >= cap:
                     continue
-                i = size
-                hk[i] = ng + h[v]
-                hn[i] = v
-                size += 1
-                while i > 0:
-                    par = (i - 1) >> 1
-                    if hk[par] <= hk[i]:
-                        break
-                    hk[par], hk[i] = hk[i], hk[par]
-                    hn[par], hn[i] = hn[i], hn[par]
-                    i = par
+                size = heap_push(hk, hn, size, ng + h[v], v)
     return np.empty(0, dtype=np.int64)
 
 
