@@ -5,6 +5,7 @@ half a second. A stable sort has one answer, so this gives numpy's (NaN last).""
 from __future__ import annotations
 
 import numpy as np
+
 from .jit import njit
 
 

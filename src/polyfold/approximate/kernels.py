@@ -5,6 +5,7 @@ normal, each over all triangles of two hulls)."""
 from __future__ import annotations
 
 import numpy as np
+
 from ..jit import njit
 
 

@@ -9,6 +9,7 @@ Touching along an edge or at a vertex gives depth ~0 on some axis and is therefo
 from __future__ import annotations
 
 import numpy as np
+
 from ..jit import njit
 
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from ..mesh.mesh import Mesh
 from .sweep import NO_LIMIT, sweep_pairs
 from .tolerance import CONTACT_TOL

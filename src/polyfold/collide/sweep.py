@@ -20,8 +20,8 @@ fixed) and degenerate faces (which `triangles_collide` finds never collide).
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from ..sorting import stable_argsort
 from .triangles import (GEO_LO, face_geometry, faces_cross, load_face, store_face, thick_collides, tri_corners,
                         triangles_collide)

@@ -35,6 +35,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
+
 from ..jit import njit
 
 _AXIS_EPS2 = 1e-24  # a candidate axis is skipped when |axis| < 1e-12 * (product of the lengths crossed)

@@ -36,8 +36,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT
 from .tabs import TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room

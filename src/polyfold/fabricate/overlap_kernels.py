@@ -12,6 +12,7 @@ is the area of the subject within the window, for any simple subject ring.
 from __future__ import annotations
 
 import numpy as np
+
 from ..jit import njit
 
 

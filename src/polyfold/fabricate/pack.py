@@ -35,11 +35,11 @@ from functools import lru_cache
 
 import numpy as np
 import shapely
-from ..jit import njit
 from shapely import MultiPolygon, Polygon
 
 from ..deadline import clock
 from ..errors import PolyfoldError
+from ..jit import njit
 from ..shelves import shelf_offsets
 
 _CELLS = 600  # grid cells along the long printable side: ~0.46 mm on A4

@@ -20,12 +20,12 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from ..jit import njit
 
 from ..collide.sweep import fill_face_geometry, gather_boxes, largest_group, sort_by_lo_x, sweep_collides
 from ..collide.tolerance import EXEMPT_REACH
 from ..collide.triangles import GEO_SIZE
 from ..deadline import Deadline
+from ..jit import njit
 from .kinematics import fold_faces
 
 if TYPE_CHECKING:

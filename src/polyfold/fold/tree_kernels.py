@@ -9,8 +9,8 @@ than the work on a small net); after an error code they are not meaningful.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from ..mesh.kernels import fold_deg_to_rho
 from ..sorting import stable_argsort
 

@@ -17,8 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .appearance import Appearance
 from .closest import closest_points
 from .geometry import face_areas

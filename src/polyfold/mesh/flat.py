@@ -22,8 +22,8 @@ CCW as the region's faces were.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .geometry import FLAT_REGION_RAD
 from .mesh import Mesh
 

@@ -11,8 +11,8 @@ sqrt); dot products (einsum) and atan2 stay in numpy, whose SIMD loops round dif
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from . import geometry
 
 # geometry's conversions, compiled for kernels (one formula: the sign flips in geometry.py only)

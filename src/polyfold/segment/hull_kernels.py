@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from ..jit import njit
 
 NOISE = 1e-12  # depths below NOISE * bbox diagonal are rounding noise of the hull planes: convex

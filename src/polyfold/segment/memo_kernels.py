@@ -9,8 +9,8 @@ see merge_kernels' docstring.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .hull_kernels import HULL_FLAT_EPS, NOISE, convex_hull, copy_row, denoise, depth_chain, max_depth
 
 

@@ -24,8 +24,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .memo_kernels import bucket, memo_grown, memo_lookup, pow2, union_eval
 
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from .hull_kernels import HULL_FLAT_EPS, convex_hull, copy_row, denoise, max_depth
 
 

@@ -7,9 +7,9 @@ evaluated in one call.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
 from ..collide.flat import all_overlapping_pairs, face_bounds, overlapping_pairs, overlapping_pairs_between
+from ..jit import njit
 
 
 # Prim's heap: parallel arrays (weight, push counter, face, parent, edge) ordered by (weight,

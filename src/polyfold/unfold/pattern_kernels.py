@@ -7,8 +7,8 @@ rounds as np.degrees), so the pattern is bitwise the one numpy's formulas gave.
 from __future__ import annotations
 
 import numpy as np
-from ..jit import njit
 
+from ..jit import njit
 from ..mesh.kernels import rho_to_fold_deg
 
 

@@ -10,6 +10,7 @@ products and atan2 are left to numpy (see `mesh.kernels`).
 from __future__ import annotations
 
 import numpy as np
+
 from ..jit import njit
 
 

@@ -19,10 +19,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from ..jit import njit
 
 from ..collide.flat import face_bounds, overlapping_pairs, overlapping_pairs_between
 from ..deadline import Deadline
+from ..jit import njit
 from ..mesh.geometry import corner_angles, merged_edges
 from . import kernels as K
 from .net import Net, _dfs_intervals
