@@ -73,6 +73,10 @@ def test_kernels_run_just_in_time_without_ahead_code_and_call_kernels():
     lazy = njit(lambda x: x + 1)  # numba's other spelling: the function given directly
     assert isinstance(lazy, Kernel) and lazy(1) == 2
 
+    import pickle
+
+    assert pickle.loads(pickle.dumps(row_sums_of_squares)) is row_sums_of_squares  # (by name)
+
 
 _BUILD = r"""
 import json, sys

@@ -106,6 +106,16 @@ class Kernel:
     def __repr__(self) -> str:
         return f"<polyfold kernel {self.__module__}.{self.__qualname__}>"
 
+    def __reduce__(self) -> tuple:
+        # by name, as a function pickles (its dispatcher and ahead-of-time functions stay here)
+        return _kernel_named, (self.py_func.__module__, self.py_func.__qualname__)
+
+
+def _kernel_named(module: str, qualname: str) -> Kernel:
+    import importlib
+
+    return getattr(importlib.import_module(module), qualname)
+
 
 def njit(fn: Callable | None = None, **options: Any) -> Any:
     """`numba.njit` for polyfold's kernels: `@njit(cache=True)` or `njit(cache=True)(fn)` gives a
