@@ -29,11 +29,11 @@ def _values() -> list:
     return [a, a.T, a[:, ::2], readonly, unaligned.reshape(2, 3), np.zeros((2, 3), np.float32), np.zeros(6),
             np.zeros((1, 4)), np.zeros((0, 3)), np.zeros(3, dtype=np.int64), np.zeros(3, dtype=bool), 3, -(2 ** 63),
             2 ** 63, np.int64(3), np.int32(3), True, np.bool_(False), 1.5, np.float64(1.5), np.float32(1.5),
-            (np.zeros(3), 2.0), (np.zeros(3), 2), [np.zeros(3), 2.0], (np.zeros(3),), (1, 2), (1, 2.0)]
+            (np.zeros(3), 2.0), (np.zeros(3), 2), [np.zeros(3), 2.0], (np.zeros(3),), (1, 2), (1, 2.0), None]
 
 
 TYPES = [types.Array(types.float64, 2, "C"), types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"),
-         types.Array(types.bool_, 1, "C"), types.int64, types.int32, types.float64, types.boolean,
+         types.Array(types.bool_, 1, "C"), types.int64, types.int32, types.float64, types.boolean, types.none,
          types.Tuple((types.Array(types.float64, 1, "C"), types.float64)), types.UniTuple(types.int64, 2)]
 
 

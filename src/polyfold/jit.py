@@ -14,7 +14,7 @@ compiled as numba's just-in-time compiler compiles it: its options (`error_model
 typing, the same machine-independent optimisation. Called from Python, a `Kernel` takes the
 ahead-of-time function whose argument types match its arguments exactly (a numpy array's dtype,
 dimensions, C order and writeable; int64 as Python int or np.int64, float64 as float or
-np.float64, bool as bool or np.bool_; tuples of these), and numba's dispatcher otherwise, made at
+np.float64, bool as bool or np.bool_, None; tuples of these), and numba's dispatcher otherwise, made at
 the first need, from numba's cache, as before. So do all kernels when the module is missing,
 stale (its stamp: the sizes and modification times of polyfold's sources and of numba's and
 numpy's installs, and the CPU) or switched off (POLYFOLD_AHEAD=off). Inside other kernels numba
@@ -47,6 +47,7 @@ _SCALARS: dict[str, tuple[type, ...]] = {
     "int64": (np.int64, int), "float64": (np.float64, float), "bool": (np.bool_, bool),
     "int32": (np.int32,), "int16": (np.int16,), "int8": (np.int8,), "uint64": (np.uint64,),
     "uint32": (np.uint32,), "uint16": (np.uint16,), "uint8": (np.uint8,), "float32": (np.float32,),
+    "none": (type(None),),  # (an optional argument left out)
 }
 _INT64 = 2 ** 63
 _ARRAY_DTYPES = ("bool", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64",
@@ -314,7 +315,7 @@ def _spec_to_json(t: Any) -> list | None:
         if t.layout == "C" and t.mutable and t.aligned and str(t.dtype) in _ARRAY_DTYPES and t.ndim > 0:
             return ["array", str(t.dtype), t.ndim]
         return None
-    if isinstance(t, (types.Integer, types.Float, types.Boolean)) and str(t) in _SCALARS:
+    if isinstance(t, (types.Integer, types.Float, types.Boolean, types.NoneType)) and str(t) in _SCALARS:
         return ["scalar", str(t)]
     if isinstance(t, (types.UniTuple, types.Tuple)) and not isinstance(t, types.BaseNamedTuple):
         items = [_spec_to_json(x) for x in t.types]

@@ -74,12 +74,19 @@ def bumpy_sphere(subdivisions: int = 1, sigma: float = 0.12, seed: int = 7) -> t
 
 
 def _warm_make(mesh) -> None:
+    import trimesh
+
+    from ..mesh.mesh import Mesh
     from ..pipeline.make import make
     from ..pipeline.options import MakeOptions
+    from ..unfold.problem import UnfoldProblem
 
     with tempfile.TemporaryDirectory() as tmp:
         make(mesh, tmp, MakeOptions(), name="warm-up")
     _warm_crowded_labels()
+    # a mesh with flat edges (the sphere has none): the unfolder's set-up counts cut candidates anew
+    box = trimesh.creation.box()
+    UnfoldProblem.from_mesh(Mesh(np.asarray(box.vertices, dtype=float), np.asarray(box.faces, dtype=np.int64)))
 
 
 def _warm_crowded_labels() -> None:
@@ -218,9 +225,10 @@ def _warm_guide(mesh) -> None:
 
 
 def _warm_segment(mesh) -> None:
-    from ..segment.segment import segment
+    from ..segment.segment import part_concavity, segment
 
     segment(mesh, parts=3)
+    part_concavity(mesh, np.arange(mesh.n_faces))  # (a part's concavity from Python: make --parts reports it)
 
 
 def _warm_inflate(mesh) -> None:
@@ -229,8 +237,9 @@ def _warm_inflate(mesh) -> None:
 
     for mode in ("uniform", "constrained"):
         inflate(mesh, mode=mode, max_steps=5)
-    # the self-intersection guard with pairs to skip (a mesh that crosses itself at the start)
+    # the self-intersection guard with pairs to skip (a mesh that crosses itself at the start), and none
     crossing_pairs(mesh.vertices, mesh.faces, 1e-9, 1, np.array([1], dtype=np.int64))
+    crossing_pairs(mesh.vertices, mesh.faces, 1e-9, 1)
 
 
 # name: (what it compiles, how); in this order in one process
@@ -392,7 +401,7 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
     return seconds
 
 
-AHEAD = ("make", "fold")  # the sections whose kernel calls are compiled ahead of time
+AHEAD = WARM_UP  # the sections whose kernel calls are compiled ahead of time (all of them)
 
 
 def compile_ahead(progress: Callable[[str], None] | None = None) -> str:
@@ -407,8 +416,8 @@ def compile_ahead(progress: Callable[[str], None] | None = None) -> str:
     from ..jit import SWITCH
 
     if progress:
-        progress(f"warm-up: compiling the kernel calls of {' and '.join(SECTIONS[n][0] for n in AHEAD)} ahead of "
-                 "time (a warm command then starts without numba)")
+        progress("warm-up: the sections again, their kernel calls recorded and compiled ahead of time (a warm "
+                 "command then starts without numba)")
     proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "--ahead", *AHEAD],
                           capture_output=True, text=True, env={**os.environ, SWITCH: "off"})
     lines = proc.stdout.strip().splitlines()
