@@ -95,7 +95,7 @@ def summed_weights(n: int, u: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.nd
     return np.where(uniq[at] == want, total[at], 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def heap_push(keys, nodes, size, key, node):
     """Push (key, node) onto the binary min-heap keys[:size], nodes[:size] (room for it is the
     caller's); the new size."""
@@ -111,7 +111,7 @@ def heap_push(keys, nodes, size, key, node):
     return size + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def heap_pop(keys, nodes, size):
     """Pop the least (key, node) of the binary min-heap keys[:size], nodes[:size] (size > 0):
     (key, node, the new size)."""
