@@ -41,6 +41,7 @@ def test_warm_up_in_two_processes_runs_every_section():
     assert set(json.loads(proc.stdout.splitlines()[-1])) == {"segment", "inflate"}
 
 
+@pytest.mark.serial  # (it removes the package's bytecode: a warm-up in another worker would write it back)
 def test_warm_up_writes_the_bytecode_of_every_module_even_where_python_would_not():
     """An editable install under PYTHONDONTWRITEBYTECODE (as on this machine) never gets
     `__pycache__/*.pyc` for polyfold's modules; after compile_bytecode a fresh process under that
