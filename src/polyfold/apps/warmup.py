@@ -271,8 +271,7 @@ class Beside:
     stage's planners (`fold-plan`) and the guide's kernels (`guide`) at once; when its own fold
     stage begins (`ready`) it compiles the path check (`fold-check`) itself if the second process
     is still compiling, then waits for it, and loads the rest from the cache instead of compiling
-    it. The
-    fold stage's kernels are the largest share of a first run's compiling (about half of the
+    it. The fold stage's kernels are the largest share of a first run's compiling (about half of the
     bunny's 33 s here) and share little with the stages before it, which this process compiles
     meanwhile: the two processes end within half a second of each other. If the second process
     fails, this one compiles what it needs as usual. Use as a context manager (the process is
@@ -366,7 +365,7 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 def warm_up(progress: Callable[[str], None] | None = None, processes: int | None = None,
             ahead: bool = True) -> dict[str, float]:
     """Call every compiled kernel a command can reach once, just in time (into numba's cache);
-    then, with `ahead`, compile the calls of make's kernels ahead of time (`compile_ahead`);
+    then, with `ahead`, compile the kernel calls of those sections ahead of time (`compile_ahead`);
     seconds per section ("ahead": that step). processes: 1 runs every section here; 2 (the default
     with two or more cores) runs SECOND_PROCESS in a second Python process at the same time (numba
     compiles in one thread; its cache is written file by file, a temporary file renamed, so two
@@ -405,11 +404,8 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
     return seconds
 
 
-AHEAD = WARM_UP  # the sections whose kernel calls are compiled ahead of time (all of them)
-
-
 def compile_ahead(progress: Callable[[str], None] | None = None) -> str:
-    """Compile the kernels the AHEAD sections call from Python ahead of time (`jit.build_ahead`), in
+    """Compile the kernels the WARM_UP sections call from Python ahead of time (`jit.build_ahead`), in
     a Python process of its own: it runs them just in time (from numba's cache, which the
     sections before filled), on one core so that no forked worker makes a call unrecorded. Returns
     its one-line account."""
@@ -422,7 +418,7 @@ def compile_ahead(progress: Callable[[str], None] | None = None) -> str:
     if progress:
         progress("warm-up: the sections again, their kernel calls recorded and compiled ahead of time (a warm "
                  "command then starts without numba)")
-    proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "--ahead", *AHEAD],
+    proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "--ahead", *WARM_UP],
                           capture_output=True, text=True, env={**os.environ, SWITCH: "off"})
     lines = proc.stdout.strip().splitlines()
     if proc.returncode != 0 or not lines:

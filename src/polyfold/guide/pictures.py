@@ -82,9 +82,7 @@ def fit_camera(points: np.ndarray, rotation: np.ndarray, width: int, height: int
 def face_ids(cam: Camera, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(ids (H, W) int64, -1 on the background; depth (H, W)) of triangles (F, 3, 3), nearest
     face wins: one pass of the rasteriser (`raster.triangle_index`)."""
-    if not len(tris):
-        return triangle_index((cam.height, cam.width), np.zeros((0, 3, 2)), np.zeros((0, 3)))
-    px, depth = cam.project(tris)
+    px, depth = cam.project(np.asarray(tris, dtype=np.float64).reshape(-1, 3, 3))
     return triangle_index((cam.height, cam.width), px, depth)
 
 
