@@ -1,5 +1,5 @@
 """polyfold/graphs.py: what scipy.sparse.csgraph gives for the same graphs, exactly (component
-numbering, breadth-first predecessors, shortest distances), on random graphs with isolated nodes,
+numbering, breadth-first predecessors, shortest distances, the heaviest component), on random graphs with isolated nodes,
 repeated edges, edges given both ways and self-loops."""
 
 from __future__ import annotations
@@ -57,6 +57,14 @@ def test_shortest_distances_are_scipys_bit_for_bit():
         assert np.array_equal(got, want), np.abs(got - want)[np.isfinite(want)].max()
 
 
+def test_heaviest_component_is_bincount_of_scipys_components_bit_for_bit():
+    for n, u, v, rng in _random_graphs(300, 4):
+        w = rng.random(len(u)) * rng.choice([1e-3, 1.0, 1e3], len(u))
+        _, label = connected_components(coo_matrix((np.ones(len(u)), (u, v)), shape=(n, n)), directed=False)
+        want = np.bincount(label[u], weights=w).max() if len(u) else 0.0
+        assert graphs.heaviest_component(n, u, v, w) == want
+
+
 @pytest.mark.parametrize("n", [0, 1])
 def test_tiny_graphs(n):
     none = np.zeros(0, dtype=np.int64)
@@ -65,3 +73,4 @@ def test_tiny_graphs(n):
     if n:
         assert graphs.breadth_first_predecessors(n, none, none, 0).tolist() == [graphs.NO_PREDECESSOR]
         assert graphs.shortest_distances(n, none, none, np.zeros(0), 0).tolist() == [0.0]
+    assert graphs.heaviest_component(n, none, none, np.zeros(0)) == 0.0

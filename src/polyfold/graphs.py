@@ -54,6 +54,37 @@ def connected_components(n: int, u: np.ndarray, v: np.ndarray) -> tuple[int, np.
     return len(roots), numbered.astype(np.int64)
 
 
+@njit(cache=True)
+def heaviest_component(n, u, v, w):
+    """The largest total weight of the edges of one connected component of the undirected graph
+    on nodes 0..n-1 with edges u[i]-v[i] of weight w[i] (0.0 with no edges): what
+    `np.bincount(connected_components(n, u, v)[1][u], weights=w).max()` gives, to the last bit
+    (each component's weights are added in edge order). Union-find with path halving, for
+    callers that ask it per step of a growing build (`guide.order.opening_rims`)."""
+    parent = np.arange(n)
+    for i in range(len(u)):
+        a, b = u[i], v[i]
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        while parent[b] != b:
+            parent[b] = parent[parent[b]]
+            b = parent[b]
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    total = np.zeros(n)
+    for i in range(len(u)):
+        a = u[i]
+        while parent[a] != a:
+            a = parent[a]
+        total[a] += w[i]
+    best = 0.0
+    for k in range(n):
+        if total[k] > best:
+            best = total[k]
+    return best
+
+
 def breadth_first_predecessors(n: int, u: np.ndarray, v: np.ndarray, head: int) -> np.ndarray:
     """(n,) int64 predecessor of each node in the breadth-first tree from `head` of the undirected
     graph with edges u[i]-v[i]; NO_PREDECESSOR at head and where unreached (scipy's

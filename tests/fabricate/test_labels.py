@@ -110,3 +110,55 @@ def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, 
     assert (one[2].seam_runs > 0) == (name == "fish-472") == one[2].labels_by_run
     if name == "fish-472":
         assert sheet(1, by_run=True) == one
+
+
+def _distances_by_numpy(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """(k,) distances from p (2,) to the segments (k, 2, 2) as numpy writes them."""
+    a, ab = segments[:, 0], segments[:, 1] - segments[:, 0]
+    t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(a + t[:, None] * ab - p, axis=1)
+
+
+def _nearer_by_numpy(p: np.ndarray, segments: np.ndarray, own: np.ndarray, pad: float) -> bool:
+    """The test of a spot beside its own edge in numpy (the other segments' distances; `own`
+    left out either way round)."""
+    d, mine = _distances_by_numpy(p, segments), float(_distances_by_numpy(p, own[None])[0])
+    same = (np.abs(segments - own).max(axis=(1, 2)) < 1e-9) | (np.abs(segments - own[::-1]).max(axis=(1, 2)) < 1e-9)
+    return bool(np.all(d[~same] > mine + pad))
+
+
+def test_spots_beside_an_edge_are_told_as_numpy_tells_them():
+    """`PieceLabels._nearest_to`'s compiled test agrees with numpy's distances on every point, own
+    side given either way round, zero-length sides among the others, and pads that put a point's
+    nearest other side right at the limit (the last bit decides)."""
+    from polyfold.fabricate.labels import _nearer_than_others
+
+    rng = np.random.default_rng(5)
+    for trial in range(300):
+        segments = rng.uniform(-10, 10, (int(rng.integers(2, 30)), 2, 2))
+        zero = rng.random(len(segments)) < 0.1
+        segments[zero, 1] = segments[zero, 0]
+        k = int(rng.integers(0, len(segments)))
+        own = segments[k].copy() if trial % 2 else segments[k][::-1].copy()
+        pts = rng.uniform(-12, 12, (20, 2))
+        pads = [LABEL_PAD_MM]
+        for p in pts[:3]:  # the pad at which p's nearest other side is as far as its own plus the pad
+            d = _distances_by_numpy(p, segments)
+            d[k] = np.inf
+            pads.append(float(d.min() - _distances_by_numpy(p, own[None])[0]))
+        for pad in pads:
+            got = _nearer_than_others(pts, np.ascontiguousarray(segments), own, pad)
+            assert got.tolist() == [_nearer_by_numpy(p, segments, own, pad) for p in pts]
+        assert _nearer_than_others(pts, np.zeros((0, 2, 2)), own, LABEL_PAD_MM).all()
+
+
+def test_text_boxes_are_text_box_at_each_centre_to_the_last_bit():
+    from polyfold.fabricate.labels import text_boxes
+
+    rng = np.random.default_rng(6)
+    for text in ("7", "128", "AB"):
+        angle = rng.uniform(0, 2 * math.pi)
+        u = np.array([math.cos(angle), math.sin(angle)])
+        centres = rng.uniform(-100, 100, (25, 2))
+        want = np.stack([text_box(c, u, text, 2.5) for c in centres])
+        assert np.array_equal(text_boxes(centres, u, text, 2.5), want)

@@ -97,6 +97,22 @@ def _warm_crowded_labels() -> None:
     free = np.ones((8, 8), dtype=bool)
     _clear_leaders(~free, np.zeros(2), 5.0, np.zeros(2), np.ones((3, 2)), np.linspace(0.0, 1.0, 5), 2)
     _grid_bfs(free, 1, 1, 5, np.ones((1, 8, 8), dtype=bool), 2)
+    _warm_label_sides()
+
+
+def _warm_label_sides() -> None:
+    """The test of spots beside an edge (`labels.PieceLabels._nearest_to`: nearer it than the
+    piece's other cut sides), on a triangle."""
+    from shapely.geometry import Polygon
+
+    from ..fabricate.labels import PieceLabels
+    from ..fabricate.tabs import CutSide, Room
+
+    tri = np.array([[0.0, 0.0], [10.0, 0.0], [5.0, 8.0]])
+    side = CutSide(0, 0, 0, tri[0], tri[1], tri)
+    labels = PieceLabels(Room(np.array([Polygon(tri)], dtype=object)), 2.0,
+                         np.stack([tri, np.roll(tri, -1, axis=0)], axis=1))
+    labels._nearest_to(tri - [0.0, 1.0], side)
 
 
 def _warm_fold(mesh) -> None:
@@ -165,8 +181,8 @@ def _star_tree():
 
 def _warm_tabs(mesh) -> None:
     """The layout's overlap kernels, with the argument types tabs and labels give them: a tab
-    beside a face, its corner discs kept free (`tabs.Room.blocked`), and a label box beside
-    another (`labels._Boxes.hits`)."""
+    beside a face, its corner discs kept free (`tabs.Room.blocked`), a label box beside another
+    (`labels._Boxes.hits`) and spots beside an edge (`_warm_label_sides`)."""
     from shapely.geometry import Polygon
 
     from ..fabricate.labels import _Boxes, text_box
@@ -181,6 +197,7 @@ def _warm_tabs(mesh) -> None:
     side = CutSide(0, 0, 0, tri[0], tri[1], tri)
     choose_tab((side, side), [room])
     room.blocked(Polygon(tri + [0.0, -1.0]), None, TAB_CLEAR_MM)
+    _warm_label_sides()
 
 
 def _warm_fold_plan(mesh) -> None:
@@ -211,9 +228,10 @@ def _warm_fold_check(mesh) -> None:
 def _warm_guide(mesh) -> None:
     """make's assembly guide: a folded pose (`fold_positions`), a face-id picture (`face_ids`) of
     `star_net`'s crease tree (whose kernels the fold stage compiled before) and its label spots
-    (`label_spots`), and the distances along the surface that order the build steps."""
+    (`label_spots`), and the distances along the surface that order the build steps and the
+    openings left as they are glued (`heaviest_component`)."""
     from ..fold.tree import FoldTree, fold_positions
-    from ..graphs import shortest_distances
+    from ..graphs import heaviest_component, shortest_distances
     from ..guide.pictures import face_ids, fit_camera, label_spots
 
     pattern, _, opts = _star_tree()
@@ -222,6 +240,7 @@ def _warm_guide(mesh) -> None:
     ids, _ = face_ids(fit_camera(tris, np.eye(3), 8, 8), tris)
     label_spots(ids, [0], min_px=1)
     shortest_distances(3, np.array([0, 1]), np.array([1, 2]), np.ones(2), 0)
+    heaviest_component(3, np.array([0, 1]), np.array([1, 2]), np.ones(2))
 
 
 def _warm_segment(mesh) -> None:

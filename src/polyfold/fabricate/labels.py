@@ -54,6 +54,10 @@ LEADER_STEP_MM = 0.4  # a leader is looked up in the raster at points this far a
 LEADER_TRIES = 1000  # most spots whose leader is checked against the raster (nearest first)
 ELSEWHERE_GIVE_UP = 20  # a piece where this many labels found no spot is too crowded to look further
 TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
+# `PieceLabels._outside`'s spots: along the edge (t of its length), and the turns of a leader's
+# direction from the edge's outward normal (cos, sin of 0, 30, -30, 60, -60 degrees, as math has them)
+_ALONG = np.array([0.5, 0.35, 0.65, 0.2, 0.8])
+_TURNS = np.array([(math.cos(math.radians(t)), math.sin(math.radians(t))) for t in (0.0, 30.0, -30.0, 60.0, -60.0)])
 
 
 def label_font(min_cap_mm: float) -> float:
@@ -89,6 +93,14 @@ def text_box(center: np.ndarray, u: np.ndarray, text: str, size: float) -> np.nd
     hw, hh = text_width(text, size) / 2, CAP_HEIGHT * size / 2
     return np.array([center - hw * u - hh * n, center + hw * u - hh * n, center + hw * u + hh * n,
                      center - hw * u + hh * n])
+
+
+def text_boxes(centers: np.ndarray, u: np.ndarray, text: str, size: float) -> np.ndarray:
+    """(k, 4, 2) `text_box` at each of the centres (k, 2): the same corners to the last bit."""
+    n = np.array([-u[1], u[0]])
+    hw, hh = text_width(text, size) / 2, CAP_HEIGHT * size / 2
+    a, b = hw * u, hh * n
+    return np.stack([centers - a - b, centers + a - b, centers + a + b, centers - a + b], axis=1)
 
 
 def inside_triangle(tri: np.ndarray, pts: np.ndarray, pad: float) -> bool:
@@ -203,11 +215,33 @@ def _nearest_on(poly, p: np.ndarray) -> np.ndarray:
     return np.asarray(ring.interpolate(ring.project(Point(*p))).coords[0])
 
 
-def _segment_distances(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """(k,) distances from point p (2,) to the segments (k, 2, 2)."""
-    a, ab = segments[:, 0], segments[:, 1] - segments[:, 0]
-    t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
-    return np.linalg.norm(a + t[:, None] * ab - p, axis=1)
+@njit(cache=True)
+def _nearer_than_others(pts, segments, own, pad):
+    """(k,) bool: per point of pts (k, 2), whether every segment of `segments` (m, 2, 2) other
+    than `own` (2, 2) (either way round, to 1e-9) is farther from it than `own` by more than pad.
+    Each distance is numpy's of the nearest point on the segment, to the last bit: t = ((p - a) .
+    ab) / max(ab . ab, 1e-300) clipped to [0, 1], then the norm of a + t ab - p."""
+    out = np.ones(len(pts), dtype=np.bool_)
+    for i in range(len(pts)):
+        limit = _segment_distance(pts[i, 0], pts[i, 1], own[0, 0], own[0, 1], own[1, 0], own[1, 1]) + pad
+        for k in range(len(segments)):
+            a0, a1, b0, b1 = segments[k, 0, 0], segments[k, 0, 1], segments[k, 1, 0], segments[k, 1, 1]
+            same = max(abs(a0 - own[0, 0]), abs(a1 - own[0, 1]), abs(b0 - own[1, 0]), abs(b1 - own[1, 1])) < 1e-9
+            swapped = max(abs(a0 - own[1, 0]), abs(a1 - own[1, 1]), abs(b0 - own[0, 0]), abs(b1 - own[0, 1])) < 1e-9
+            if not (same or swapped) and not _segment_distance(pts[i, 0], pts[i, 1], a0, a1, b0, b1) > limit:
+                out[i] = False
+                break
+    return out
+
+
+@njit(cache=True, inline="always")
+def _segment_distance(px, py, a0, a1, b0, b1):
+    """Distance from (px, py) to the segment (a0, a1)-(b0, b1), as `_nearer_than_others` says."""
+    ab0, ab1 = b0 - a0, b1 - a1
+    t = ((px - a0) * ab0 + (py - a1) * ab1) / max(ab0 * ab0 + ab1 * ab1, 1e-300)
+    t = min(max(t, 0.0), 1.0)
+    d0, d1 = a0 + t * ab0 - px, a1 + t * ab1 - py
+    return math.sqrt(d0 * d0 + d1 * d1)
 
 
 def _end_away(side: CutSide, neighbour: CutSide) -> np.ndarray:
@@ -523,7 +557,7 @@ class PieceLabels:
         self.room = room
         # (k, 2, 2) ends of every cut side of the piece: a label without a leader off the faces is
         # placed nearer its own side than any other, or a reader takes it for that one's
-        self.cut_sides = np.zeros((0, 2, 2)) if cut_sides is None else np.asarray(cut_sides, dtype=float)
+        self.cut_sides = np.zeros((0, 2, 2)) if cut_sides is None else np.ascontiguousarray(cut_sides, dtype=float)
         # off-face labels stay in the room fitting a piece to the page leaves for its tabs
         self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
         shapely.prepare(self.allowed)  # asked whether it contains a label box for every spot tried
@@ -664,28 +698,32 @@ class PieceLabels:
     def _outside(self, text: str, side: CutSide, u: np.ndarray, n_out: np.ndarray, beyond: float, h: float) -> bool:
         """3. Outside the edge, `beyond` mm past it (its tab's depth): right beside it (nearer it
         than any other cut side), else up to LEADER_STEPS_MM away in a free spot with a leader line
-        from the middle of the edge."""
-        from shapely.geometry import LineString, Polygon
+        from the middle of the edge. The spots' boxes, their shapes and whether they lie in the
+        allowed room are made for all spots at once; the rest is asked spot by spot, in order."""
+        import shapely
+        from shapely.geometry import LineString
 
         d = side.p1 - side.p0
         mid = side.p0 + 0.5 * d
         start = mid + n_out * beyond
         near = beyond + TAB_CLEAR_MM + LABEL_PAD_MM + h / 2
-        spots = [(side.p0 + t * d + n_out * near, n_out, False) for t in (0.5, 0.35, 0.65, 0.2, 0.8)]
-        for dist in LEADER_STEPS_MM:
-            for turn in (0.0, 30.0, -30.0, 60.0, -60.0):
-                a = math.radians(turn)
-                w = np.array([n_out[0] * math.cos(a) - n_out[1] * math.sin(a), n_out[0] * math.sin(a) + n_out[1] * math.cos(a)])
-                spots.append((start + w * (dist + h / 2 + TAB_CLEAR_MM), w, True))
-        for center, w, leader in spots:
-            if not leader and not self._nearest_to(center, side):
-                continue
-            box = text_box(center, u, text, self.size)
-            poly = Polygon(box)
-            if not self.allowed.contains(poly) or self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
+        turns = np.stack([n_out[0] * _TURNS[:, 0] - n_out[1] * _TURNS[:, 1],
+                          n_out[0] * _TURNS[:, 1] + n_out[1] * _TURNS[:, 0]], axis=1)
+        reach = np.array([dist + h / 2 + TAB_CLEAR_MM for dist in LEADER_STEPS_MM])
+        # beside the edge (no leader), then for each distance every turn (a leader)
+        centers = np.concatenate([side.p0 + _ALONG[:, None] * d + n_out * near,
+                                  (start + turns[None] * reach[:, None, None]).reshape(-1, 2)])
+        leader = np.arange(len(centers)) >= len(_ALONG)
+        ok = leader | self._nearest_to(centers, side)
+        boxes = text_boxes(centers, u, text, self.size)
+        polys = shapely.polygons(boxes)
+        ok &= shapely.contains(self.allowed, polys)
+        for i in np.flatnonzero(ok).tolist():
+            center, box, poly = centers[i], boxes[i], polys[i]
+            if self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
                 continue
             extra = [poly]
-            if leader:
+            if leader[i]:
                 end = _nearest_on(poly, start)
                 line = LineString([start + (end - start) * min(1.0, TAB_CLEAR_MM / max(np.linalg.norm(end - start), 1e-9)), end])
                 # drawn from the edge itself, over its own tab: a leader ending at the tab's tip
@@ -702,16 +740,12 @@ class PieceLabels:
             return True
         return False
 
-    def _nearest_to(self, p: np.ndarray, side: CutSide) -> bool:
-        """Whether point p is nearer `side` than every other cut side of the piece, by LABEL_PAD_MM
-        (a label beside an edge names the edge a reader sees nearest to it)."""
-        if not len(self.cut_sides):
-            return True
-        d = _segment_distances(p, self.cut_sides)
-        ends = np.array([side.p0, side.p1])
-        own = (np.abs(self.cut_sides - ends).max(axis=(1, 2)) < 1e-9) | (np.abs(self.cut_sides - ends[::-1]).max(axis=(1, 2)) < 1e-9)
-        mine = float(_segment_distances(p, ends[None])[0])
-        return bool(np.all(d[~own] > mine + LABEL_PAD_MM))
+    def _nearest_to(self, pts: np.ndarray, side: CutSide) -> np.ndarray:
+        """(k,) bool per point of pts (k, 2): whether it is nearer `side` than every other cut side
+        of the piece, by LABEL_PAD_MM (a label beside an edge names the edge a reader sees nearest
+        to it)."""
+        return _nearer_than_others(np.ascontiguousarray(pts, dtype=float), self.cut_sides,
+                                   np.array([side.p0, side.p1], dtype=float), LABEL_PAD_MM)
 
     def _elsewhere(self, text: str, sides: list[CutSide]) -> bool:
         """4. The free spot nearest the middle of an edge of `sides` (a run's, middle one first;

@@ -220,7 +220,7 @@ def opening_rims(mesh: Mesh, piece_faces: list[np.ndarray], seams: list[Seam], s
     the open edges (a side of a placed face whose other side is not placed, or a seam not glued
     yet, counted on both copies) chained into holes. A finger or a pencil reaches the inside
     through any hole, so the largest one counts; 0 once the model is closed."""
-    from ..graphs import connected_components
+    from ..graphs import heaviest_component
 
     topo = mesh.topology
     edges, ef = topo.edges, topo.edge_faces
@@ -244,7 +244,6 @@ def opening_rims(mesh: Mesh, piece_faces: list[np.ndarray], seams: list[Seam], s
             open_e = np.flatnonzero(mult > 0)
             if len(open_e) == 0:
                 continue
-            a, b = edges[open_e, 0], edges[open_e, 1]
-            _, label = connected_components(mesh.n_vertices, a, b)
-            rim[k] = float(np.bincount(label[a], weights=length[open_e] * mult[open_e]).max())
+            rim[k] = heaviest_component(mesh.n_vertices, edges[open_e, 0], edges[open_e, 1],
+                                        length[open_e] * mult[open_e])
     return rim
