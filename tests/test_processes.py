@@ -183,3 +183,35 @@ def test_exit_status_is_the_interpreters() -> None:
     for code in (None, 0, 3, 141, "a message"):
         run = subprocess.run([sys.executable, "-c", f"import sys; sys.exit({code!r})"], capture_output=True, timeout=60)
         assert exit_status(SystemExit(code)) == run.returncode, code
+
+
+def _down(n: int) -> int:
+    return 0 if n == 0 else _down(n - 1) + 1
+
+
+def _up_and_down() -> None:
+    """Calls 0-400 deep, again and again: across the end of a 16 KB frame chunk or two."""
+    for _ in range(100):
+        for depth in range(0, 400, 7):
+            _down(depth)
+
+
+def _page_faults(fn) -> int:
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    fn()
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+
+def test_calls_in_the_roomy_stack_map_no_frame_chunks() -> None:
+    """Outside `in_roomy_stack`, calls going up and down across a chunk's end map a fresh chunk
+    each time (its pages fault in anew: thousands of faults); inside, they reuse its one chunk
+    (a handful). And the function's value comes back."""
+    from polyfold.processes import in_roomy_stack
+
+    outside = _page_faults(_up_and_down)
+    inside = _page_faults(lambda: in_roomy_stack(_up_and_down))
+    assert outside > 1000, outside  # (the churn this guards against, as CPython 3.11 has it)
+    assert inside < outside / 20, (inside, outside)
+    assert in_roomy_stack(lambda: _down(50)) == 50

@@ -564,4 +564,7 @@ if __name__ == "__main__":  # `polyfold server start` runs this in the backgroun
 
     parser = argparse.ArgumentParser(prog="python -m polyfold.apps.server")
     parser.add_argument("--idle-minutes", type=float, default=IDLE_MINUTES)
-    serve(parser.parse_args().idle_minutes)
+    idle = parser.parse_args().idle_minutes
+    from ..processes import in_roomy_stack
+
+    in_roomy_stack(lambda: serve(idle))

@@ -461,13 +461,16 @@ if __name__ == "__main__":  # the second process of warm_up: sections named on t
     import json
     import sys
 
-    from ..processes import collect_less
+    from ..processes import collect_less, in_roomy_stack
 
     collect_less()
     from ..jit import just_in_time
 
-    if sys.argv[1:2] == ["--ahead"]:
-        print(json.dumps({"ahead": _record_and_build(sys.argv[2:])}))
-    else:
-        with just_in_time():
-            print(json.dumps(run_sections(sys.argv[1:])))
+    def run() -> None:
+        if sys.argv[1:2] == ["--ahead"]:
+            print(json.dumps({"ahead": _record_and_build(sys.argv[2:])}))
+        else:
+            with just_in_time():
+                print(json.dumps(run_sections(sys.argv[1:])))
+
+    in_roomy_stack(run)

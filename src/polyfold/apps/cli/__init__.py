@@ -25,11 +25,11 @@ def main() -> None:
     code = forward(sys.argv[1:])
     if code is not None:
         sys.exit(code)
-    from ...processes import collect_less, exit_status, leave
+    from ...processes import collect_less, exit_status, in_roomy_stack, leave
     from .app import main as run_here
 
     collect_less()
     try:
-        run_here()
+        in_roomy_stack(run_here)
     except SystemExit as done:  # how `main` ends (always with an int code: its errors are said already)
         leave(exit_status(done))
