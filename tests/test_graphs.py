@@ -29,6 +29,7 @@ def test_components_are_scipys():
         want_n, want = connected_components(coo_matrix((np.ones(len(u)), (u, v)), shape=(n, n)), directed=False)
         got_n, got = graphs.connected_components(n, u, v)
         assert got_n == want_n and np.array_equal(got, want)
+        assert np.array_equal(graphs.union_labels(n, u, v), want)
 
 
 def test_breadth_first_predecessors_are_scipys():

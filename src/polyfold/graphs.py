@@ -1,5 +1,6 @@
-"""Graph primitives over edge lists, compiled: connected components, a breadth-first tree and
-single-source shortest distances of undirected graphs on nodes 0..n-1.
+"""Graph primitives over edge lists: connected components (numpy, and `union_labels` for
+kernels), the heaviest component, a breadth-first tree and single-source shortest distances of
+undirected graphs on nodes 0..n-1.
 
 They give exactly what scipy.sparse.csgraph gives for the same sparse matrix (tests compare
 them): its numbering of components (in the order of each one's lowest node), its breadth-first
@@ -55,29 +56,48 @@ def connected_components(n: int, u: np.ndarray, v: np.ndarray) -> tuple[int, np.
 
 
 @njit(cache=True)
+def union_labels(n, f0, f1):
+    """Component label of each of n items joined by the pairs (f0[i], f1[i]); components are
+    numbered in the order of their smallest item (as scipy's connected_components numbers them)."""
+    root = np.arange(n)
+    for k in range(f0.shape[0]):
+        a, b = f0[k], f1[k]
+        while root[a] != a:
+            root[a] = root[root[a]]
+            a = root[a]
+        while root[b] != b:
+            root[b] = root[root[b]]
+            b = root[b]
+        if a != b:
+            if a < b:
+                root[b] = a
+            else:
+                root[a] = b
+    label = np.empty(n, dtype=np.int64)
+    nxt = 0
+    for i in range(n):
+        r = i
+        while root[r] != r:
+            r = root[r]
+        if r == i:
+            label[i] = nxt
+            nxt += 1
+        else:
+            label[i] = label[r]  # r < i: the root is the smallest item, labelled already
+    return label
+
+
+@njit(cache=True)
 def heaviest_component(n, u, v, w):
     """The largest total weight of the edges of one connected component of the undirected graph
     on nodes 0..n-1 with edges u[i]-v[i] of weight w[i] (0.0 with no edges): what
     `np.bincount(connected_components(n, u, v)[1][u], weights=w).max()` gives, to the last bit
-    (each component's weights are added in edge order). Union-find with path halving, for
-    callers that ask it per step of a growing build (`guide.order.opening_rims`)."""
-    parent = np.arange(n)
-    for i in range(len(u)):
-        a, b = u[i], v[i]
-        while parent[a] != a:
-            parent[a] = parent[parent[a]]
-            a = parent[a]
-        while parent[b] != b:
-            parent[b] = parent[parent[b]]
-            b = parent[b]
-        if a != b:
-            parent[max(a, b)] = min(a, b)
+    (each component's weights are added in edge order), for callers that ask it per step of a
+    growing build (`guide.order.opening_rims`)."""
+    label = union_labels(n, u, v)
     total = np.zeros(n)
     for i in range(len(u)):
-        a = u[i]
-        while parent[a] != a:
-            a = parent[a]
-        total[a] += w[i]
+        total[label[u[i]]] += w[i]
     best = 0.0
     for k in range(n):
         if total[k] > best:

@@ -10,44 +10,9 @@ import math
 
 import numpy as np
 
+from ..graphs import union_labels
 from ..jit import njit
 from .hull_kernels import HULL_FLAT_EPS, convex_hull, copy_row, denoise, max_depth
-
-
-# ----------------------------------------------------------------------------------------------
-# Connected components
-
-
-@njit(cache=True)
-def union_labels(n, f0, f1):
-    """Component label of each of n items joined by the pairs (f0[i], f1[i]); components are
-    numbered in the order of their smallest item (as scipy's connected_components numbers them)."""
-    root = np.arange(n)
-    for k in range(f0.shape[0]):
-        a, b = f0[k], f1[k]
-        while root[a] != a:
-            root[a] = root[root[a]]
-            a = root[a]
-        while root[b] != b:
-            root[b] = root[root[b]]
-            b = root[b]
-        if a != b:
-            if a < b:
-                root[b] = a
-            else:
-                root[a] = b
-    label = np.empty(n, dtype=np.int64)
-    nxt = 0
-    for i in range(n):
-        r = i
-        while root[r] != r:
-            r = root[r]
-        if r == i:
-            label[i] = nxt
-            nxt += 1
-        else:
-            label[i] = label[r]  # r < i: the root is the smallest item, labelled already
-    return label
 
 
 # ----------------------------------------------------------------------------------------------
