@@ -277,15 +277,30 @@ def _half_cells(size: float) -> int:
 def _free_centres(taken: np.ndarray, w: float, h: float) -> np.ndarray:
     """(ny, nx) bool: the cells of the raster `taken` that centre a w x h mm box of cells none of
     which is taken (2 ceil(h / 2 cell) + 1 rows by 2 ceil(w / 2 cell) + 1 columns, all inside the
-    raster), counted by a summed-area table."""
-    hw, hh = _half_cells(w), _half_cells(h)
-    out = np.zeros(taken.shape, dtype=bool)
+    raster), counted by a summed-area table (`_box_free`)."""
+    return _box_free(np.ascontiguousarray(taken), _half_cells(w), _half_cells(h))
+
+
+@njit(cache=True)
+def _box_free(taken, hw, hh):
+    """(ny, nx) bool: the cells of `taken` (ny, nx) whose box of 2 hh + 1 rows by 2 hw + 1 columns
+    around them lies inside the raster and holds no True cell (a summed-area table of int32
+    counts, as numpy's cumulative sums would make it)."""
+    ny, nx = taken.shape
+    out = np.zeros((ny, nx), dtype=np.bool_)
     kh, kw = 2 * hh + 1, 2 * hw + 1
-    if taken.shape[0] < kh or taken.shape[1] < kw:
+    if ny < kh or nx < kw:
         return out
-    s = np.pad(np.cumsum(np.cumsum(taken, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
-    count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
-    out[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
+    table = np.zeros((ny + 1, nx + 1), dtype=np.int32)
+    for r in range(ny):
+        row = 0
+        for c in range(nx):
+            row += taken[r, c]
+            table[r + 1, c + 1] = table[r, c + 1] + row
+    for r in range(ny - kh + 1):
+        for c in range(nx - kw + 1):
+            count = table[r + kh, c + kw] - table[r, c + kw] - table[r + kh, c] + table[r, c]
+            out[r + hh, c + hw] = count == 0
     return out
 
 
@@ -321,6 +336,31 @@ def _grid_bfs(free, sr, sc, max_steps, ok, want):
                             found[n_found, 0], found[n_found, 1], found[n_found, 2] = k, rr, cc
                             n_found += 1
     return dist, found[:n_found]
+
+
+@njit(cache=True)
+def _free_cells_near(free, in_faces, inside, r0, r1, c0, c1, origin, p, cell, r2):
+    """(centres (k, 2), their squared distances (k,) from p) of the cells of rows r0..r1 and
+    columns c0..c1 (inclusive) that are True in `free` (ny, nx) and in `in_faces` as `inside`
+    says, centre origin + (column or row + 0.5) cell, within squared distance r2 of p, in row
+    order: what numpy's nonzero of the window and that distance test give, to the last bit."""
+    n = (r1 - r0 + 1) * (c1 - c0 + 1)
+    centres = np.empty((n, 2))
+    d2 = np.empty(n)
+    k = 0
+    for r in range(r0, r1 + 1):
+        y = origin[1] + (r + 0.5) * cell
+        dy = y - p[1]
+        for c in range(c0, c1 + 1):
+            if free[r, c] and in_faces[r, c] == inside:
+                x = origin[0] + (c + 0.5) * cell
+                dx = x - p[0]
+                dd = dx * dx + dy * dy
+                if dd <= r2:
+                    centres[k, 0], centres[k, 1] = x, y
+                    d2[k] = dd
+                    k += 1
+    return centres[:k], d2[:k]
 
 
 @njit(cache=True)
@@ -489,18 +529,17 @@ class _Taken:
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         if self.grid[r0:r1 + 1, c0:c1 + 1].all():
             return np.zeros((0, 2))
-        rows, cols = np.nonzero(self.free(w, h)[r0:r1 + 1, c0:c1 + 1] & (self.in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
-        centres = self.origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
-        d2 = ((centres - p) ** 2).sum(axis=1)
-        near = np.flatnonzero(d2 <= ELSEWHERE_MM ** 2)
+        p = np.asarray(p, dtype=np.float64)
+        centres, d2 = _free_cells_near(self.free(w, h), self.in_faces, inside, int(r0), int(r1), int(c0), int(c1),
+                                       self.origin, p, FREE_CELL_MM, ELSEWHERE_MM ** 2)
+        near = np.arange(len(d2))
         if len(near) > LEADER_TRIES:
-            near = near[np.argpartition(d2[near], LEADER_TRIES)[:LEADER_TRIES]]
+            near = np.argpartition(d2, LEADER_TRIES)[:LEADER_TRIES]
         centres = centres[near[np.argsort(d2[near], kind="stable")]]
         # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
         # most) are free; nearest first, until `want` are found
         t = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
-        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, np.asarray(p, dtype=np.float64),
-                                      centres, t, want)]
+        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, centres, t, want)]
 
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
