@@ -23,9 +23,10 @@ project's cache is left alone):
   folder of its own; memory there is the server's process tree (the server, the child and its
   workers) less nothing: the server's own pages count too;
 - make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
-  faces, one per noise seed of --sphere-seeds; bunny-348 Loop-subdivided once, 1,392 faces, a
-  model whose small faces crowd its labels at 150 mm), warm cache, fold on, A4 at 150 mm: seconds
-  and peak memory.
+  faces, one per noise seed of --sphere-seeds; shared models Loop-subdivided (--dense: bunny-348
+  once, 1,392 faces, horse-302 once, 1,208, fish-472 once, 1,888, moneybox-128 twice, 2,048,
+  bumpy-528 once, 2,112: models whose small faces crowd their labels at 150 mm), warm cache, fold
+  on, A4 at 150 mm: seconds and peak memory.
 Prints a table; compile seconds per stage are the cold make's own (report.json "compile_seconds").
 """
 
@@ -47,6 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "polyfold").exists() else [sys.executable, "-m", "polyfold"]
 BUNNY = ROOT / "examples" / "bunny-128.obj"
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
+DENSE = "bunny-348:1,horse-302:1,fish-472:1,moneybox-128:2,bumpy-528:1"  # (--dense) name:Loop subdivisions
 
 
 def _tree_pss_mb(pid: int) -> float:
@@ -152,7 +154,8 @@ def main() -> None:
     ap.add_argument("--skip-cold", action="store_true", help="no cold rows (each compiles for about a minute)")
     ap.add_argument("--sizes", default="128,1500,5000", help="face counts of the make rows")
     ap.add_argument("--sphere-seeds", default="1,2,3", help="noise draws of each size's sphere (a sphere each)")
-    ap.add_argument("--no-dense", action="store_true", help="leave out the Loop-subdivided bunny-348")
+    ap.add_argument("--dense", default=DENSE, help="shared models to Loop-subdivide, name:times,...")
+    ap.add_argument("--no-dense", action="store_true", help="leave out the Loop-subdivided models")
     ap.add_argument("--no-server", action="store_true", help="no rows through `polyfold server`")
     a = ap.parse_args()
     rows: list[tuple[str, float, float, str]] = []
@@ -214,15 +217,17 @@ def main() -> None:
             mesh = tmp / f"sphere-{n}-{seed}.obj"
             got = sphere_obj(mesh, n, seed)
             meshes.append((f"make noisy sphere, {got} faces, noise seed {seed}", mesh))
-    if not a.no_dense and (MODELS / "bunny-348.obj").exists():
+    for name, times in ([] if a.no_dense else [item.split(":") for item in a.dense.split(",")]):
+        if not (MODELS / f"{name}.obj").exists():
+            continue
         sys.path.insert(0, str(ROOT / "bench"))
         from bench_build import loop_subdivided
 
-        v, f = loop_subdivided(MODELS / "bunny-348.obj", 1)
-        mesh = tmp / "bunny-348-loop1.obj"
+        v, f = loop_subdivided(MODELS / f"{name}.obj", int(times))
+        mesh = tmp / f"{name}-loop{times}.obj"
         mesh.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
                         + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
-        meshes.append((f"make bunny-348 Loop-subdivided, {len(f)} faces", mesh))
+        meshes.append((f"make {name} Loop-subdivided{' twice' if times == '2' else ''}, {len(f)} faces", mesh))
     for k, (label, mesh) in enumerate(meshes):
         for how, env in (("", None), (", served", served)):
             if how and served is None:
