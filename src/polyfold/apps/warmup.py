@@ -183,8 +183,9 @@ def _star_tree():
 
 def _warm_tabs(mesh) -> None:
     """The layout's overlap kernels, with the argument types tabs and labels give them: a tab
-    beside a face, its corner discs kept free (`tabs.Room.blocked`), a label box beside another
-    (`labels._Boxes.hits`) and spots beside an edge (`_warm_label_sides`)."""
+    beside a face, its corner discs kept free (`tabs.Room.blocked`) and a label box beside another
+    (`labels._Boxes.hits`): what every make calls (a first run compiles them beside; the bunny's
+    labels all fit in their faces, so `_warm_label_sides` is left to a make that needs it)."""
     from shapely.geometry import Polygon
 
     from ..fabricate.labels import _Boxes, text_box
@@ -199,7 +200,6 @@ def _warm_tabs(mesh) -> None:
     side = CutSide(0, 0, 0, tri[0], tri[1], tri)
     choose_tab((side, side), [room])
     room.blocked(Polygon(tri + [0.0, -1.0]), None, TAB_CLEAR_MM)
-    _warm_label_sides()
 
 
 def _warm_fold_plan(mesh) -> None:
