@@ -89,14 +89,11 @@ def text_width(text: str, size: float) -> float:
 def text_box(center: np.ndarray, u: np.ndarray, text: str, size: float) -> np.ndarray:
     """The 4 corners (4, 2) of the glyph box of `text` at font `size` centred at `center`, its
     reading direction the unit vector u: `text_width` wide, a cap height high."""
-    n = np.array([-u[1], u[0]])
-    hw, hh = text_width(text, size) / 2, CAP_HEIGHT * size / 2
-    return np.array([center - hw * u - hh * n, center + hw * u - hh * n, center + hw * u + hh * n,
-                     center - hw * u + hh * n])
+    return text_boxes(np.asarray(center, dtype=float)[None], u, text, size)[0]
 
 
 def text_boxes(centers: np.ndarray, u: np.ndarray, text: str, size: float) -> np.ndarray:
-    """(k, 4, 2) `text_box` at each of the centres (k, 2): the same corners to the last bit."""
+    """(k, 4, 2) `text_box` at each of the centres (k, 2)."""
     n = np.array([-u[1], u[0]])
     hw, hh = text_width(text, size) / 2, CAP_HEIGHT * size / 2
     a, b = hw * u, hh * n
