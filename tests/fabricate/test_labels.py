@@ -168,3 +168,39 @@ def test_text_boxes_are_their_corners_at_each_centre():
                                    c - hw * u + hh * n]) for c in centres])
         assert np.array_equal(text_boxes(centres, u, text, 2.5), want)
         assert np.array_equal(np.stack([text_box(c, u, text, 2.5) for c in centres]), want)
+
+
+def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
+    """The raster search of `PieceLabels._elsewhere`: the summed-area test of free boxes
+    (`_free_centres`) and the free cells near a point (`_free_cells_near`) against numpy's
+    cumulative sums, nonzero and distances on random rasters, windows and points."""
+    from polyfold.fabricate.labels import FREE_CELL_MM, _free_cells_near, _free_centres, _half_cells
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        ny, nx = (int(v) for v in rng.integers(1, 90, 2))
+        taken = rng.random((ny, nx)) < rng.uniform(0.0, 0.3)
+        w, h = rng.uniform(0.1, 8.0, 2)
+        hw, hh = _half_cells(w), _half_cells(h)
+        want = np.zeros((ny, nx), dtype=bool)
+        kh, kw = 2 * hh + 1, 2 * hw + 1
+        if ny >= kh and nx >= kw:
+            s = np.pad(np.cumsum(np.cumsum(taken, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
+            count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
+            want[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
+        assert np.array_equal(_free_centres(taken, w, h), want)
+
+        free, in_faces = ~taken, rng.random((ny, nx)) < 0.5
+        origin = rng.uniform(-50, 50, 2)
+        p = origin + rng.uniform(0, 1, 2) * [nx, ny] * FREE_CELL_MM  # (over the raster)
+        r0, r1 = sorted(int(v) for v in rng.integers(0, ny, 2))
+        c0, c1 = sorted(int(v) for v in rng.integers(0, nx, 2))
+        radius2 = float(rng.uniform(0.5, 10.0)) ** 2
+        for inside in (True, False):
+            rows, cols = np.nonzero(free[r0:r1 + 1, c0:c1 + 1] & (in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
+            centres = origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
+            d2 = ((centres - p) ** 2).sum(axis=1)
+            near = np.flatnonzero(d2 <= radius2)
+            got_centres, got_d2 = _free_cells_near(free, in_faces, inside, r0, r1, c0, c1, origin, p, FREE_CELL_MM,
+                                                   radius2)
+            assert np.array_equal(got_centres, centres[near]) and np.array_equal(got_d2, d2[near])
