@@ -172,9 +172,9 @@ def test_text_boxes_are_their_corners_at_each_centre():
 
 def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
     """The raster search of `PieceLabels._elsewhere`: the summed-area test of free boxes
-    (`_free_centres`) and the free cells near a point (`_free_cells_near`) against numpy's
+    (`_box_free`) and the free cells near a point (`_free_cells_near`) against numpy's
     cumulative sums, nonzero and distances on random rasters, windows and points."""
-    from polyfold.fabricate.labels import FREE_CELL_MM, _free_cells_near, _free_centres, _half_cells
+    from polyfold.fabricate.labels import FREE_CELL_MM, _box_free, _free_cells_near, _half_cells
 
     rng = np.random.default_rng(7)
     for _ in range(60):
@@ -188,7 +188,7 @@ def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
             s = np.pad(np.cumsum(np.cumsum(taken, axis=0, dtype=np.int32), axis=1), ((1, 0), (1, 0)))
             count = s[kh:, kw:] - s[:-kh, kw:] - s[kh:, :-kw] + s[:-kh, :-kw]
             want[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
-        assert np.array_equal(_free_centres(taken, w, h), want)
+        assert np.array_equal(_box_free(taken, hw, hh), want)
 
         free, in_faces = ~taken, rng.random((ny, nx)) < 0.5
         origin = rng.uniform(-50, 50, 2)

@@ -57,6 +57,8 @@ TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
 # `PieceLabels._outside`'s spots: along the edge (t of its length), and the turns of a leader's
 # direction from the edge's outward normal (cos, sin of 0, 30, -30, 60, -60 degrees, as math has them)
 _ALONG = np.array([0.5, 0.35, 0.65, 0.2, 0.8])
+# where a leader of ELSEWHERE_MM at most is looked up in the raster (fractions of its length)
+_LEADER_T = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
 _TURNS = np.array([(math.cos(math.radians(t)), math.sin(math.radians(t))) for t in (0.0, 30.0, -30.0, 60.0, -60.0)])
 
 
@@ -218,14 +220,18 @@ def _nearer_than_others(pts, segments, own, pad):
     than `own` (2, 2) (either way round, to 1e-9) is farther from it than `own` by more than pad.
     Each distance is numpy's of the nearest point on the segment, to the last bit: t = ((p - a) .
     ab) / max(ab . ab, 1e-300) clipped to [0, 1], then the norm of a + t ab - p."""
+    other = np.empty(len(segments), dtype=np.bool_)
+    for k in range(len(segments)):
+        a0, a1, b0, b1 = segments[k, 0, 0], segments[k, 0, 1], segments[k, 1, 0], segments[k, 1, 1]
+        same = max(abs(a0 - own[0, 0]), abs(a1 - own[0, 1]), abs(b0 - own[1, 0]), abs(b1 - own[1, 1])) < 1e-9
+        swapped = max(abs(a0 - own[1, 0]), abs(a1 - own[1, 1]), abs(b0 - own[0, 0]), abs(b1 - own[0, 1])) < 1e-9
+        other[k] = not (same or swapped)
     out = np.ones(len(pts), dtype=np.bool_)
     for i in range(len(pts)):
         limit = _segment_distance(pts[i, 0], pts[i, 1], own[0, 0], own[0, 1], own[1, 0], own[1, 1]) + pad
         for k in range(len(segments)):
-            a0, a1, b0, b1 = segments[k, 0, 0], segments[k, 0, 1], segments[k, 1, 0], segments[k, 1, 1]
-            same = max(abs(a0 - own[0, 0]), abs(a1 - own[0, 1]), abs(b0 - own[1, 0]), abs(b1 - own[1, 1])) < 1e-9
-            swapped = max(abs(a0 - own[1, 0]), abs(a1 - own[1, 1]), abs(b0 - own[0, 0]), abs(b1 - own[0, 1])) < 1e-9
-            if not (same or swapped) and not _segment_distance(pts[i, 0], pts[i, 1], a0, a1, b0, b1) > limit:
+            if other[k] and not _segment_distance(pts[i, 0], pts[i, 1], segments[k, 0, 0], segments[k, 0, 1],
+                                                  segments[k, 1, 0], segments[k, 1, 1]) > limit:
                 out[i] = False
                 break
     return out
@@ -271,18 +277,11 @@ def _half_cells(size: float) -> int:
     return int(math.ceil(size / 2 / FREE_CELL_MM - 1e-9))
 
 
-def _free_centres(taken: np.ndarray, w: float, h: float) -> np.ndarray:
-    """(ny, nx) bool: the cells of the raster `taken` that centre a w x h mm box of cells none of
-    which is taken (2 ceil(h / 2 cell) + 1 rows by 2 ceil(w / 2 cell) + 1 columns, all inside the
-    raster), counted by a summed-area table (`_box_free`)."""
-    return _box_free(np.ascontiguousarray(taken), _half_cells(w), _half_cells(h))
-
-
 @njit(cache=True)
 def _box_free(taken, hw, hh):
-    """(ny, nx) bool: the cells of `taken` (ny, nx) whose box of 2 hh + 1 rows by 2 hw + 1 columns
-    around them lies inside the raster and holds no True cell (a summed-area table of int32
-    counts, as numpy's cumulative sums would make it)."""
+    """(ny, nx) bool: the cells of `taken` (ny, nx) that centre a box of 2 hh + 1 rows by 2 hw + 1
+    columns (`_half_cells` of a box's height and width) that lies inside the raster and holds no
+    True cell, counted by a summed-area table (int32, as numpy's cumulative sums would make it)."""
     ny, nx = taken.shape
     out = np.zeros((ny, nx), dtype=np.bool_)
     kh, kw = 2 * hh + 1, 2 * hw + 1
@@ -494,12 +493,12 @@ class _Taken:
             self._refresh(windows[~to_texts])
 
     def free(self, w: float, h: float) -> np.ndarray:
-        """(ny, nx) `_free_centres` of the whole raster for w x h mm boxes, kept up to date as
+        """(ny, nx) `_box_free` of the whole raster for w x h mm boxes, kept up to date as
         cells are taken (`_refresh`): a label is looked for a dozen times between two placements."""
         self._flush()
         key = (_half_cells(w), _half_cells(h))
         if key not in self._free:
-            self._free[key] = _free_centres(self.grid, w, h)
+            self._free[key] = _box_free(self.grid, *key)
         return self._free[key]
 
     def _refresh(self, windows: np.ndarray) -> None:
@@ -510,12 +509,12 @@ class _Taken:
         for (hw, hh), free in self._free.items():
             near = (windows[:, 1] - windows[:, 0] + 1 + 4 * hh) * (windows[:, 3] - windows[:, 2] + 1 + 4 * hw)
             if near.sum() > ny * nx:
-                free[:] = _free_centres(self.grid, (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
+                free[:] = _box_free(self.grid, hw, hh)
                 continue
             for r0, r1, c0, c1 in windows.tolist():
                 t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
                 s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
-                part = _free_centres(self.grid[s0:s1 + 1, v0:v1 + 1], (2 * hw) * FREE_CELL_MM, (2 * hh) * FREE_CELL_MM)
+                part = _box_free(np.ascontiguousarray(self.grid[s0:s1 + 1, v0:v1 + 1]), hw, hh)
                 free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
 
     def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
@@ -535,8 +534,7 @@ class _Taken:
         centres = centres[near[np.argsort(d2[near], kind="stable")]]
         # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
         # most) are free; nearest first, until `want` are found
-        t = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
-        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, centres, t, want)]
+        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, centres, _LEADER_T, want)]
 
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
@@ -750,7 +748,8 @@ class PieceLabels:
         centers = np.concatenate([side.p0 + _ALONG[:, None] * d + n_out * near,
                                   (start + turns[None] * reach[:, None, None]).reshape(-1, 2)])
         leader = np.arange(len(centers)) >= len(_ALONG)
-        ok = leader | self._nearest_to(centers, side)
+        ok = leader.copy()  # (a spot with a leader names its edge by the leader)
+        ok[:len(_ALONG)] = self._nearest_to(centers[:len(_ALONG)], side)
         boxes = text_boxes(centers, u, text, self.size)
         polys = shapely.polygons(boxes)
         ok &= shapely.contains(self.allowed, polys)
