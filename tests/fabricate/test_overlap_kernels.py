@@ -154,3 +154,110 @@ def test_grown_box_meets_gives_shapelys_answers():
         answers.append(quick)
     answers = np.array(answers)
     assert (answers == 1).mean() > 0.2 and (answers == 0).mean() > 0.2 and (answers == -1).mean() < 0.3
+
+
+def _crowded_piece(rng: np.random.Generator):
+    """PieceLabels on a 6 x 6 grid of jittered 4 mm squares (two triangles each) with a few tabs
+    in its room and label boxes and leader strips placed over it (one strip a MultiPolygon: no
+    ring for the compiled tests)."""
+    from shapely.geometry import LineString
+
+    from polyfold.fabricate.labels import PieceLabels, text_box
+
+    g = np.stack(np.meshgrid(np.arange(7.0), np.arange(7.0), indexing="ij"), axis=-1) * 4.0
+    g[1:-1, 1:-1] += rng.uniform(-1.0, 1.0, (5, 5, 2))
+    tris = []
+    for i in range(6):
+        for j in range(6):
+            a, b, c, d = g[i, j], g[i + 1, j], g[i + 1, j + 1], g[i, j + 1]
+            tris += [np.array([a, b, c]), np.array([a, c, d])]
+    room = Room(np.array([Polygon(t) for t in tris], dtype=object))
+    room.add([Polygon([[x, -0.5], [x + 1.0, -3.0], [x + 3.0, -3.0], [x + 4.0, -0.5]]) for x in (0.0, 8.0, 16.0)])
+    labels = PieceLabels(room, 2.5)
+    for _ in range(12):
+        turn = rng.uniform(0, np.pi)
+        u = np.array([np.cos(turn), np.sin(turn)])
+        centre = rng.uniform(-4.0, 28.0, 2)
+        labels._put("7", centre, u, 2.5, "edge-label", text_box(centre, u, "77", 2.5))
+    for _ in range(4):
+        a = rng.uniform(-4.0, 28.0, 2)
+        labels.strips.add_geom(LineString([a, a + rng.normal(0.0, 5.0, 2)]).buffer(0.1))
+    labels.strips.add_geom(shapely.MultiPolygon([Polygon(t + [40.0, 0.0]) for t in tris[:2]]))
+    return labels
+
+
+def test_first_clear_box_takes_the_spot_that_hits_and_blocked_take():
+    # label spots around a crowded piece: the first clear of labels, leaders and the room, found
+    # by the compiled test (asking the Python tests only where it says it cannot tell), is the one
+    # the Python tests (spatial hash, shapely, `Room.blocked`) find one by one
+    from polyfold.fabricate.labels import LABEL_PAD_MM, _box_cells, text_boxes
+    from polyfold.fabricate.overlap_kernels import first_clear_box
+
+    rng = np.random.default_rng(11)
+    found, asked = 0, 0
+    for trial in range(40):
+        labels = _crowded_piece(rng)
+        a, b = labels.boxes.rings, labels.strips.rings
+        for _ in range(10):
+            turn = rng.uniform(0, np.pi)
+            boxes = text_boxes(rng.uniform(-6.0, 30.0, (8, 2)), np.array([np.cos(turn), np.sin(turn)]), "123", 2.5)
+            order = np.flatnonzero(rng.random(8) < 0.8)
+            expect = next((int(i) for i in order if not (labels._hits(boxes[i]) or
+                                                         labels.room.blocked(Polygon(boxes[i]), None, TAB_CLEAR_MM))),
+                          None)
+            cells = _box_cells(boxes)
+            got, j = None, 0
+            while j < len(order):
+                j, status = first_clear_box(boxes, order, j, cells, LABEL_PAD_MM, a.pts, a.ring_ptr, a.cells,
+                                            a.has_ring, a.n, b.pts, b.ring_ptr, b.cells, b.has_ring, b.n,
+                                            TAB_CLEAR_MM, OVERLAP_MM2, *labels.room.obstacle_table())
+                if status < 0:
+                    break
+                i = int(order[j])
+                j += 1
+                asked += status == 1
+                if status == 0 or not (labels._hits(boxes[i]) or
+                                       labels.room.blocked(Polygon(boxes[i]), None, TAB_CLEAR_MM)):
+                    got = i
+                    break
+            assert got == expect
+            found += got is not None
+    assert 0.2 < found / 400 < 0.95  # spots found and not
+    assert 0 < asked < 100  # the MultiPolygon strip (and unsure answers) went to Python, little else
+
+
+def test_first_box_in_triangle_takes_the_box_inside_triangle_and_hits_take():
+    import math
+
+    from polyfold.fabricate.labels import LABEL_PAD_MM, _box_cells, inside_triangle, text_boxes
+    from polyfold.fabricate.overlap_kernels import first_box_in_triangle
+
+    rng = np.random.default_rng(12)
+    found = 0
+    for trial in range(40):
+        labels = _crowded_piece(rng)
+        a, b = labels.boxes.rings, labels.strips.rings
+        for _ in range(10):
+            tri = rng.uniform(-4.0, 28.0, 2) + rng.normal(0.0, 8.0, (3, 2))
+            turn = rng.uniform(0, np.pi)
+            boxes = text_boxes(tri.mean(axis=0) + rng.normal(0.0, 1.5, (6, 2)), np.array([np.cos(turn), np.sin(turn)]),
+                               "45", 1.5)
+            expect = next((i for i in range(6) if inside_triangle(tri, boxes[i], LABEL_PAD_MM)
+                           and not labels._hits(boxes[i])), None)
+            lengths = np.array([math.hypot(*(tri[(k + 1) % 3] - tri[k])) for k in range(3)])
+            cells = _box_cells(boxes)
+            got, i = None, 0
+            while i < 6:
+                k, status = first_box_in_triangle(boxes[i:], tri, lengths, LABEL_PAD_MM, cells[i:], LABEL_PAD_MM,
+                                                  a.pts, a.ring_ptr, a.cells, a.has_ring, a.n,
+                                                  b.pts, b.ring_ptr, b.cells, b.has_ring, b.n)
+                i += int(k)
+                if status < 0:
+                    break
+                if status == 0 or not labels._hits(boxes[i]):
+                    got = i
+                    break
+                i += 1
+            assert got == expect
+            found += got is not None
+    assert 0.1 < found / 400 < 0.9

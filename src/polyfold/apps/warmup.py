@@ -103,11 +103,12 @@ def _warm_crowded_labels() -> None:
 
 
 def _warm_label_sides() -> None:
-    """The test of spots beside an edge (`labels.PieceLabels._nearest_to`: nearer it than the
-    piece's other cut sides), on a triangle."""
+    """The tests of spots beside an edge (`labels.PieceLabels._nearest_to`: nearer it than the
+    piece's other cut sides; `_outside`'s compiled test of its spots; `_hits`), on a triangle
+    too small for its labels."""
     from shapely.geometry import Polygon
 
-    from ..fabricate.labels import PieceLabels
+    from ..fabricate.labels import PieceLabels, text_box
     from ..fabricate.tabs import CutSide, Room
 
     tri = np.array([[0.0, 0.0], [10.0, 0.0], [5.0, 8.0]])
@@ -115,6 +116,9 @@ def _warm_label_sides() -> None:
     labels = PieceLabels(Room(np.array([Polygon(tri)], dtype=object)), 2.0,
                          np.stack([tri, np.roll(tri, -1, axis=0)], axis=1))
     labels._nearest_to(tri - [0.0, 1.0], side)
+    for text in ("12345", "12345"):  # beside the edge (there is no room in the face), then next to that
+        labels.edge(side, text)
+    labels._hits(text_box(np.array([5.0, -1.0]), np.array([1.0, 0.0]), "1", 2.0))
 
 
 def _warm_fold(mesh) -> None:

@@ -38,9 +38,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..jit import njit
+from .overlap_kernels import first_box_in_triangle, first_clear_box
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT
-from .tabs import TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
+from .tabs import OVERLAP_MM2, TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
 
 PIECE_FONT_MAX_MM = 6.0  # a piece's name may be larger, up to this, where its face has room
 LABEL_PAD_MM = 0.25  # gap between a label's glyph box and any line or other label
@@ -118,16 +119,59 @@ def inside_triangle(tri: np.ndarray, pts: np.ndarray, pad: float) -> bool:
     return True
 
 
+def _box_cells(boxes: np.ndarray) -> np.ndarray:
+    """(k, 4) `_cell_range` of each box (k, m, 2)'s corners, as `_Boxes._keys` finds them."""
+    lo, hi = np.floor_divide(boxes.min(axis=1), CELL_MM), np.floor_divide(boxes.max(axis=1), CELL_MM)
+    return np.stack([lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1]], axis=1).astype(np.int64)
+
+
+class _Rings:
+    """Every geometry placed in a `_Boxes`, as `overlap_kernels.first_clear_box` reads them: the
+    points of each one's ring (`pts`, `ring_ptr`; none and has_ring False for a geometry that is
+    not one simple polygon) and the range of hash cells it was put in (`cells`: first and last
+    column, first and last row). Arrays grow by doubling; the first n rows are the items."""
+
+    def __init__(self) -> None:
+        self.pts, self.ring_ptr = np.zeros((16, 2)), np.zeros(9, dtype=np.int64)
+        self.cells, self.has_ring = np.zeros((8, 4), dtype=np.int64), np.zeros(8, dtype=bool)
+        self.n = self.n_pts = 0
+
+    def add(self, ring: np.ndarray | None, cells: tuple[int, int, int, int]) -> None:
+        k = 0 if ring is None else len(ring)
+        if self.n_pts + k > len(self.pts):
+            self.pts = np.concatenate([self.pts, np.zeros((max(self.n_pts + k, 2 * len(self.pts)) - len(self.pts), 2))])
+        if self.n + 1 >= len(self.cells):
+            more = len(self.cells)
+            self.cells = np.concatenate([self.cells, np.zeros((more, 4), dtype=np.int64)])
+            self.has_ring = np.concatenate([self.has_ring, np.zeros(more, dtype=bool)])
+            self.ring_ptr = np.concatenate([self.ring_ptr, np.zeros(more, dtype=np.int64)])
+        if k:
+            self.pts[self.n_pts:self.n_pts + k] = ring
+        self.n_pts += k
+        self.cells[self.n] = cells
+        self.has_ring[self.n] = ring is not None
+        self.n += 1
+        self.ring_ptr[self.n] = self.n_pts
+
+
+def _cell_range(x0: float, y0: float, x1: float, y1: float) -> tuple[int, int, int, int]:
+    """First and last column, first and last row of the CELL_MM hash cells a box with these
+    bounds lies in."""
+    return int(x0 // CELL_MM), int(x1 // CELL_MM), int(y0 // CELL_MM), int(y1 // CELL_MM)
+
+
 @dataclass(eq=False)
 class _Boxes:
-    """Label boxes placed on one piece, in a spatial hash of CELL_MM cells."""
+    """Label boxes placed on one piece, in a spatial hash of CELL_MM cells (and in `rings`, for
+    compiled tests)."""
 
     cells: dict = field(default_factory=dict)
     count: int = 0  # boxes placed (their ids)
+    rings: _Rings = field(default_factory=_Rings)
 
     def _keys(self, box: np.ndarray):
         xs, ys = box[:, 0].tolist(), box[:, 1].tolist()  # (Python's min of a few floats: no numpy call)
-        x0, x1, y0, y1 = (int(v // CELL_MM) for v in (min(xs), max(xs), min(ys), max(ys)))
+        x0, x1, y0, y1 = _cell_range(min(xs), min(ys), max(xs), max(ys))
         return [(i, j) for i in range(x0, x1 + 1) for j in range(y0, y1 + 1)]
 
     def at(self, corners: np.ndarray) -> list:
@@ -172,6 +216,7 @@ class _Boxes:
         self.count += 1
         for key in self._keys(np.array([[x0, y0], [x1, y1]])):
             self.cells.setdefault(key, []).append(item)
+        self.rings.add(ring, _cell_range(x0, y0, x1, y1))
 
 
 def _grown_box_hits(box: np.ndarray, near: list) -> bool:
@@ -713,13 +758,27 @@ class PieceLabels:
         u = _reading(d / length)
         n_out = side.outward()
         h = CAP_HEIGHT * s
-        ts = (0.5, 0.35, 0.65, 0.2, 0.8)
-        inside = [side.p0 + t * d - n_out * (1.2 * LABEL_PAD_MM + h / 2) for t in ts] + [_incentre(side.tri)]
-        for center in inside:  # 1. inside the face
-            box = text_box(center, u, text, s)
-            if inside_triangle(side.tri, box, LABEL_PAD_MM) and not self._hits(box):
-                self._put(text, center, u, s, "edge-label", box)
+        # 1. inside the face: the first of these spots whose box fits (a compiled test; a box
+        # whose labels around it that cannot tell is asked here)
+        inside = np.concatenate([side.p0 + _ALONG[:, None] * d - n_out * (1.2 * LABEL_PAD_MM + h / 2),
+                                 _incentre(side.tri)[None]])
+        boxes = text_boxes(inside, u, text, s)
+        cells = _box_cells(boxes)
+        tri = side.tri
+        lengths = np.array([math.hypot(*(tri[(k + 1) % 3] - tri[k])) for k in range(3)])
+        a, b = self.boxes.rings, self.strips.rings
+        i = 0
+        while i < len(boxes):
+            k, status = first_box_in_triangle(boxes[i:], tri, lengths, LABEL_PAD_MM, cells[i:], LABEL_PAD_MM,
+                                              a.pts, a.ring_ptr, a.cells, a.has_ring, a.n,
+                                              b.pts, b.ring_ptr, b.cells, b.has_ring, b.n)
+            i += int(k)
+            if status < 0:
+                break
+            if status == 0 or not self._hits(boxes[i]):
+                self._put(text, inside[i], u, s, "edge-label", boxes[i])
                 return True
+            i += 1
         if self._on_tab(text, u, tab_parts, tab_folds, n_out, h):
             self.stats.on_tabs += 1
             return True
@@ -753,9 +812,26 @@ class PieceLabels:
         boxes = text_boxes(centers, u, text, self.size)
         polys = shapely.polygons(boxes)
         ok &= shapely.contains(self.allowed, polys)
-        for i in np.flatnonzero(ok).tolist():
+        order = np.flatnonzero(ok)
+        if not len(order):
+            return False
+        # the boxes' hash cells (as `_Boxes._keys` finds them), then spot by spot, in order, the
+        # first clear of labels and leaders and not blocked in the room (a compiled test; the
+        # few it cannot tell are asked here)
+        cells = _box_cells(boxes)
+        a, b = self.boxes.rings, self.strips.rings
+        table = self.room.obstacle_table()
+        j = 0
+        while j < len(order):
+            j, status = first_clear_box(boxes, order, j, cells, LABEL_PAD_MM, a.pts, a.ring_ptr, a.cells, a.has_ring,
+                                        a.n, b.pts, b.ring_ptr, b.cells, b.has_ring, b.n, TAB_CLEAR_MM, OVERLAP_MM2,
+                                        *table)
+            if status < 0:
+                return False
+            i = int(order[j])
+            j += 1
             center, box, poly = centers[i], boxes[i], polys[i]
-            if self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM):
+            if status == 1 and (self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
                 continue
             extra = [poly]
             if leader[i]:

@@ -212,15 +212,22 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
     one of its sides; -1 when neither tells for some ring and none overlaps (a ring touching it,
     or near it across a corner)."""
+    return _grown_box_meets(box, pad, pts, ring_ptr, np.arange(ring_ptr.shape[0] - 1))
+
+
+@njit(cache=True)
+def _grown_box_meets(box, pad, pts, ring_ptr, rings):
+    """`grown_box_meets` for the rings whose indices are `rings` (the answer does not depend on
+    their order: 1 as soon as one overlaps, else -1 when one was unsure)."""
     window = offset_bounds(box, pad)[0]
     k = window.shape[0]
     sign = 1.0 if _orientation(window) >= 0 else -1.0
     longest = 0
-    for r in range(ring_ptr.shape[0] - 1):
+    for r in rings:
         longest = max(longest, ring_ptr[r + 1] - ring_ptr[r])
     bufs = np.empty((2, 4 * (longest + k) + 16, 2))
     unsure = False
-    for r in range(ring_ptr.shape[0] - 1):
+    for r in rings:
         lo, hi = ring_ptr[r], ring_ptr[r + 1]
         apart = False
         for e in range(k):
@@ -246,3 +253,136 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
             return 1
         unsure = True
     return -1 if unsure else 0
+
+
+@njit(cache=True)
+def _near_cells(cells, has_ring, n, cx0, cx1, cy0, cy1, out):
+    """How many of the first n items (cells (n, 4): first and last column, first and last row of
+    the hash cells they lie in) share a cell with the range cx0..cx1, cy0..cy1, their indices
+    written to out; -1 when one of them has no ring (`has_ring` False)."""
+    m = 0
+    for t in range(n):
+        if cells[t, 0] <= cx1 and cx0 <= cells[t, 1] and cells[t, 2] <= cy1 and cy0 <= cells[t, 3]:
+            if not has_ring[t]:
+                return -1
+            out[m] = t
+            m += 1
+    return m
+
+
+@njit(cache=True)
+def _meets_labels(box, cx0, cx1, cy0, cy1, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
+                  b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, near_a, near_b):
+    """Whether the box (4, 2) in hash cells cx0..cx1, cy0..cy1, grown by `pad`, meets a label
+    shape of set a or b sharing a cell with it (see `first_clear_box`): 1 yes, 0 no, -1 when this
+    cannot tell (an item near it without a ring, or `grown_box_meets` unsure)."""
+    na = _near_cells(a_cells, a_has_ring, a_n, cx0, cx1, cy0, cy1, near_a)
+    nb = _near_cells(b_cells, b_has_ring, b_n, cx0, cx1, cy0, cy1, near_b)
+    if na < 0 or nb < 0:
+        return -1
+    unsure = False
+    if na > 0:
+        hit = _grown_box_meets(box, pad, a_pts, a_ring_ptr, near_a[:na])
+        if hit == 1:
+            return 1
+        unsure = hit < 0
+    if nb > 0:
+        hit = _grown_box_meets(box, pad, b_pts, b_ring_ptr, near_b[:nb])
+        if hit == 1:
+            return 1
+        unsure = unsure or hit < 0
+    return -1 if unsure else 0
+
+
+@njit(cache=True)
+def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
+                    b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, clear, least, pts, ring_ptr, ring_sign, obs_ptr,
+                    face_bounds, extra_bounds, n_extras):
+    """The first position j >= start of `order` whose box boxes[order[j]] (4, 2 corners, convex)
+    neither meets, grown by `pad` (`grown_box_meets`), a ring of two hashed sets of label shapes
+    near it (a: rings a_pts[a_ring_ptr[t]:a_ring_ptr[t + 1]] of the first a_n items, each in the
+    hash cells a_cells[t] (first, last column; first, last row); b alike), nor is `blocked_by` the
+    obstacles of a piece's table (pts .. obs_ptr: the module docstring) whose bounds (x0, y0,
+    x1, y1) meet its own grown by `clear`: the faces (face_bounds (F, 4), obstacles 0..F-1),
+    then the first n_extras extras (extra_bounds, obstacles F..). The labels near a box are those
+    sharing a hash cell with it (box_cells[i], as the items'). As (j, 0); (j, 1) when that box is
+    one these tests cannot tell (an item without a ring near it, or an unsure answer: the caller
+    decides it); (len(order), -1) when none is clear."""
+    no_discs = np.zeros((0, 1, 2))
+    no_ring = np.zeros((0, 2))
+    near_a = np.empty(a_n, dtype=np.int64)
+    near_b = np.empty(b_n, dtype=np.int64)
+    n_faces = face_bounds.shape[0]
+    obstacles = np.empty(n_faces + n_extras, dtype=np.int64)
+    for j in range(start, order.shape[0]):
+        i = order[j]
+        box = np.ascontiguousarray(boxes[i])
+        hit = _meets_labels(box, box_cells[i, 0], box_cells[i, 1], box_cells[i, 2], box_cells[i, 3], pad,
+                            a_pts, a_ring_ptr, a_cells, a_has_ring, a_n, b_pts, b_ring_ptr, b_cells, b_has_ring, b_n,
+                            near_a, near_b)
+        if hit == 1:
+            continue
+        if hit < 0:
+            return j, 1
+        x0, y0 = min(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), min(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
+        x1, y1 = max(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), max(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
+        x0, y0, x1, y1 = x0 - clear, y0 - clear, x1 + clear, y1 + clear
+        m = 0
+        for f in range(n_faces):
+            if face_bounds[f, 0] <= x1 and x0 <= face_bounds[f, 2] and face_bounds[f, 1] <= y1 and y0 <= face_bounds[f, 3]:
+                obstacles[m] = f
+                m += 1
+        for e in range(n_extras):
+            if extra_bounds[e, 0] <= x1 and x0 <= extra_bounds[e, 2] and extra_bounds[e, 1] <= y1 and y0 <= extra_bounds[e, 3]:
+                obstacles[m] = n_faces + e
+                m += 1
+        if m == 0:
+            return j, 0
+        answer = blocked_by(box, clear, no_discs, no_ring, least, pts, ring_ptr, ring_sign, obs_ptr, obstacles[:m])
+        if answer == 1:
+            continue
+        if answer == 0:
+            return j, 0
+        return j, 1
+    return order.shape[0], -1
+
+
+@njit(cache=True)
+def first_box_in_triangle(boxes, tri, side_lengths, inset, box_cells, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
+                          b_pts, b_ring_ptr, b_cells, b_has_ring, b_n):
+    """The first index i of boxes (k, 4, 2) whose corners all lie inside the triangle `tri`
+    (3, 2), either orientation, at least `inset` from its sides (as `labels.inside_triangle`
+    computes it; side_lengths (3,): Python's math.hypot of sides ab, bc, ca, which numba's may
+    differ from in the last bit), and which meets no label shape near it grown by `pad` (`first_clear_box`'s a
+    and b): (i, 0); (i, 1) when the labels' test cannot tell for that box (the caller decides);
+    (k, -1) when none."""
+    near_a = np.empty(a_n, dtype=np.int64)
+    near_b = np.empty(b_n, dtype=np.int64)
+    ax, ay, bx, by, cx, cy = tri[0, 0], tri[0, 1], tri[1, 0], tri[1, 1], tri[2, 0], tri[2, 1]
+    area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    sgn = 1.0 if area2 > 0 else -1.0
+    for i in range(boxes.shape[0]):
+        inside = True
+        for s in range(3):
+            px, py = tri[s, 0], tri[s, 1]
+            ex, ey = tri[(s + 1) % 3, 0] - px, tri[(s + 1) % 3, 1] - py
+            ln = side_lengths[s]
+            if ln == 0:
+                return boxes.shape[0], -1
+            for c in range(boxes.shape[1]):
+                if sgn * (ex * (boxes[i, c, 1] - py) - ey * (boxes[i, c, 0] - px)) / ln < inset:
+                    inside = False
+                    break
+            if not inside:
+                break
+        if not inside:
+            continue
+        box = np.ascontiguousarray(boxes[i])
+        hit = _meets_labels(box, box_cells[i, 0], box_cells[i, 1], box_cells[i, 2], box_cells[i, 3], pad,
+                            a_pts, a_ring_ptr, a_cells, a_has_ring, a_n, b_pts, b_ring_ptr, b_cells, b_has_ring, b_n,
+                            near_a, near_b)
+        if hit == 0:
+            return i, 0
+        if hit < 0:
+            return i, 1
+    return boxes.shape[0], -1

@@ -185,6 +185,7 @@ class Room:
 
     faces: np.ndarray  # shapely Polygons, one per face
     tree: object = field(init=False)
+    face_bounds: np.ndarray = field(init=False)  # (F, 4) x0, y0, x1, y1 of every face
     key: bytes = field(init=False)
     extra: list = field(default_factory=list)
     _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
@@ -196,6 +197,7 @@ class Room:
 
         self.tree = shapely.STRtree(self.faces)
         self._table = _Obstacles(self.faces)
+        self.face_bounds = np.ascontiguousarray(shapely.bounds(self.faces), dtype=float).reshape(-1, 4)
         digest = hashlib.blake2b(np.ascontiguousarray(shapely.get_num_coordinates(self.faces)).tobytes(),
                                  digest_size=16)
         digest.update(np.ascontiguousarray(shapely.get_coordinates(self.faces)).tobytes())
@@ -220,6 +222,16 @@ class Room:
             digest.update(shapely.to_wkb(g))
         self.key = digest.digest()
         self._bounds_array = None
+
+    def obstacle_table(self) -> tuple:
+        """What `overlap_kernels.first_clear_box` reads of the room: its obstacles' table (points,
+        ring pointers and signs, obstacle pointers), the faces' bounds (F, 4), the extras'
+        bounds (E, 4) and E."""
+        t = self._table
+        if self._bounds_array is None:
+            self._bounds_array = np.asarray(self._bounds, dtype=float).reshape(-1, 4)
+        return (t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._bounds_array,
+                len(self._bounds))
 
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
