@@ -186,3 +186,21 @@ def test_periscope2_seed_1_gets_a_path_both_checkers_accept(models_dir):
     assert check.ok, check.why()
     assert check_path(fold).ok
     assert check_path(fold, tol_rel=1e-5).first_collision is None
+
+
+@pytest.mark.parametrize("moves", [
+    [(30.0, 0.0), (60.0, 0.0), (120.0, 0.0), (179.9999, 0.0), (179.9999, -179.9999)],  # collides last
+    [(179.9999, 0.0), (179.9999, -179.9999), (179.9999, -90.0), (179.9999, -30.0), (179.9999, 0.0)],  # first
+    [(30.0, -20.0), (60.0, -40.0), (90.0, -60.0), (60.0, -30.0), (0.0, 0.0)],  # no collision
+])
+def test_a_path_checked_in_two_processes_gets_the_same_verdict(monkeypatch, moves):
+    import polyfold.verify.paths as paths
+    from polyfold.processes import beside
+
+    fold = _strip(_frames((0.0, 0.0), *moves))
+    fold["edges_foldAngle"] = fold["polyfold:path"][-1]
+    alone = check_fold_path(fold, thickness=1e-3)
+    monkeypatch.setattr(paths, "PARALLEL_CHECK_WORK", 0)  # (any path is long enough to split)
+    split = check_fold_path(fold, thickness=1e-3, side_by_side=beside)
+    assert split == alone
+    assert split.configs > 1

@@ -166,11 +166,14 @@ def plan_checked(fold: dict, tree: FoldTree, *, planner: str, resolution_deg: fl
 
 
 def _checked(fold: dict, path: FoldPath, resolution_deg: float, contact_tol: float, thickness: float):
-    """(the FOLD dict with the path as written, the independent check of it at `thickness`)."""
+    """(the FOLD dict with the path as written, the independent check of it at `thickness`; a
+    long path's halves side by side in two processes where there are two cores)."""
+    from ..processes import beside, usable_cores
     from ..verify.paths import check_fold_path
 
     written = with_path(fold, path, resolution_deg, contact_tol, thickness)
-    return written, check_fold_path(written, thickness=thickness)
+    return written, check_fold_path(written, thickness=thickness,
+                                    side_by_side=beside if usable_cores() > 1 else None)
 
 
 def verify_written(pattern: CreasePattern, path: FoldPath, opts: MakeOptions, thickness: float):

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +49,9 @@ from ..jit import njit
 # rule as the planners' collide.tolerance.EXEMPT_REACH, stated here again: nothing is imported)
 EXEMPT_REACH = 10.0
 CUT = ("B", "C")
+# configurations x faces from which `check_fold_path` checks a path's two halves side by side
+# (a fork costs about 10 ms; a configuration of a 300-face piece about 2 ms)
+PARALLEL_CHECK_WORK = 50_000
 
 
 @dataclass(frozen=True)
@@ -501,14 +505,19 @@ def _diagonal(pts: np.ndarray) -> float:
 
 
 def check_fold_path(fold: dict, step_deg: float | None = None, tol_rel: float | None = None,
-                    thickness: float = 0.0, reach: float | None = None) -> PathCheck:
+                    thickness: float = 0.0, reach: float | None = None,
+                    side_by_side: Callable[[Callable, Callable], tuple] | None = None) -> PathCheck:
     """Re-verify the `polyfold:path` of a FOLD dict (see the module docstring).
 
     step_deg: largest angle change between samples (default: the file's
     `polyfold:path_resolutionDeg`, else 1); tol_rel: contact tolerance relative to the bounding-box
     diagonal of the foldedForm (default: the file's `polyfold:path_contactTol`, else 1e-7);
     thickness: absolute, in the file's units; reach: the exemption radius around shared points
-    (default EXEMPT_REACH x thickness)."""
+    (default EXEMPT_REACH x thickness). side_by_side: a function that runs its two arguments at
+    once and returns both results (polyfold's `processes.beside`, a forked process: given by the
+    caller, as nothing of polyfold is imported here); with it a long path (configurations x faces
+    at least PARALLEL_CHECK_WORK) has its later half of segments checked meanwhile, for the same
+    verdict."""
     step = float(step_deg if step_deg is not None else fold.get("polyfold:path_resolutionDeg", 1.0))
     tol_rel = float(tol_rel if tol_rel is not None else fold.get("polyfold:path_contactTol", 1e-7))
     coords = np.asarray(fold["vertices_coords"], dtype=np.float64)
@@ -556,19 +565,38 @@ def check_fold_path(fold: dict, step_deg: float | None = None, tol_rel: float | 
         if err > 1e-6 * max(scale, 1e-300):
             problems.append(f"the last frame does not rebuild the folded form (off by {err / scale:.2g} of its size)")
             return verdict()
-    configs = 0
-    k, i, j, n = _segment(frames[0], frames[0], 0, 0, len(frames) == 1, *args)
-    configs += n
-    if k >= 0:
-        return verdict((0, 0.0, int(i), int(j)), 0, configs)
-    for s in range(len(frames) - 1):
-        qa, qb = frames[s], frames[s + 1]
-        m = max(1, int(math.ceil(float(np.abs(qb - qa).max()) / step - 1e-9)))
-        k, i, j, n = _segment(qa, qb, m, 1, s == len(frames) - 2, *args)
-        configs += n
-        if k >= 0:
-            return verdict((s, k / m, int(i), int(j)), s + 1, configs)
-    return verdict(None, len(frames) - 1, configs)
+    n_segments = len(frames) - 1
+    samples = [max(1, int(math.ceil(float(np.abs(frames[s + 1] - frames[s]).max()) / step - 1e-9)))
+               for s in range(n_segments)]
+
+    def run(lo: int, hi: int, start: bool) -> tuple[tuple[int, float, int, int] | None, int, int]:
+        """Segments lo..hi-1 (after the first frame when `start`): (the first collision or None,
+        the segments checked up to it, the configurations checked)."""
+        configs = 0
+        if start:
+            k, i, j, n = _segment(frames[0], frames[0], 0, 0, len(frames) == 1, *args)
+            configs += n
+            if k >= 0:
+                return (0, 0.0, int(i), int(j)), 0, configs
+        for s in range(lo, hi):
+            m = samples[s]
+            k, i, j, n = _segment(frames[s], frames[s + 1], m, 1, s == len(frames) - 2, *args)
+            configs += n
+            if k >= 0:
+                return (s, k / m, int(i), int(j)), s + 1, configs
+        return None, hi, configs
+
+    if side_by_side is not None and n_segments > 1 and (1 + sum(samples)) * len(faces) >= PARALLEL_CHECK_WORK:
+        # the later segments meanwhile; their verdict counts only when the earlier ones pass (so it
+        # is the verdict of checking them in order)
+        mid = int(np.searchsorted(np.cumsum(samples), sum(samples) / 2)) + 1
+        mid = min(max(mid, 1), n_segments - 1)
+        (first, segments, configs), (later, later_segments, later_configs) = side_by_side(
+            lambda: run(0, mid, True), lambda: run(mid, n_segments, False))
+        if first is None:
+            first, segments, configs = later, later_segments, configs + later_configs
+        return verdict(first, segments, configs)
+    return verdict(*run(0, n_segments, True))
 
 
 def _goal_error(goal_deg: np.ndarray, tree: _Tree, faces: np.ndarray, folded: np.ndarray) -> float:
