@@ -117,3 +117,78 @@ def test_a_memo_gives_the_tab_choose_tab_gives() -> None:
     blocked = choose_tab((side, side), [crowded, other], memo)
     assert len(memo) == 2
     assert blocked is None and choose_tab((side, side), [crowded, other]) is None
+
+
+def _grid_room(rng: np.random.Generator, shift: float, n: int = 5, cell: float = 4.0):
+    """A jittered n x n grid of cell-mm squares (two triangles each) at x + shift, as a Room,
+    with its triangles and the sides of its outline (CutSides of piece `shift > 0`)."""
+    g = np.stack(np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij"), axis=-1) * cell
+    g[1:-1, 1:-1] += rng.uniform(-1.0, 1.0, (n - 1, n - 1, 2))
+    g[..., 0] += shift
+    tris = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = g[i, j], g[i + 1, j], g[i + 1, j + 1], g[i, j + 1]
+            tris += [np.array([a, b, c]), np.array([a, c, d])]
+    piece = int(shift > 0)
+    sides = []
+    for f, tri in enumerate(tris):
+        for k in range(3):
+            p0, p1 = tri[k], tri[(k + 1) % 3]
+            mid = (p0 + p1) / 2 - [shift, 0.0]
+            if min(mid.min(), n * cell - mid.max()) < 1e-9:  # on the grid's outline
+                sides.append(CutSide(piece, f, k, p0, p1, tri))
+    return Room(np.array([Polygon(t) for t in tris], dtype=object)), sides
+
+
+def test_choose_tab_takes_the_tab_the_one_by_one_rule_takes(monkeypatch):
+    # random crowded rooms (tabs already placed along the outline): the variants tried on both
+    # sides at once by a compiled test, and clipped tabs skipped when the obstacles' area alone
+    # leaves too little glue, give the tab of trying each variant with Room.blocked, in order,
+    # then clipping both sides in full
+    import polyfold.fabricate.overlap_kernels as kernels
+    from polyfold.fabricate.tabs import _CIRCLE, TAB_MIN_MM, _clipped, _choose_tab, _area, tab_polygon
+
+    def one_by_one(sides, rooms):
+        for depth_kind, side_deg, reason in TAB_VARIANTS:
+            for s, side in enumerate(sides):
+                depth = full_depth(side.length) if depth_kind == "full" else TAB_MIN_MM
+                if depth_kind == "min" and depth >= full_depth(side.length):
+                    continue
+                poly = tab_polygon(side, depth, side_deg)
+                ends = np.stack([side.p0, side.p1])[:, None, :] + 2 * TAB_CLEAR_MM * _CIRCLE
+                if poly is not None and Polygon(poly).is_valid and not rooms[side.piece].blocked(
+                        Polygon(poly), side.face, TAB_CLEAR_MM, lambda ends=ends: ends):
+                    return ("whole", s, reason, poly)
+        with monkeypatch.context() as m:
+            m.setattr(kernels, "overlap_area", lambda *args: np.nan)  # (no shortcut)
+            clipped = [t for s, side in enumerate(sides) if (t := _clipped(s, side, rooms[side.piece])) is not None]
+        best = max(clipped, key=_area, default=None)
+        return None if best is None else ("clipped", best.side, best.reason, np.concatenate(best.polygons))
+
+    rng = np.random.default_rng(3)
+    kinds = []
+    for trial in range(30):
+        (room0, sides0), (room1, sides1) = _grid_room(rng, 0.0), _grid_room(rng, 100.0)
+        rooms = [room0, room1]
+        for room, sides in ((room0, sides0), (room1, sides1)):
+            for side in sides:
+                if rng.random() < 0.4:  # a tab (or label) already beside some of the outline
+                    n = side.outward()
+                    off = rng.uniform(0.2, 4.0)
+                    w = rng.uniform(0.5, 3.0)
+                    at = side.p0 + rng.uniform(0.0, 1.0) * (side.p1 - side.p0) + n * off
+                    u = (side.p1 - side.p0) / side.length
+                    room.add([Polygon([at - u * w, at + u * w, at + u * w + n * w, at - u * w + n * w])])
+        for _ in range(15):
+            pair = (sides0[rng.integers(len(sides0))], sides1[rng.integers(len(sides1))])
+            got = _choose_tab(pair, rooms)
+            expect = one_by_one(pair, rooms)
+            if expect is None:
+                assert got is None
+            else:
+                kind, s, reason, poly = expect
+                assert got is not None and (got.side, got.reason) == (s, reason)
+                assert np.array_equal(np.concatenate(got.polygons), poly)
+            kinds.append("none" if expect is None else expect[0])
+    assert {"none", "whole", "clipped"} <= set(kinds)

@@ -192,7 +192,7 @@ def _warm_tabs(mesh) -> None:
     labels all fit in their faces, so `_warm_label_sides` is left to a make that needs it)."""
     from shapely.geometry import Polygon
 
-    from ..fabricate.labels import _Boxes, text_box
+    from ..fabricate.labels import PieceLabels, _Boxes, text_box
     from ..fabricate.tabs import TAB_CLEAR_MM, CutSide, Room, choose_tab
 
     boxes = _Boxes()
@@ -204,6 +204,10 @@ def _warm_tabs(mesh) -> None:
     side = CutSide(0, 0, 0, tri[0], tri[1], tri)
     choose_tab((side, side), [room])
     room.blocked(Polygon(tri + [0.0, -1.0]), None, TAB_CLEAR_MM)
+    # a face in the tab's way: a clipped tab (`tabs._clipped`), then a label in the face
+    spike = np.array([[4.5, -0.5], [5.5, -0.5], [5.0, -15.0]])
+    choose_tab((side, side), [Room(np.array([Polygon(tri), Polygon(spike)], dtype=object))])
+    PieceLabels(room, 2.0, np.stack([tri, np.roll(tri, -1, axis=0)], axis=1)).edge(side, "1")
 
 
 def _warm_fold_plan(mesh) -> None:

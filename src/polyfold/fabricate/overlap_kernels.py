@@ -327,15 +327,7 @@ def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_ce
         x0, y0 = min(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), min(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
         x1, y1 = max(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), max(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
         x0, y0, x1, y1 = x0 - clear, y0 - clear, x1 + clear, y1 + clear
-        m = 0
-        for f in range(n_faces):
-            if face_bounds[f, 0] <= x1 and x0 <= face_bounds[f, 2] and face_bounds[f, 1] <= y1 and y0 <= face_bounds[f, 3]:
-                obstacles[m] = f
-                m += 1
-        for e in range(n_extras):
-            if extra_bounds[e, 0] <= x1 and x0 <= extra_bounds[e, 2] and extra_bounds[e, 1] <= y1 and y0 <= extra_bounds[e, 3]:
-                obstacles[m] = n_faces + e
-                m += 1
+        m = _room_obstacles(x0, y0, x1, y1, -1, face_bounds, extra_bounds, n_extras, obstacles)
         if m == 0:
             return j, 0
         answer = blocked_by(box, clear, no_discs, no_ring, least, pts, ring_ptr, ring_sign, obs_ptr, obstacles[:m])
@@ -386,3 +378,61 @@ def first_box_in_triangle(boxes, tri, side_lengths, inset, box_cells, pad, a_pts
         if hit < 0:
             return i, 1
     return boxes.shape[0], -1
+
+
+@njit(cache=True)
+def _room_obstacles(x0, y0, x1, y1, skip_face, face_bounds, extra_bounds, n_extras, out):
+    """How many obstacles of a room (faces but skip_face, then extras: numbered as `blocked_by`'s
+    table) have bounds (x0, y0, x1, y1) meeting the box x0..x1, y0..y1 (edges included), written
+    to out in that order."""
+    m = 0
+    n_faces = face_bounds.shape[0]
+    for f in range(n_faces):
+        if f != skip_face and face_bounds[f, 0] <= x1 and x0 <= face_bounds[f, 2] and face_bounds[f, 1] <= y1 \
+                and y0 <= face_bounds[f, 3]:
+            out[m] = f
+            m += 1
+    for e in range(n_extras):
+        if extra_bounds[e, 0] <= x1 and x0 <= extra_bounds[e, 2] and extra_bounds[e, 1] <= y1 and y0 <= extra_bounds[e, 3]:
+            out[m] = n_faces + e
+            m += 1
+    return m
+
+
+@njit(cache=True)
+def first_unblocked(polys, side_of, skip_faces, discs, clear, least,
+                    pts0, ring_ptr0, ring_sign0, obs_ptr0, face_bounds0, extra_bounds0, n_extras0,
+                    pts1, ring_ptr1, ring_sign1, obs_ptr1, face_bounds1, extra_bounds1, n_extras1):
+    """The first of the convex polygons polys (k, m, 2) not `blocked_by` the room of its side
+    (side_of[c], 0 or 1: a glued pair's two sides, each with its room's table, faces' and
+    extras' bounds as `first_clear_box` takes them): the room's obstacles whose bounds meet the
+    polygon's grown by `clear`, but face skip_faces[side], measured outside the side's discs
+    (discs[side]: (d, n, 2) convex rings). As (c, 0); (c, 1) when `blocked_by` cannot tell for
+    it (the caller asks `tabs.Room.blocked`); (k, -1) when every one is blocked."""
+    no_ring = np.zeros((0, 2))
+    out0 = np.empty(face_bounds0.shape[0] + n_extras0, dtype=np.int64)
+    out1 = np.empty(face_bounds1.shape[0] + n_extras1, dtype=np.int64)
+    for c in range(polys.shape[0]):
+        ring = np.ascontiguousarray(polys[c])
+        x0, y0, x1, y1 = ring[0, 0], ring[0, 1], ring[0, 0], ring[0, 1]
+        for i in range(1, ring.shape[0]):
+            x0, y0 = min(x0, ring[i, 0]), min(y0, ring[i, 1])
+            x1, y1 = max(x1, ring[i, 0]), max(y1, ring[i, 1])
+        x0, y0, x1, y1 = x0 - clear, y0 - clear, x1 + clear, y1 + clear
+        s = side_of[c]
+        if s == 0:
+            m = _room_obstacles(x0, y0, x1, y1, skip_faces[0], face_bounds0, extra_bounds0, n_extras0, out0)
+            if m == 0:
+                return c, 0
+            answer = blocked_by(ring, clear, discs[0], no_ring, least, pts0, ring_ptr0, ring_sign0, obs_ptr0, out0[:m])
+        else:
+            m = _room_obstacles(x0, y0, x1, y1, skip_faces[1], face_bounds1, extra_bounds1, n_extras1, out1)
+            if m == 0:
+                return c, 0
+            answer = blocked_by(ring, clear, discs[1], no_ring, least, pts1, ring_ptr1, ring_sign1, obs_ptr1, out1[:m])
+        if answer == 1:
+            continue
+        if answer == 0:
+            return c, 0
+        return c, 1
+    return polys.shape[0], -1

@@ -95,13 +95,23 @@ def full_depth(length: float) -> float:
 def tab_polygon(side: CutSide, depth: float, side_deg: float) -> np.ndarray | None:
     """Trapezoid (4, 2) = (base start, top, top, base end) outside the face, `depth` mm deep, its
     sides at `side_deg` to the base or steeper, so the top keeps 10 % of the edge."""
+    polys = tab_polygons(side, [(depth, side_deg)])
+    return None if polys is None else polys[0]
+
+
+def tab_polygons(side: CutSide, shapes: list[tuple[float, float]]) -> np.ndarray | None:
+    """(k, 4, 2) `tab_polygon` of each (depth, side_deg) of shapes at once; None on a side
+    shorter than 1e-9 mm."""
     length = side.length
     if length < 1e-9:
         return None
     u = (side.p1 - side.p0) / length
     n = side.outward()
-    inset = min(depth / math.tan(math.radians(side_deg)), 0.45 * length)
-    return np.array([side.p0, side.p0 + u * inset + n * depth, side.p1 - u * inset + n * depth, side.p1])
+    depth = np.array([d for d, _deg in shapes])[:, None]
+    inset = np.array([min(d / math.tan(math.radians(deg)), 0.45 * length) for d, deg in shapes])[:, None]
+    out = np.empty((len(shapes), 4, 2))
+    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = side.p0, side.p0 + u * inset + n * depth, side.p1 - u * inset + n * depth, side.p1
+    return out
 
 
 def _rings(geom) -> list[tuple[np.ndarray, float]]:
@@ -233,9 +243,18 @@ class Room:
         return (t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._bounds_array,
                 len(self._bounds))
 
+    def obstacle_ids(self, region, skip_face: int | None = None) -> np.ndarray:
+        """The obstacles whose bounds meet `region`'s, as the table numbers them (faces, but
+        `skip_face`, then len(faces) + the extras' indices)."""
+        faces = self.tree.query(region)
+        if skip_face is not None:
+            faces = faces[faces != skip_face]
+        return np.concatenate([faces, len(self.faces) + self._extras_near(region)]).astype(np.int64)
+
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
-        return [self.faces[i] for i in self.tree.query(region) if i != skip_face] + self.extras_near(region)
+        n = len(self.faces)
+        return [self.faces[i] if i < n else self.extra[i - n] for i in self.obstacle_ids(region, skip_face).tolist()]
 
     def _extras_near(self, region) -> np.ndarray:
         """Indices of the extras whose bounds meet `region`'s."""
@@ -332,13 +351,23 @@ def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
     import shapely
     from shapely.geometry import Polygon
 
+    from .overlap_kernels import overlap_area
+
     full = tab_polygon(side, full_depth(side.length), 45.0)
     if full is None:
         return None
     whole = Polygon(full)
-    near = room.obstacles(whole.buffer(TAB_CLEAR_MM, quad_segs=2), side.face)
+    ids = room.obstacle_ids(whole.buffer(TAB_CLEAR_MM, quad_segs=2), side.face)
+    n = len(room.faces)
+    near = [room.faces[i] if i < n else room.extra[i - n] for i in ids.tolist()]
     rest = whole
     if near:
+        # what is left can be no more than the full tab less the obstacles' area within it (they
+        # never overlap one another): too little glue area is told without the overlays below
+        t = room._table
+        covered = overlap_area(full, _NO_DISCS, t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, ids)
+        if covered == covered and whole.area - covered < MIN_GLUE_FRAC * whole.area - 1e-9:
+            return None
         # grown so the chords of the buffer's arcs and the simplification below keep TAB_CLEAR_MM
         grow = TAB_CLEAR_MM / math.cos(math.pi / 8) + SIMPLIFY_MM
         rest = shapely.difference(whole, shapely.union_all(near).buffer(grow, quad_segs=2))
@@ -383,26 +412,54 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | N
 
 
 def _choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
-    from shapely.geometry import Polygon
+    import shapely
+
+    from .overlap_kernels import first_unblocked
 
     # where a tab's fold line meets the neighbouring faces: near contact expected there (the discs
-    # around a side's ends, made the first time a tab on that side comes near something)
-    @functools.cache
+    # around a side's ends)
     def corners(s: int) -> np.ndarray:
         return np.stack([sides[s].p0, sides[s].p1])[:, None, :] + 2 * TAB_CLEAR_MM * _CIRCLE
 
-    for depth_kind, side_deg, reason in TAB_VARIANTS:
+    # every variant on either side, in order (those that make a valid polygon)
+    shapes: list[list[tuple[float, float, int, str]]] = [[], []]  # per side: (depth, side angle, variant, reason)
+    for v, (depth_kind, side_deg, reason) in enumerate(TAB_VARIANTS):
         for s, side in enumerate(sides):
-            depth = full_depth(side.length) if depth_kind == "full" else TAB_MIN_MM
-            if depth_kind == "min" and depth >= full_depth(side.length):
+            full = full_depth(side.length)
+            depth = full if depth_kind == "full" else TAB_MIN_MM
+            if depth_kind == "min" and depth >= full:
                 continue
-            poly = tab_polygon(side, depth, side_deg)
-            if poly is None:
-                continue
-            tab = Polygon(poly)
-            near_ends = functools.partial(corners, s)
-            if tab.is_valid and not rooms[side.piece].blocked(tab, side.face, TAB_CLEAR_MM, near_ends):
+            shapes[s].append((depth, side_deg, v, reason))
+    tries = []
+    for s, side in enumerate(sides):
+        polys = tab_polygons(side, [(depth, deg) for depth, deg, _v, _r in shapes[s]]) if shapes[s] else None
+        if polys is not None:
+            tries += [(v, s, poly, depth, reason) for (depth, _deg, v, reason), poly in zip(shapes[s], polys)]
+    tries = [t[1:] for t in sorted(tries, key=lambda t: (t[0], t[1]))]
+    if tries:
+        polys = np.array([poly for _s, poly, _d, _r in tries])
+        tries = [t for t, valid in zip(tries, shapely.is_valid(shapely.polygons(polys))) if valid]
+    if tries:
+        # the first that nothing blocks: a compiled test of them all (`Room.blocked` asked for a
+        # tab it cannot tell)
+        polys = np.array([poly for _s, poly, _d, _r in tries])
+        side_of = np.array([s for s, _p, _d, _r in tries], dtype=np.int64)
+        skip = np.array([sides[0].face, sides[1].face], dtype=np.int64)
+        discs = np.stack([corners(0), corners(1)])
+        tables = [rooms[side.piece].obstacle_table() for side in sides]
+        c = 0
+        while c < len(tries):
+            k, status = first_unblocked(polys[c:], side_of[c:], skip, discs, TAB_CLEAR_MM, OVERLAP_MM2,
+                                        *tables[0], *tables[1])
+            c += int(k)
+            if status < 0:
+                break
+            s, poly, depth, reason = tries[c]
+            side = sides[s]
+            if status == 0 or not rooms[side.piece].blocked(shapely.Polygon(poly), side.face, TAB_CLEAR_MM,
+                                                              functools.partial(corners, s)):
                 return Tab(s, (poly,), np.array([[side.p0, side.p1]]), depth, reason)
+            c += 1
     clipped = [tab for s, side in enumerate(sides) if (tab := _clipped(s, side, rooms[side.piece])) is not None]
     return max(clipped, key=_area, default=None)
 
