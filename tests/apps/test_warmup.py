@@ -25,7 +25,10 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
                    "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs",
-                   "fabricate.overlap_kernels.blocked_by", "fabricate.overlap_kernels.grown_box_meets"):
+                   "fabricate.overlap_kernels.blocked_by", "fabricate.overlap_kernels.grown_box_meets",
+                   "fabricate.overlap_kernels.first_clear_box", "fabricate.overlap_kernels.first_box_in_triangle",
+                   "fabricate.overlap_kernels.first_unblocked", "fabricate.overlap_kernels.overlap_area",
+                   "fabricate.labels._path_back", "fabricate.labels._path_turns"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"
 
 

@@ -190,17 +190,70 @@ def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
             want[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
         assert np.array_equal(_box_free(taken, hw, hh), want)
 
-        free, in_faces = ~taken, rng.random((ny, nx)) < 0.5
+        free, other, in_faces = ~taken, rng.random((ny, nx)) < 0.6, rng.random((ny, nx)) < 0.5
         origin = rng.uniform(-50, 50, 2)
         p = origin + rng.uniform(0, 1, 2) * [nx, ny] * FREE_CELL_MM  # (over the raster)
         r0, r1 = sorted(int(v) for v in rng.integers(0, ny, 2))
         c0, c1 = sorted(int(v) for v in rng.integers(0, nx, 2))
         radius2 = float(rng.uniform(0.5, 10.0)) ** 2
-        for inside in (True, False):
-            rows, cols = np.nonzero(free[r0:r1 + 1, c0:c1 + 1] & (in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
+        got_centres, got_d2, counts = _free_cells_near(free, other, in_faces, r0, r1, c0, c1, origin, p, FREE_CELL_MM,
+                                                       radius2)
+        for q, (inside, layer) in enumerate([(True, free), (True, other), (False, free), (False, other)]):
+            rows, cols = np.nonzero(layer[r0:r1 + 1, c0:c1 + 1] & (in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
             centres = origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
             d2 = ((centres - p) ** 2).sum(axis=1)
             near = np.flatnonzero(d2 <= radius2)
-            got_centres, got_d2 = _free_cells_near(free, in_faces, inside, r0, r1, c0, c1, origin, p, FREE_CELL_MM,
-                                                   radius2)
-            assert np.array_equal(got_centres, centres[near]) and np.array_equal(got_d2, d2[near])
+            n = counts[q]
+            assert np.array_equal(got_centres[q, :n], centres[near]) and np.array_equal(got_d2[q, :n], d2[near])
+
+
+def test_bent_leader_kernels_give_the_python_rules_paths():
+    """A bent leader's way back from a found cell (`_path_back`: one step nearer each time, the
+    first of right, down, left, up, then the diagonals) and its turns (`_path_turns`: from each
+    kept point the farthest later one whose stretch, looked up at linspace points, crosses no
+    label cell) against the rules written out in Python, on random rasters."""
+    from polyfold.fabricate.labels import FREE_CELL_MM, LEADER_STEP_MM, _grid_bfs, _path_back, _path_turns
+
+    def back(dist, r, c):
+        path = [(r, c)]
+        while dist[path[-1]] > 0:
+            r, c = path[-1]
+            d = dist[r, c]
+            path.append([(r + dr, c + dc) for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+                         if 0 <= r + dr < dist.shape[0] and 0 <= c + dc < dist.shape[1] and dist[r + dr, c + dc] == d - 1][0])
+        return np.array(path)
+
+    def turns(pts, texts, origin):
+        last = np.array([texts.shape[1] - 1, texts.shape[0] - 1])
+        keep = [0]
+        while keep[-1] < len(pts) - 1:
+            i, j = keep[-1], len(pts) - 1
+            while j > i + 1:
+                t = np.linspace(0.0, 1.0, int(math.ceil(np.linalg.norm(pts[j] - pts[i]) / LEADER_STEP_MM)) + 1)
+                ij = np.clip(((pts[i] + t[:, None] * (pts[j] - pts[i]) - origin) * (1.0 / FREE_CELL_MM)).astype(np.int32),
+                             0, last)
+                if not texts[ij[:, 1], ij[:, 0]].any():
+                    break
+                j -= 1
+            keep.append(j)
+        return np.array(keep)
+
+    rng = np.random.default_rng(21)
+    bent = 0
+    for _ in range(60):
+        ny, nx = (int(v) for v in rng.integers(20, 120, 2))
+        texts = rng.random((ny, nx)) < rng.uniform(0.05, 0.35)
+        sr, sc = int(rng.integers(ny)), int(rng.integers(nx))
+        free = ~texts
+        free[sr, sc] = True
+        dist, found = _grid_bfs(free, sr, sc, 150, (rng.random((1, ny, nx)) < 0.01), 10)
+        origin = rng.uniform(-50, 50, 2)
+        for _k, r, c in found.tolist():
+            path = _path_back(dist, r, c)
+            assert np.array_equal(path, back(dist, r, c))
+            pts = origin + (path[::-1][:, ::-1] + 0.5) * FREE_CELL_MM
+            pts[0] += rng.uniform(-0.1, 0.1, 2)
+            got = _path_turns(np.ascontiguousarray(pts), texts, origin, 1.0 / FREE_CELL_MM, LEADER_STEP_MM)
+            assert np.array_equal(got, turns(pts, texts, origin))
+            bent += len(got) > 2
+    assert bent > 20  # paths with turns, not only straight ones

@@ -92,12 +92,14 @@ def _warm_make(mesh) -> None:
 def _warm_crowded_labels() -> None:
     """The label kernels that only crowded pieces reach (the warm-up's sphere has room for every
     label beside its edge), with the argument types `labels._Taken` gives them."""
-    from ..fabricate.labels import _box_free, _clear_leaders, _free_cells_near, _grid_bfs
+    from ..fabricate.labels import _box_free, _clear_leaders, _free_cells_near, _grid_bfs, _path_back, _path_turns
 
     free = np.ones((8, 8), dtype=bool)
     _clear_leaders(~free, np.zeros(2), 5.0, np.zeros(2), np.ones((3, 2)), np.linspace(0.0, 1.0, 5), 2)
-    _grid_bfs(free, 1, 1, 5, np.ones((1, 8, 8), dtype=bool), 2)
-    _free_cells_near(free, free, True, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, 4.0)
+    dist, _found = _grid_bfs(free, 1, 1, 5, np.ones((1, 8, 8), dtype=bool), 2)
+    _path_back(dist, 3, 3)
+    _path_turns(np.ones((3, 2)), ~free, np.zeros(2), 5.0, 0.4)
+    _free_cells_near(free, free, free, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, 4.0)
     _box_free(~free, 1, 1)
     _warm_label_sides()
 

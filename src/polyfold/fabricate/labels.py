@@ -380,28 +380,97 @@ def _grid_bfs(free, sr, sc, max_steps, ok, want):
 
 
 @njit(cache=True)
-def _free_cells_near(free, in_faces, inside, r0, r1, c0, c1, origin, p, cell, r2):
-    """(centres (k, 2), their squared distances (k,) from p) of the cells of rows r0..r1 and
-    columns c0..c1 (inclusive) that are True in `free` (ny, nx) and in `in_faces` as `inside`
-    says, centre origin + (column or row + 0.5) cell, within squared distance r2 of p, in row
-    order: what numpy's nonzero of the window and that distance test give, to the last bit."""
-    n = (r1 - r0 + 1) * (c1 - c0 + 1)
-    centres = np.empty((n, 2))
-    d2 = np.empty(n)
+def _path_back(dist, r, c):
+    """(n, 2) the cells (row, column) from (r, c) back to the cell at distance 0 of `dist` (ny, nx:
+    `_grid_bfs`'s steps, -1 unreached), each step to the first neighbour one step nearer in the
+    order right, down, left, up, then the diagonals (down-right, down-left, up-right, up-left)."""
+    ny, nx = dist.shape
+    steps = ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+    out = np.empty((dist[r, c] + 1, 2), dtype=np.int64)
+    out[0, 0], out[0, 1] = r, c
     k = 0
+    while dist[r, c] > 0:
+        d = dist[r, c]
+        for dr, dc in steps:
+            rr, cc = r + dr, c + dc
+            if 0 <= rr < ny and 0 <= cc < nx and dist[rr, cc] == d - 1:
+                r, c = rr, cc
+                break
+        k += 1
+        out[k, 0], out[k, 1] = r, c
+    return out
+
+
+@njit(cache=True)
+def _path_turns(pts, texts, origin, inv_cell, step):
+    """Indices of the points of a path pts (n, 2) kept at its turns: from each kept point the
+    farthest later one whose straight stretch crosses no True cell of `texts` (ny, nx), looked up
+    at ceil(length / step) + 1 points spaced as numpy's linspace spaces t from 0 to 1, each in
+    the cell (column, row) = int((point - origin) inv_cell), clipped to the raster (as
+    `_Taken._cells`); the next point when none is."""
+    ny, nx = texts.shape
+    n = pts.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    keep[0] = 0
+    m = 1
+    while keep[m - 1] < n - 1:
+        i = keep[m - 1]
+        j = n - 1
+        while j > i + 1:
+            dx, dy = pts[j, 0] - pts[i, 0], pts[j, 1] - pts[i, 1]
+            count = int(math.ceil(math.sqrt(dx * dx + dy * dy) / step)) + 1
+            delta = 1.0 / (count - 1) if count > 1 else 0.0
+            clear = True
+            for q in range(count):
+                t = 1.0 if (q == count - 1 and count > 1) else q * delta
+                col = np.int32((pts[i, 0] + t * dx - origin[0]) * inv_cell)
+                row = np.int32((pts[i, 1] + t * dy - origin[1]) * inv_cell)
+                col = min(max(col, 0), nx - 1)
+                row = min(max(row, 0), ny - 1)
+                if texts[row, col]:
+                    clear = False
+                    break
+            if clear:
+                break
+            j -= 1
+        keep[m] = j
+        m += 1
+    return keep[:m]
+
+
+@njit(cache=True)
+def _free_cells_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, r2):
+    """The cells of rows r0..r1 and columns c0..c1 (inclusive) within squared distance r2 of p
+    (their centres origin + (column or row + 0.5) cell) that are True in free_a, free_b (ny, nx)
+    and in `in_faces` or not, as four lists: (a, in a face), (b, in a face), (a, off the faces),
+    (b, off the faces), each in row order: (centres (4, m, 2), their squared distances from p
+    (4, m), counts (4,)), what numpy's nonzero of each map's window, the in_faces test and that
+    distance test give, to the last bit."""
+    n = (r1 - r0 + 1) * (c1 - c0 + 1)
+    centres = np.empty((4, n, 2))
+    d2 = np.empty((4, n))
+    counts = np.zeros(4, dtype=np.int64)
     for r in range(r0, r1 + 1):
         y = origin[1] + (r + 0.5) * cell
         dy = y - p[1]
         for c in range(c0, c1 + 1):
-            if free[r, c] and in_faces[r, c] == inside:
-                x = origin[0] + (c + 0.5) * cell
-                dx = x - p[0]
-                dd = dx * dx + dy * dy
-                if dd <= r2:
-                    centres[k, 0], centres[k, 1] = x, y
-                    d2[k] = dd
-                    k += 1
-    return centres[:k], d2[:k]
+            a, b = free_a[r, c], free_b[r, c]
+            if not (a or b):
+                continue
+            x = origin[0] + (c + 0.5) * cell
+            dx = x - p[0]
+            dd = dx * dx + dy * dy
+            if dd > r2:
+                continue
+            off = 0 if in_faces[r, c] else 2
+            for k in range(2):
+                if (a, b)[k]:
+                    q = off + k
+                    i = counts[q]
+                    centres[q, i, 0], centres[q, i, 1] = x, y
+                    d2[q, i] = dd
+                    counts[q] = i + 1
+    return centres, d2, counts
 
 
 @njit(cache=True)
@@ -562,25 +631,32 @@ class _Taken:
                 part = _box_free(np.ascontiguousarray(self.grid[s0:s1 + 1, v0:v1 + 1]), hw, hh)
                 free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
 
-    def free_near(self, p: np.ndarray, w: float, h: float, want: int, inside: bool) -> np.ndarray:
-        """Centres (up to want, 2) of level w x h mm boxes that touch no taken cell and whose
-        leader from p crosses no label, within ELSEWHERE_MM of p, nearest first; centred in a
-        face (`inside`) or off the faces."""
+    def free_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int) -> Iterator[tuple[int, np.ndarray]]:
+        """Centres of level boxes of each of the two sizes (w, h mm) that touch no taken cell and whose
+        leader from p crosses no label, within ELSEWHERE_MM of p: up to `want` per size and place,
+        nearest first, centred in a face (each size in turn), then off the faces (the same), as
+        (index into sizes, centre), each list made when asked for. The raster's window is scanned
+        once for all of them (`_free_cells_near`); nothing may be placed between two asks."""
         self._flush()
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         if self.grid[r0:r1 + 1, c0:c1 + 1].all():
-            return np.zeros((0, 2))
+            return
         p = np.asarray(p, dtype=np.float64)
-        centres, d2 = _free_cells_near(self.free(w, h), self.in_faces, inside, int(r0), int(r1), int(c0), int(c1),
-                                       self.origin, p, FREE_CELL_MM, ELSEWHERE_MM ** 2)
-        near = np.arange(len(d2))
-        if len(near) > LEADER_TRIES:
-            near = np.argpartition(d2, LEADER_TRIES)[:LEADER_TRIES]
-        centres = centres[near[np.argsort(d2[near], kind="stable")]]
-        # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
-        # most) are free; nearest first, until `want` are found
-        return centres[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, centres, _LEADER_T, want)]
-
+        centres, d2, counts = _free_cells_near(self.free(*sizes[0]), self.free(*sizes[1]), self.in_faces, int(r0),
+                                               int(r1), int(c0), int(c1), self.origin, p, FREE_CELL_MM, ELSEWHERE_MM ** 2)
+        for q in range(4):  # in a face first (each size), then off the faces
+            n = int(counts[q])
+            if not n:
+                continue
+            found, dist2 = centres[q, :n], d2[q, :n]
+            near = np.arange(n)
+            if n > LEADER_TRIES:
+                near = np.argpartition(dist2, LEADER_TRIES)[:LEADER_TRIES]
+            found = found[near[np.argsort(dist2[near], kind="stable")]]
+            # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
+            # most) are free; nearest first, until `want` are found
+            for c in found[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, found, _LEADER_T, want)]:
+                yield q % 2, c
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
                     ) -> Iterator[tuple[int, np.ndarray, np.ndarray]]:
@@ -597,33 +673,16 @@ class _Taken:
         centres = np.stack([self.free(w, h)[r0:r1 + 1, c0:c1 + 1] for w, h in sizes])
         dist, found = _grid_bfs(free, int(sr), int(sc), int(ELSEWHERE_MM / FREE_CELL_MM), centres, want)
         for k, r, c in found.tolist():
-            path = [(r, c)]
-            while dist[path[-1]] > 0:  # back to p, one step nearer each time (straightest first)
-                r, c = path[-1]
-                d = dist[r, c]
-                step_to = [(r + dr, c + dc) for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
-                           if 0 <= r + dr < dist.shape[0] and 0 <= c + dc < dist.shape[1] and dist[r + dr, c + dc] == d - 1]
-                path.append(step_to[0])
-            pts = self.origin + (np.array(path[::-1])[:, ::-1] + np.array([c0, r0]) + 0.5) * FREE_CELL_MM
+            path = _path_back(dist, r, c)  # back to p, one step nearer each time (straightest first)
+            pts = self.origin + (path[::-1][:, ::-1] + np.array([c0, r0]) + 0.5) * FREE_CELL_MM
             pts[0] = p
             yield k, pts[-1].copy(), self._turns(pts)
 
     def _turns(self, pts: np.ndarray) -> np.ndarray:
         """A path of cell centres cut to its turns: from each kept point the farthest later one a
-        straight stretch reaches without crossing a label."""
+        straight stretch reaches without crossing a label (`_path_turns`)."""
         self._flush()
-        keep = [0]
-        while keep[-1] < len(pts) - 1:
-            i = keep[-1]
-            j = len(pts) - 1
-            while j > i + 1:
-                t = np.linspace(0.0, 1.0, int(math.ceil(np.linalg.norm(pts[j] - pts[i]) / LEADER_STEP_MM)) + 1)
-                ij = self._cells(pts[i] + t[:, None] * (pts[j] - pts[i]))
-                if not self.texts[ij[:, 1], ij[:, 0]].any():
-                    break
-                j -= 1
-            keep.append(j)
-        return pts[keep]
+        return pts[_path_turns(np.ascontiguousarray(pts), self.texts, self.origin, 1.0 / FREE_CELL_MM, LEADER_STEP_MM)]
 
 
 class PieceLabels:
@@ -878,10 +937,9 @@ class PieceLabels:
             for side in sides:
                 for t in (0.5, 0.25, 0.75):
                     mid = side.p0 + t * (side.p1 - side.p0)
-                    for inside in (True, False):  # in a face first: off them a label takes paper
-                        for u, bw, bh in ((level, w, h), (upward, h, w)):
-                            for c in self._taken.free_near(mid, bw, bh, ELSEWHERE_TRIES, inside):
-                                yield mid, u, c
+                    # in a face first (off them a label takes paper), level, then upright
+                    for k, c in self._taken.free_near(mid, [(w, h), (h, w)], ELSEWHERE_TRIES):
+                        yield mid, (level, upward)[k], c
 
         for mid, u, center in tries():
             if self._leader_spot(text, u, center, np.array([mid, center]), bent=False):
