@@ -69,6 +69,41 @@ def loop_subdivided(path: Path, iterations: int) -> tuple[np.ndarray, np.ndarray
     return np.asarray(v, dtype=float), np.asarray(f)
 
 
+def decimated(path: Path, faces: int) -> tuple[np.ndarray, np.ndarray]:
+    """A shared model Loop-subdivided twice (16 times its faces) and collapsed back to about
+    `faces` faces by quadric edge collapse (fast-simplification, polyfold's own simplifier's):
+    faces of every size and shape, as a scan decimated for papercraft has."""
+    import fast_simplification
+
+    v, f = loop_subdivided(path, 2)
+    out_v, out_f = fast_simplification.simplify(v.astype(np.float32), f.astype(np.int32), 1.0 - faces / len(f))
+    return np.asarray(out_v, dtype=float), np.asarray(out_f, dtype=np.int64)
+
+
+def hull_of_points(n: int, seed: int, stretch: float = 1.6) -> tuple[np.ndarray, np.ndarray]:
+    """The convex hull of n random points on a sphere stretched `stretch` times along x: 2n - 4
+    faces, many of them slivers."""
+    import trimesh
+
+    p = np.random.default_rng(seed).normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    p[:, 0] *= stretch
+    hull = trimesh.convex.convex_hull(p)
+    return np.asarray(hull.vertices, dtype=float), np.asarray(hull.faces)
+
+
+def torus(around: int, across: int, r_tube: float = 0.35) -> tuple[np.ndarray, np.ndarray]:
+    """A torus (radius 1, tube r_tube) of around x across quads, each two triangles."""
+    u, w = np.meshgrid(2 * np.pi * np.arange(around) / around, 2 * np.pi * np.arange(across) / across, indexing="ij")
+    v = np.stack([(1 + r_tube * np.cos(w)) * np.cos(u), (1 + r_tube * np.cos(w)) * np.sin(u), r_tube * np.sin(w)],
+                 axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(around), np.arange(across), indexing="ij")
+    a, b = i * across + j, (i + 1) % around * across + j
+    c, d = (i + 1) % around * across + (j + 1) % across, i * across + (j + 1) % across
+    f = np.concatenate([np.stack([a, b, c], axis=-1).reshape(-1, 3), np.stack([a, c, d], axis=-1).reshape(-1, 3)])
+    return v, f
+
+
 GENERATED = (  # name, builder (seeded)
     ("noisy-ico3-s03", lambda: noisy_icosphere(3, 0.03, 1)),
     ("noisy-ico3-s08", lambda: noisy_icosphere(3, 0.08, 2)),

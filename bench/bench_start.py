@@ -25,8 +25,11 @@ project's cache is left alone):
 - make at N faces: generated closed meshes (bunny-128 itself; noisy icospheres refined to about N
   faces, one per noise seed of --sphere-seeds; shared models Loop-subdivided (--dense: bunny-348
   once, 1,392 faces, horse-302 once, 1,208, fish-472 once, 1,888, moneybox-128 twice, 2,048,
-  bumpy-528 once, 2,112: models whose small faces crowd their labels at 150 mm), warm cache, fold
-  on, A4 at 150 mm: seconds and peak memory.
+  bumpy-528 once, 2,112: models whose small faces crowd their labels at 150 mm; --decimated:
+  bumpy-528, bunny-348, fish-472 and horse-302 Loop-subdivided twice and decimated to 1,500
+  faces, faces of every size and shape; the convex hull of 752 random points, 1,500 faces, many
+  slivers; a 50 x 15 torus, 1,500 faces), warm cache, fold on, A4 at 150 mm: seconds and peak
+  memory.
 Prints a table; compile seconds per stage are the cold make's own (report.json "compile_seconds").
 """
 
@@ -49,6 +52,7 @@ CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "p
 BUNNY = ROOT / "examples" / "bunny-128.obj"
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
 DENSE = "bunny-348:1,horse-302:1,fish-472:1,moneybox-128:2,bumpy-528:1"  # (--dense) name:Loop subdivisions
+DECIMATED = "bumpy-528,bunny-348,fish-472,horse-302"  # (--decimated) Loop-subdivided twice, then to 1,500 faces
 
 
 def _tree_pss_mb(pid: int) -> float:
@@ -156,6 +160,9 @@ def main() -> None:
     ap.add_argument("--sphere-seeds", default="1,2,3", help="noise draws of each size's sphere (a sphere each)")
     ap.add_argument("--dense", default=DENSE, help="shared models to Loop-subdivide, name:times,...")
     ap.add_argument("--no-dense", action="store_true", help="leave out the Loop-subdivided models")
+    ap.add_argument("--decimated", default=DECIMATED,
+                    help="shared models to subdivide and decimate to 1,500 faces (with a 1,500-face hull and torus)")
+    ap.add_argument("--no-decimated", action="store_true", help="leave out the decimated models, hull and torus")
     ap.add_argument("--no-server", action="store_true", help="no rows through `polyfold server`")
     a = ap.parse_args()
     rows: list[tuple[str, float, float, str]] = []
@@ -228,6 +235,19 @@ def main() -> None:
         mesh.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
                         + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
         meshes.append((f"make {name} Loop-subdivided{' twice' if times == '2' else ''}, {len(f)} faces", mesh))
+    if not a.no_decimated:
+        sys.path.insert(0, str(ROOT / "bench"))
+        from bench_build import decimated, hull_of_points, torus
+
+        built = [(f"{name} decimated", lambda name=name: decimated(MODELS / f"{name}.obj", 1500))
+                 for name in a.decimated.split(",") if name and (MODELS / f"{name}.obj").exists()]
+        built += [("hull of 752 random points", lambda: hull_of_points(752, 7)), ("torus 50 x 15", lambda: torus(50, 15))]
+        for label, build in built:
+            v, f = build()
+            mesh = tmp / f"{label.split()[0]}-{len(meshes)}.obj"
+            mesh.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
+                            + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
+            meshes.append((f"make {label}, {len(f)} faces", mesh))
     for k, (label, mesh) in enumerate(meshes):
         for how, env in (("", None), (", served", served)):
             if how and served is None:
