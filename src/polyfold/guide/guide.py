@@ -180,14 +180,15 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
     tris = mesh.vertices[mesh.faces]
     part_ids = sorted({p.part for p in pieces[:n_net]})
     rotations = P.corner_rotations(mesh.vertices[np.unique(mesh.faces)])
-    whole = _seen_from(tris, rotations)
+    cameras = [P.fit_camera(tris, rot, *CHOOSE_PX) for rot in rotations]  # (the same for every step)
+    whole = _seen_from(tris, rotations, cameras)
     views, placed_faces = [], []
     view = 0
     for st in plan.steps:
         placed = np.flatnonzero(np.isin(face_piece, st.placed))
         focus = np.flatnonzero(face_piece == st.piece) if st.piece is not None else np.zeros(0, dtype=np.int64)
         seam_faces = np.array([f for k in st.seams for f in seams[k].faces], dtype=np.int64)
-        view = _best_view(tris, placed, np.union1d(focus, seam_faces), rotations, whole, view)
+        view = _best_view(tris, placed, np.union1d(focus, seam_faces), rotations, cameras, whole, view)
         views.append(view)
         placed_faces.append(placed)
 
@@ -265,30 +266,31 @@ def _sides(mesh: Mesh, tris: np.ndarray, faces: np.ndarray, face_piece: np.ndarr
     return tuple(out)
 
 
-def _seen_from(tris: np.ndarray, rotations: list) -> np.ndarray:
+def _seen_from(tris: np.ndarray, rotations: list, cameras: list) -> np.ndarray:
     """(R, F): pixels of every face seen from outside (its printed side) in a small picture of
-    the whole model from each rotation."""
+    the whole model from each rotation (cameras: `fit_camera` of the model in each, CHOOSE_PX)."""
     normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     out = np.zeros((len(rotations), len(tris)))
     for k, rot in enumerate(rotations):
-        ids, _ = P.face_ids(P.fit_camera(tris, rot, *CHOOSE_PX), tris)
+        ids, _ = P.face_ids(cameras[k], tris)
         seen = ids[ids >= 0]
         out[k] = np.bincount(seen, minlength=len(tris)) * (normal @ rot[2] > 0)
     return out
 
 
-def _best_view(tris: np.ndarray, placed: np.ndarray, focus: np.ndarray, rotations: list, whole: np.ndarray,
-               keep: int) -> int:
+def _best_view(tris: np.ndarray, placed: np.ndarray, focus: np.ndarray, rotations: list, cameras: list,
+               whole: np.ndarray, keep: int) -> int:
     """The rotation (index) that shows most of the `focus` faces of the part-built model from
-    outside: the TRIES best for the whole model (`_seen_from`) drawn part-built (ties: `keep`,
-    the last step's, so the view changes only when it must)."""
+    outside: the TRIES best for the whole model (`_seen_from`) drawn part-built, framed as the
+    whole model is (`cameras`; ties: `keep`, the last step's, so the view changes only when it
+    must)."""
     sub = tris[placed]
     want = np.isin(placed, focus)
     normal = np.cross(sub[:, 1] - sub[:, 0], sub[:, 2] - sub[:, 0])
     ranked = np.argsort(-whole[:, focus].sum(axis=1), kind="stable")[:TRIES]
     best, best_score = keep, -1
     for k in [keep] + [int(r) for r in ranked if r != keep]:
-        ids, _ = P.face_ids(P.fit_camera(tris, rotations[k], *CHOOSE_PX), sub)
+        ids, _ = P.face_ids(cameras[k], sub)
         seen = ids[ids >= 0]
         score = int((want[seen] & (normal[seen] @ rotations[k][2] > 0)).sum())
         if score > best_score * 1.15 or best_score < 0:  # a clearly better view, else the one we had
