@@ -257,3 +257,25 @@ def test_bent_leader_kernels_give_the_python_rules_paths():
             assert np.array_equal(got, turns(pts, texts, origin))
             bent += len(got) > 2
     assert bent > 20  # paths with turns, not only straight ones
+
+
+def test_a_free_map_refreshed_in_windows_is_the_free_map_made_anew():
+    """`_Taken`'s maps of free box centres, refreshed only around the windows where cells were
+    taken (`_refresh_free`), equal `_box_free` of the whole raster made again."""
+    from polyfold.fabricate.labels import _box_free, _refresh_free
+
+    rng = np.random.default_rng(8)
+    for _ in range(40):
+        ny, nx = (int(v) for v in rng.integers(10, 90, 2))
+        taken = rng.random((ny, nx)) < 0.05
+        hw, hh = (int(v) for v in rng.integers(0, 6, 2))
+        free = _box_free(taken, hw, hh)
+        windows = []
+        for _ in range(int(rng.integers(1, 5))):
+            r0, r1 = sorted(int(v) for v in rng.integers(0, ny, 2))
+            c0, c1 = sorted(int(v) for v in rng.integers(0, nx, 2))
+            r1, c1 = min(r1, r0 + 6), min(c1, c0 + 6)
+            taken[r0:r1 + 1, c0:c1 + 1] |= rng.random((r1 - r0 + 1, c1 - c0 + 1)) < 0.5
+            windows.append([r0, r1, c0, c1])
+        _refresh_free(free, taken, np.array(windows, dtype=np.int64), hw, hh)
+        assert np.array_equal(free, _box_free(taken, hw, hh))

@@ -403,3 +403,30 @@ def test_runs_of_a_mask_widest_first_ties_in_row_order():
         if mask.any():
             rr, cc = np.nonzero(mask)
             assert np.isclose(row, rr.mean()) and np.isclose(col, cc.mean())
+
+
+def test_mark_rings_sets_the_cells_inside_each_geometry_in_its_window():
+    """Several geometries rasterised into one grid at once, each over its own window (what a label
+    raster marks after a placement): the cells whose centres shapely finds inside one of them,
+    on top of what the grid held."""
+    import shapely
+
+    from polyfold.fabricate.pack import mark_rings, ring_edges
+
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        grid = rng.random((60, 80)) < 0.05
+        before = grid.copy()
+        geoms = [shapely.Polygon(rng.uniform([2, 2], [75, 55], (3, 2))).buffer(rng.uniform(0.3, 2), quad_segs=2)
+                 for _ in range(int(rng.integers(1, 6)))]
+        p0, p1, owner = ring_edges(np.array(geoms, dtype=object))
+        start = np.searchsorted(owner, np.arange(len(geoms) + 1))
+        b = shapely.bounds(np.array(geoms, dtype=object))
+        windows = np.stack([np.floor(b[:, 1]), np.ceil(b[:, 3]), np.floor(b[:, 0]), np.ceil(b[:, 2])],
+                           axis=1).astype(np.int64).clip(0, [59, 59, 79, 79])
+        mark_rings(grid, p0, p1, start, windows)
+        r, c = np.mgrid[0:60, 0:80]
+        inside = np.zeros((60, 80), dtype=bool)
+        for g in geoms:
+            inside |= shapely.contains_xy(g, c + 0.5, r + 0.5)
+        assert np.array_equal(grid, before | inside)

@@ -346,6 +346,20 @@ def _box_free(taken, hw, hh):
 
 
 @njit(cache=True)
+def _refresh_free(free, taken, windows, hw, hh):
+    """`_box_free` (taken, hw, hh) written into free (ny, nx) again where cells in windows (k, 4:
+    first and last row, first and last column) may have been taken: at the centres whose boxes
+    reach them, each window's from the cells those boxes cover."""
+    ny, nx = taken.shape
+    for k in range(windows.shape[0]):
+        r0, r1, c0, c1 = windows[k, 0], windows[k, 1], windows[k, 2], windows[k, 3]
+        t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
+        s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
+        part = _box_free(np.ascontiguousarray(taken[s0:s1 + 1, v0:v1 + 1]), hw, hh)
+        free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
+
+
+@njit(cache=True)
 def _grid_bfs(free, sr, sc, max_steps, ok, want):
     """Breadth-first search over the True cells of `free` (ny, nx) from cell (sr, sc), 8
     neighbours, at most max_steps steps: (steps to each cell, -1 unreached; (n, 3) the first
@@ -533,8 +547,11 @@ class _Taken:
         tri = shapely.get_coordinates(np.asarray(labels.room.faces, dtype=object)).reshape(-1, 4, 2)[:, :3]
         a, b = tri.reshape(-1, 2), np.roll(tri, -1, axis=1).reshape(-1, 2)
         steps = np.maximum(np.ceil(np.linalg.norm(b - a, axis=1) / (0.5 * FREE_CELL_MM)).astype(int), 1)
-        t = np.concatenate([np.linspace(0.0, 1.0, k + 1) for k in steps])
+        # np.linspace(0, 1, k + 1) of each side, at once: i (1 / k), the last 1
         which = np.repeat(np.arange(len(a)), steps + 1)
+        first = np.cumsum(steps + 1) - (steps + 1)
+        t = (np.arange(len(which)) - first[which]) * (1.0 / steps)[which]
+        t[first + steps] = 1.0
         pts = a[which] + t[:, None] * (b - a)[which]
         lines = np.zeros_like(self.grid)
         ij = self._cells(pts)
@@ -585,7 +602,7 @@ class _Taken:
             return
         import shapely
 
-        from .pack import _raster, ring_edges
+        from .pack import mark_rings, ring_edges
 
         geoms, grows, to_texts = (np.array(v, dtype=t) for v, t in zip(zip(*self._pending), (object, float, bool)))
         self._pending = []
@@ -599,10 +616,7 @@ class _Taken:
             p0, p1, owner = ring_edges(grown[chosen])
             start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
             p0, p1 = (p0 - self.origin) * (1.0 / FREE_CELL_MM), (p1 - self.origin) * (1.0 / FREE_CELL_MM)
-            for g, (r0, r1, c0, c1) in enumerate(windows[chosen].tolist()):
-                corner = np.array([c0, r0], dtype=np.float64)
-                a, b = start[g], start[g + 1]
-                target[r0:r1 + 1, c0:c1 + 1] |= _raster(p0[a:b] - corner, p1[a:b] - corner, r1 - r0 + 1, c1 - c0 + 1)
+            mark_rings(target, p0, p1, start, windows[chosen])
         if (~to_texts).any():
             self._refresh(windows[~to_texts])
 
@@ -625,11 +639,7 @@ class _Taken:
             if near.sum() > ny * nx:
                 free[:] = _box_free(self.grid, hw, hh)
                 continue
-            for r0, r1, c0, c1 in windows.tolist():
-                t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
-                s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
-                part = _box_free(np.ascontiguousarray(self.grid[s0:s1 + 1, v0:v1 + 1]), hw, hh)
-                free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
+            _refresh_free(free, self.grid, windows, hw, hh)
 
     def free_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int) -> Iterator[tuple[int, np.ndarray]]:
         """Centres of level boxes of each of the two sizes (w, h mm) that touch no taken cell and whose

@@ -262,6 +262,26 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     return inside
 
 
+@njit(cache=True)
+def mark_rings(target, p0, p1, start, windows):
+    """Set the cells of target (ny, nx) whose centres lie inside geometry g's rings, edges
+    p0[start[g]:start[g + 1]] -> p1[...] (e, 2) in cell units, within its window windows[g] (first
+    and last row, first and last column): `_raster` of each over its window, even-odd."""
+    for g in range(windows.shape[0]):
+        r0, r1, c0, c1 = windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3]
+        a, b = start[g], start[g + 1]
+        q0 = np.empty((b - a, 2))
+        q1 = np.empty((b - a, 2))
+        for e in range(b - a):
+            q0[e, 0], q0[e, 1] = p0[a + e, 0] - float(c0), p0[a + e, 1] - float(r0)
+            q1[e, 0], q1[e, 1] = p1[a + e, 0] - float(c0), p1[a + e, 1] - float(r0)
+        inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
+        for r in range(r1 - r0 + 1):
+            for c in range(c1 - c0 + 1):
+                if inside[r, c]:
+                    target[r0 + r, c0 + c] = True
+
+
 @dataclass
 class _Shape:
     """One piece in one rotation, rasterised on a grid aligned with its rotated bounding box."""
