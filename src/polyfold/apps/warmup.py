@@ -303,11 +303,11 @@ BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its section
 class Beside:
     """Warm-up sections compiled in a second Python process while this one works on, for the
     stage that needs them: a first run's `make` (nothing in numba's cache) starts the layout's
-    overlap tests (`tabs`: 3 s, in the cache long before this process lays out), the fold
-    stage's planners (`fold-plan`) and the guide's kernels (`guide`) at once; when its own fold
-    stage begins (`ready`) it compiles the path check (`fold-check`) itself if the second process
-    is still compiling, then waits for it, and loads the rest from the cache instead of compiling
-    it. The fold stage's kernels are the largest share of a first run's compiling (about half of the
+    overlap tests of tabs and labels (`tabs`: 5 s, in the cache long before this process lays
+    out) and the fold stage's planners (`fold-plan`) at once; when its own fold stage begins
+    (`ready`) it compiles the path check (`fold-check`) and the guide's kernels (`guide`) itself
+    if the second process is still compiling, then waits for it, and loads the rest from the
+    cache instead of compiling it. The fold stage's kernels are the largest share of a first run's compiling (about half of the
     bunny's 33 s here) and share little with the stages before it, which this process compiles
     meanwhile: the two processes end within half a second of each other. If the second process
     fails, this one compiles what it needs as usual. Use as a context manager (the process is
@@ -363,10 +363,12 @@ def compile_beside() -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
     `kernels_cached()` False); else None."""
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
-        # the guide's kernels there too, after the planners: with them here this process was the
-        # last to reach the fold stage's end by 1-2 s (the bunny: the second process done at 15.5 s,
-        # this one's path check and guide at 16.8-17.5 s)
-        return Beside(("tabs", "fold-plan", "guide"), ("fold-check",), "fold")
+        # the guide's kernels here, with the path check, while the second process compiles the
+        # planners: its `tabs` section grew by 2 s with the compiled tests of tabs and labels (the
+        # thirteenth session), and with the guide there too this process waited for it (cold make
+        # of the bunny, alternating: 18.6-19.2 s with the guide there, 17.6-18.3 s here; the
+        # eleventh session had put it there when `tabs` took 3 s)
+        return Beside(("tabs", "fold-plan"), ("fold-check", "guide"), "fold")
     return None
 
 
