@@ -421,8 +421,7 @@ def _path_turns(pts, texts, origin, inv_cell, step):
     farthest later one whose straight stretch crosses no True cell of `texts` (ny, nx), looked up
     at ceil(length / step) + 1 points spaced as numpy's linspace spaces t from 0 to 1, each in
     the cell (column, row) = int((point - origin) inv_cell), clipped to the raster (as
-    `_Taken._cells`); the next point when none is."""
-    ny, nx = texts.shape
+    `_Taken._cells`, `_taken_at`); the next point when none is."""
     n = pts.shape[0]
     keep = np.empty(n, dtype=np.int64)
     keep[0] = 0
@@ -437,11 +436,7 @@ def _path_turns(pts, texts, origin, inv_cell, step):
             clear = True
             for q in range(count):
                 t = 1.0 if (q == count - 1 and count > 1) else q * delta
-                col = np.int32((pts[i, 0] + t * dx - origin[0]) * inv_cell)
-                row = np.int32((pts[i, 1] + t * dy - origin[1]) * inv_cell)
-                col = min(max(col, 0), nx - 1)
-                row = min(max(row, 0), ny - 1)
-                if texts[row, col]:
+                if _taken_at(texts, pts[i, 0] + t * dx, pts[i, 1] + t * dy, origin, inv_cell):
                     clear = False
                     break
             if clear:
@@ -487,13 +482,22 @@ def _free_cells_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, 
     return centres, d2, counts
 
 
+@njit(cache=True, inline="always")
+def _taken_at(texts, x, y, origin, inv_cell):
+    """Whether the cell (column, row) = int((x, y) - origin) inv_cell of texts (ny, nx), clipped to
+    the raster (as `_Taken._cells`), is True."""
+    ny, nx = texts.shape
+    c = min(max(np.int32((x - origin[0]) * inv_cell), 0), nx - 1)
+    r = min(max(np.int32((y - origin[1]) * inv_cell), 0), ny - 1)
+    return texts[r, c]
+
+
 @njit(cache=True)
 def _clear_leaders(texts, origin, inv_cell, p, centres, t, want):
     """Indices (up to want, in order) of the centres (k, 2) whose leader from p crosses no True
     cell of `texts` (ny, nx): the leader is looked up at the points p + t (centre - p), each in the
     cell (column, row) = int((point - origin) inv_cell), clipped to the raster (as
     `_Taken._cells`), and given up at its first taken point."""
-    ny, nx = texts.shape
     out = np.empty(min(want, len(centres)), dtype=np.int64)
     n = 0
     for i in range(len(centres)):
@@ -501,11 +505,8 @@ def _clear_leaders(texts, origin, inv_cell, p, centres, t, want):
             break
         clear = True
         for j in range(len(t)):
-            c = np.int32((p[0] + t[j] * (centres[i, 0] - p[0]) - origin[0]) * inv_cell)
-            r = np.int32((p[1] + t[j] * (centres[i, 1] - p[1]) - origin[1]) * inv_cell)
-            c = min(max(c, 0), nx - 1)
-            r = min(max(r, 0), ny - 1)
-            if texts[r, c]:
+            if _taken_at(texts, p[0] + t[j] * (centres[i, 0] - p[0]), p[1] + t[j] * (centres[i, 1] - p[1]), origin,
+                         inv_cell):
                 clear = False
                 break
         if clear:
@@ -720,6 +721,48 @@ class PieceLabels:
         self._no_spot = 0  # labels `_elsewhere` found no spot for
         self.crowded: list[np.ndarray] = []  # where labels with no readable place went (their face's centroid)
 
+    def _first_in_face(self, boxes: np.ndarray, tri: np.ndarray) -> int | None:
+        """The first of the label boxes (k, 4, 2) inside triangle tri (3, 2) by LABEL_PAD_MM
+        (`inside_triangle`) and clear of the placed labels and leaders (`_hits`), or None: a
+        compiled test of them all (`overlap_kernels.first_box_in_triangle`); `_hits` decides a
+        box it cannot tell."""
+        cells = _box_cells(boxes)
+        lengths = np.array([math.hypot(*(tri[(k + 1) % 3] - tri[k])) for k in range(3)])
+        a, b = self.boxes.rings, self.strips.rings
+        i = 0
+        while i < len(boxes):
+            k, status = first_box_in_triangle(boxes[i:], tri, lengths, LABEL_PAD_MM, cells[i:], LABEL_PAD_MM,
+                                              a.pts, a.ring_ptr, a.cells, a.has_ring, a.n,
+                                              b.pts, b.ring_ptr, b.cells, b.has_ring, b.n)
+            i += int(k)
+            if status < 0:
+                return None
+            if status == 0 or not self._hits(boxes[i]):
+                return i
+            i += 1
+        return None
+
+    def _clear_spots(self, boxes: np.ndarray, polys: np.ndarray, order: np.ndarray) -> Iterator[int]:
+        """The label boxes (k, 4, 2; their shapely polygons) of `order` (indices) clear of the
+        placed labels and leaders (`_hits`) and not blocked off the faces in the room
+        (`Room.blocked`, TAB_CLEAR_MM), in that order: a compiled test of them all
+        (`overlap_kernels.first_clear_box`), the Python tests deciding a box it cannot tell.
+        Nothing may be placed while it is iterated."""
+        cells = _box_cells(boxes)
+        a, b = self.boxes.rings, self.strips.rings
+        table = self.room.obstacle_table()
+        j = 0
+        while j < len(order):
+            j, status = first_clear_box(boxes, order, j, cells, LABEL_PAD_MM, a.pts, a.ring_ptr, a.cells, a.has_ring,
+                                        a.n, b.pts, b.ring_ptr, b.cells, b.has_ring, b.n, TAB_CLEAR_MM, OVERLAP_MM2,
+                                        *table)
+            if status < 0:
+                return
+            i = int(order[j])
+            j += 1
+            if status == 0 or not (self._hits(boxes[i]) or self.room.blocked(polys[i], None, TAB_CLEAR_MM)):
+                yield i
+
     def _hits(self, box: np.ndarray) -> bool:
         """True when a label box (4, 2) comes within LABEL_PAD_MM of a placed label or leader."""
         return _grown_box_hits(box, self.boxes._items_at(box) + self.strips._items_at(box))
@@ -832,22 +875,10 @@ class PieceLabels:
         inside = np.concatenate([side.p0 + _ALONG[:, None] * d - n_out * (1.2 * LABEL_PAD_MM + h / 2),
                                  _incentre(side.tri)[None]])
         boxes = text_boxes(inside, u, text, s)
-        cells = _box_cells(boxes)
-        tri = side.tri
-        lengths = np.array([math.hypot(*(tri[(k + 1) % 3] - tri[k])) for k in range(3)])
-        a, b = self.boxes.rings, self.strips.rings
-        i = 0
-        while i < len(boxes):
-            k, status = first_box_in_triangle(boxes[i:], tri, lengths, LABEL_PAD_MM, cells[i:], LABEL_PAD_MM,
-                                              a.pts, a.ring_ptr, a.cells, a.has_ring, a.n,
-                                              b.pts, b.ring_ptr, b.cells, b.has_ring, b.n)
-            i += int(k)
-            if status < 0:
-                break
-            if status == 0 or not self._hits(boxes[i]):
-                self._put(text, inside[i], u, s, "edge-label", boxes[i])
-                return True
-            i += 1
+        i = self._first_in_face(boxes, side.tri)
+        if i is not None:
+            self._put(text, inside[i], u, s, "edge-label", boxes[i])
+            return True
         if self._on_tab(text, u, tab_parts, tab_folds, n_out, h):
             self.stats.on_tabs += 1
             return True
@@ -881,27 +912,9 @@ class PieceLabels:
         boxes = text_boxes(centers, u, text, self.size)
         polys = shapely.polygons(boxes)
         ok &= shapely.contains(self.allowed, polys)
-        order = np.flatnonzero(ok)
-        if not len(order):
-            return False
-        # the boxes' hash cells (as `_Boxes._keys` finds them), then spot by spot, in order, the
-        # first clear of labels and leaders and not blocked in the room (a compiled test; the
-        # few it cannot tell are asked here)
-        cells = _box_cells(boxes)
-        a, b = self.boxes.rings, self.strips.rings
-        table = self.room.obstacle_table()
-        j = 0
-        while j < len(order):
-            j, status = first_clear_box(boxes, order, j, cells, LABEL_PAD_MM, a.pts, a.ring_ptr, a.cells, a.has_ring,
-                                        a.n, b.pts, b.ring_ptr, b.cells, b.has_ring, b.n, TAB_CLEAR_MM, OVERLAP_MM2,
-                                        *table)
-            if status < 0:
-                return False
-            i = int(order[j])
-            j += 1
+        # spot by spot, in order, those clear of labels and leaders and not blocked in the room
+        for i in self._clear_spots(boxes, polys, np.flatnonzero(ok)):
             center, box, poly = centers[i], boxes[i], polys[i]
-            if status == 1 and (self._hits(box) or self.room.blocked(poly, None, TAB_CLEAR_MM)):
-                continue
             extra = [poly]
             if leader[i]:
                 end = _nearest_on(poly, start)
