@@ -309,11 +309,9 @@ def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_ce
     one these tests cannot tell (an item without a ring near it, or an unsure answer: the caller
     decides it); (len(order), -1) when none is clear."""
     no_discs = np.zeros((0, 1, 2))
-    no_ring = np.zeros((0, 2))
     near_a = np.empty(a_n, dtype=np.int64)
     near_b = np.empty(b_n, dtype=np.int64)
-    n_faces = face_bounds.shape[0]
-    obstacles = np.empty(n_faces + n_extras, dtype=np.int64)
+    obstacles = np.empty(face_bounds.shape[0] + n_extras, dtype=np.int64)
     for j in range(start, order.shape[0]):
         i = order[j]
         box = np.ascontiguousarray(boxes[i])
@@ -324,13 +322,8 @@ def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_ce
             continue
         if hit < 0:
             return j, 1
-        x0, y0 = min(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), min(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
-        x1, y1 = max(box[0, 0], box[1, 0], box[2, 0], box[3, 0]), max(box[0, 1], box[1, 1], box[2, 1], box[3, 1])
-        x0, y0, x1, y1 = x0 - clear, y0 - clear, x1 + clear, y1 + clear
-        m = _room_obstacles(x0, y0, x1, y1, -1, face_bounds, extra_bounds, n_extras, obstacles)
-        if m == 0:
-            return j, 0
-        answer = blocked_by(box, clear, no_discs, no_ring, least, pts, ring_ptr, ring_sign, obs_ptr, obstacles[:m])
+        answer = _room_blocks(box, clear, no_discs, least, -1, pts, ring_ptr, ring_sign, obs_ptr, face_bounds,
+                              extra_bounds, n_extras, obstacles)
         if answer == 1:
             continue
         if answer == 0:
@@ -400,6 +393,23 @@ def _room_obstacles(x0, y0, x1, y1, skip_face, face_bounds, extra_bounds, n_extr
 
 
 @njit(cache=True)
+def _room_blocks(ring, clear, discs, least, skip_face, pts, ring_ptr, ring_sign, obs_ptr, face_bounds, extra_bounds,
+                 n_extras, out):
+    """`blocked_by` of the convex ring (k, 2) by a room's obstacles whose bounds meet its own grown
+    by `clear` (`_room_obstacles`, but face skip_face; `out` their work array): 0 when there are
+    none."""
+    x0, y0, x1, y1 = ring[0, 0], ring[0, 1], ring[0, 0], ring[0, 1]
+    for i in range(1, ring.shape[0]):
+        x0, y0 = min(x0, ring[i, 0]), min(y0, ring[i, 1])
+        x1, y1 = max(x1, ring[i, 0]), max(y1, ring[i, 1])
+    m = _room_obstacles(x0 - clear, y0 - clear, x1 + clear, y1 + clear, skip_face, face_bounds, extra_bounds, n_extras,
+                        out)
+    if m == 0:
+        return 0
+    return blocked_by(ring, clear, discs, np.zeros((0, 2)), least, pts, ring_ptr, ring_sign, obs_ptr, out[:m])
+
+
+@njit(cache=True)
 def first_unblocked(polys, side_of, skip_faces, discs, clear, least,
                     pts0, ring_ptr0, ring_sign0, obs_ptr0, face_bounds0, extra_bounds0, n_extras0,
                     pts1, ring_ptr1, ring_sign1, obs_ptr1, face_bounds1, extra_bounds1, n_extras1):
@@ -409,27 +419,16 @@ def first_unblocked(polys, side_of, skip_faces, discs, clear, least,
     polygon's grown by `clear`, but face skip_faces[side], measured outside the side's discs
     (discs[side]: (d, n, 2) convex rings). As (c, 0); (c, 1) when `blocked_by` cannot tell for
     it (the caller asks `tabs.Room.blocked`); (k, -1) when every one is blocked."""
-    no_ring = np.zeros((0, 2))
     out0 = np.empty(face_bounds0.shape[0] + n_extras0, dtype=np.int64)
     out1 = np.empty(face_bounds1.shape[0] + n_extras1, dtype=np.int64)
     for c in range(polys.shape[0]):
         ring = np.ascontiguousarray(polys[c])
-        x0, y0, x1, y1 = ring[0, 0], ring[0, 1], ring[0, 0], ring[0, 1]
-        for i in range(1, ring.shape[0]):
-            x0, y0 = min(x0, ring[i, 0]), min(y0, ring[i, 1])
-            x1, y1 = max(x1, ring[i, 0]), max(y1, ring[i, 1])
-        x0, y0, x1, y1 = x0 - clear, y0 - clear, x1 + clear, y1 + clear
-        s = side_of[c]
-        if s == 0:
-            m = _room_obstacles(x0, y0, x1, y1, skip_faces[0], face_bounds0, extra_bounds0, n_extras0, out0)
-            if m == 0:
-                return c, 0
-            answer = blocked_by(ring, clear, discs[0], no_ring, least, pts0, ring_ptr0, ring_sign0, obs_ptr0, out0[:m])
+        if side_of[c] == 0:
+            answer = _room_blocks(ring, clear, discs[0], least, skip_faces[0], pts0, ring_ptr0, ring_sign0, obs_ptr0,
+                                  face_bounds0, extra_bounds0, n_extras0, out0)
         else:
-            m = _room_obstacles(x0, y0, x1, y1, skip_faces[1], face_bounds1, extra_bounds1, n_extras1, out1)
-            if m == 0:
-                return c, 0
-            answer = blocked_by(ring, clear, discs[1], no_ring, least, pts1, ring_ptr1, ring_sign1, obs_ptr1, out1[:m])
+            answer = _room_blocks(ring, clear, discs[1], least, skip_faces[1], pts1, ring_ptr1, ring_sign1, obs_ptr1,
+                                  face_bounds1, extra_bounds1, n_extras1, out1)
         if answer == 1:
             continue
         if answer == 0:

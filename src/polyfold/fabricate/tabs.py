@@ -238,10 +238,14 @@ class Room:
         ring pointers and signs, obstacle pointers), the faces' bounds (F, 4), the extras'
         bounds (E, 4) and E."""
         t = self._table
+        return t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._extra_bounds(), len(self._bounds)
+
+    def _extra_bounds(self) -> np.ndarray:
+        """(E, 4) x0, y0, x1, y1 of every extra, made when asked for after an addition (it is
+        asked about a dozen times between two)."""
         if self._bounds_array is None:
             self._bounds_array = np.asarray(self._bounds, dtype=float).reshape(-1, 4)
-        return (t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._bounds_array,
-                len(self._bounds))
+        return self._bounds_array
 
     def obstacle_ids(self, region, skip_face: int | None = None) -> np.ndarray:
         """The obstacles whose bounds meet `region`'s, as the table numbers them (faces, but
@@ -251,19 +255,21 @@ class Room:
             faces = faces[faces != skip_face]
         return np.concatenate([faces, len(self.faces) + self._extras_near(region)]).astype(np.int64)
 
+    def geometries(self, ids: np.ndarray) -> list:
+        """The faces and extras numbered as the table numbers them (`obstacle_ids`)."""
+        n = len(self.faces)
+        return [self.faces[i] if i < n else self.extra[i - n] for i in ids.tolist()]
+
     def obstacles(self, region, skip_face: int | None = None) -> list:
         """Faces (but `skip_face`) and extras whose bounds meet `region`'s."""
-        n = len(self.faces)
-        return [self.faces[i] if i < n else self.extra[i - n] for i in self.obstacle_ids(region, skip_face).tolist()]
+        return self.geometries(self.obstacle_ids(region, skip_face))
 
     def _extras_near(self, region) -> np.ndarray:
         """Indices of the extras whose bounds meet `region`'s."""
         if not self._bounds:
             return np.zeros(0, dtype=np.int64)
         x0, y0, x1, y1 = region.bounds
-        if self._bounds_array is None:  # (asked about a dozen times between two additions)
-            self._bounds_array = np.asarray(self._bounds)
-        b = self._bounds_array
+        b = self._extra_bounds()
         return np.flatnonzero((b[:, 0] <= x1) & (x0 <= b[:, 2]) & (b[:, 1] <= y1) & (y0 <= b[:, 3]))
 
     def extras_near(self, region) -> list:
@@ -358,8 +364,7 @@ def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
         return None
     whole = Polygon(full)
     ids = room.obstacle_ids(whole.buffer(TAB_CLEAR_MM, quad_segs=2), side.face)
-    n = len(room.faces)
-    near = [room.faces[i] if i < n else room.extra[i - n] for i in ids.tolist()]
+    near = room.geometries(ids)
     rest = whole
     if near:
         # what is left can be no more than the full tab less the obstacles' area within it (they
@@ -438,11 +443,11 @@ def _choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None
     tries = [t[1:] for t in sorted(tries, key=lambda t: (t[0], t[1]))]
     if tries:
         polys = np.array([poly for _s, poly, _d, _r in tries])
-        tries = [t for t, valid in zip(tries, shapely.is_valid(shapely.polygons(polys))) if valid]
+        valid = shapely.is_valid(shapely.polygons(polys))
+        tries, polys = [t for t, ok in zip(tries, valid) if ok], polys[valid]
     if tries:
         # the first that nothing blocks: a compiled test of them all (`Room.blocked` asked for a
         # tab it cannot tell)
-        polys = np.array([poly for _s, poly, _d, _r in tries])
         side_of = np.array([s for s, _p, _d, _r in tries], dtype=np.int64)
         skip = np.array([sides[0].face, sides[1].face], dtype=np.int64)
         discs = np.stack([corners(0), corners(1)])
