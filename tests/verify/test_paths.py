@@ -204,3 +204,55 @@ def test_a_path_checked_in_two_processes_gets_the_same_verdict(monkeypatch, move
     split = check_fold_path(fold, thickness=1e-3, side_by_side=beside)
     assert split == alone
     assert split.configs > 1
+
+
+def test_testing_only_pairs_of_different_rigid_bodies_finds_what_testing_every_pair_finds(models_dir):
+    """`_segment` tests only pairs of faces in different rigid bodies along a segment (`_bodies`:
+    the others keep their relative pose, checked at its start). On random walks of bunny-128's
+    net, one to three creases turning per segment by up to 120 degrees, at a thickness of 1 % of
+    its size: every two corners of one body keep their distance from start to end, each turning
+    crease makes one body more, and from every start free of collision the first colliding
+    sample and pair are those of a test of every pair (many segments collide)."""
+    import polyfold.verify.paths as paths
+
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    net, _ = unfold(mesh, seed=1, time_limit=10)
+    fold = pattern_fold(crease_pattern([net]))
+    faces = np.asarray(fold["faces_vertices"], dtype=np.int64)
+    assignment = [str(a).upper() for a in fold["edges_assignment"]]
+    tree = paths._tree(np.asarray(fold["vertices_coords"], dtype=float), faces,
+                       np.asarray(fold["edges_vertices"], dtype=np.int64), assignment)
+    creases = np.flatnonzero([a not in paths.CUT for a in assignment])
+    folded = np.asarray(fold["file_frames"][0]["vertices_coords"])
+    scale = float(np.linalg.norm(folded.max(axis=0) - folded.min(axis=0)))
+    args = (tree.order, tree.parent, tree.edge, tree.hinge, tree.flat, np.ascontiguousarray(folded[faces]), tree.piece,
+            faces, np.full_like(faces, -1), 1e-7 * scale, 0.01 * scale, 0.1 * scale)
+
+    def corners(q):
+        return paths._fold(q, tree.order, tree.parent, tree.edge, tree.hinge, tree.flat,
+                           np.empty((len(faces), 3, 3))).reshape(-1, 3)
+
+    rng = np.random.default_rng(5)
+    colliding = free = 0
+    for _walk in range(12):
+        q = np.zeros(len(assignment))
+        for _step in range(12):
+            nxt = q.copy()
+            turn = rng.choice(creases, size=int(rng.integers(1, 4)), replace=False)
+            nxt[turn] = np.clip(nxt[turn] + rng.uniform(-120.0, 120.0, len(turn)), -180.0, 180.0)
+            body = np.repeat(paths._bodies(q, nxt, False, tree.order, tree.parent, tree.edge), 3)
+            assert len(np.unique(body)) == 1 + np.count_nonzero(nxt != q)
+            a, b = corners(q), corners(nxt)
+            same = body[:, None] == body[None, :]
+            moved = np.abs(np.linalg.norm(a[:, None] - a[None], axis=2) - np.linalg.norm(b[:, None] - b[None], axis=2))
+            assert moved[same].max() < 1e-9 * scale
+            m = int(np.ceil(np.abs(nxt - q).max()))
+            whole = paths._segment(q, nxt, m, 1, False, True, *args)
+            rigid = paths._segment(q, nxt, m, 1, False, False, *args)
+            assert rigid[:3] == whole[:3]
+            if whole[0] >= 0:
+                colliding += 1
+                break  # (a walk goes on from configurations free of collision only)
+            free += 1
+            q = nxt
+    assert colliding >= 5 and free >= 20, (colliding, free)

@@ -433,8 +433,9 @@ def _within(T, g, f, nf, tol):
 
 
 @njit(cache=True)
-def _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, goal):
-    """The first colliding pair (i, j) of folded faces T (F, 3, 3) by a sweep on z, or (-1, -1)."""
+def _first_pair(T, G, piece, body, faces, mesh_faces, tol, thick, reach, goal):
+    """The first colliding pair (i, j) of folded faces T (F, 3, 3) by a sweep on z, or (-1, -1):
+    of the pairs in one piece and in different rigid bodies (body (F,), see `_bodies`)."""
     n = T.shape[0]
     lo = np.empty((n, 3))
     hi = np.empty((n, 3))
@@ -459,7 +460,7 @@ def _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, goal):
             j = zs[b]
             if lo[j, 2] > hi[i, 2] + m:
                 break
-            if piece[i] != piece[j] or not solid[j]:
+            if piece[i] != piece[j] or body[i] == body[j] or not solid[j]:
                 continue
             if lo[j, 0] > hi[i, 0] + m or lo[i, 0] > hi[j, 0] + m or lo[j, 1] > hi[i, 1] + m or lo[i, 1] > hi[j, 1] + m:
                 continue
@@ -469,11 +470,30 @@ def _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, goal):
 
 
 @njit(cache=True)
-def _segment(qa, qb, m, k0, last, order, parent, edge, hinge, flat, G, piece, faces, mesh_faces, tol, thick, reach):
+def _bodies(qa, qb, whole, order, parent, edge):
+    """(F,) the rigid body of every face along the segment qa -> qb: faces joined by creases whose
+    angle stays put (qa[e] == qb[e], so every sample has it bit for bit) move as one, and the
+    pair test of two faces of one body, a function of their relative pose alone (distances, dot
+    products, tolerances in model units), gives what it gave at qa. whole: every face a body of its
+    own (every pair is tested)."""
+    body = np.empty(order.shape[0], dtype=np.int64)
+    for ii in range(order.shape[0]):
+        f = order[ii]
+        p = parent[f]
+        body[f] = body[p] if p >= 0 and not whole and qa[edge[f]] == qb[edge[f]] else f
+    return body
+
+
+@njit(cache=True)
+def _segment(qa, qb, m, k0, last, whole, order, parent, edge, hinge, flat, G, piece, faces, mesh_faces, tol, thick,
+             reach):
     """Samples k0..m of qa -> qb (t = k / m): (first colliding k or -1, i, j, samples checked).
-    last: the segment ends at the goal (its t = 1 gets the goal's exemption)."""
+    last: the segment ends at the goal (its t = 1 gets the goal's exemption). Tested: the pairs of
+    different rigid bodies (`_bodies`; whole: every pair), the others are as at qa, which the caller
+    has checked (at qa every pair is free of collision, by induction from a whole check)."""
     q = np.empty(qa.shape[0])
     T = np.empty((flat.shape[0], 3, 3))
+    body = _bodies(qa, qb, whole, order, parent, edge)
     checked = 0
     for k in range(k0, m + 1):
         t = k / m if m > 0 else 1.0
@@ -481,7 +501,7 @@ def _segment(qa, qb, m, k0, last, order, parent, edge, hinge, flat, G, piece, fa
             q[e] = qa[e] + t * (qb[e] - qa[e]) if k < m else qb[e]
         _fold(q, order, parent, edge, hinge, flat, T)
         checked += 1
-        i, j = _first_pair(T, G, piece, faces, mesh_faces, tol, thick, reach, last and k == m)
+        i, j = _first_pair(T, G, piece, body, faces, mesh_faces, tol, thick, reach, last and k == m)
         if i >= 0:
             return k, i, j, checked
     return -1, -1, -1, checked
@@ -491,7 +511,7 @@ def faces_collide(a: np.ndarray, b: np.ndarray, tol: float, thickness: float = 0
     """The pair test for two faces a, b (3, 3) that share nothing (no crease, no point)."""
     T = np.stack([np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)])
     faces = np.array([[0, 1, 2], [3, 4, 5]], dtype=np.int64)
-    i, _ = _first_pair(T, np.empty((0, 3, 3)), np.zeros(2, dtype=np.int64), faces, np.full((2, 3), -1, dtype=np.int64), float(tol),
+    i, _ = _first_pair(T, np.empty((0, 3, 3)), np.zeros(2, dtype=np.int64), np.arange(2), faces, np.full((2, 3), -1, dtype=np.int64), float(tol),
                        float(thickness), EXEMPT_REACH * float(thickness), False)
     return bool(i >= 0)
 
@@ -569,34 +589,31 @@ def check_fold_path(fold: dict, step_deg: float | None = None, tol_rel: float | 
     samples = [max(1, int(math.ceil(float(np.abs(frames[s + 1] - frames[s]).max()) / step - 1e-9)))
                for s in range(n_segments)]
 
-    def run(lo: int, hi: int, start: bool) -> tuple[tuple[int, float, int, int] | None, int, int]:
-        """Segments lo..hi-1 (after the first frame when `start`): (the first collision or None,
-        the segments checked up to it, the configurations checked)."""
-        configs = 0
-        if start:
-            k, i, j, n = _segment(frames[0], frames[0], 0, 0, len(frames) == 1, *args)
-            configs += n
-            if k >= 0:
-                return (0, 0.0, int(i), int(j)), 0, configs
+    def run(lo: int, hi: int) -> tuple[tuple[int, float, int, int] | None, int, int]:
+        """Frame lo (every pair: the base of `_segment`'s induction), then segments lo..hi-1: (the
+        first collision or None, the segments checked up to it, the configurations checked)."""
+        k, i, j, configs = _segment(frames[lo], frames[lo], 0, 0, lo == len(frames) - 1, True, *args)
+        if k >= 0:
+            return (lo, 0.0, int(i), int(j)), lo, configs
         for s in range(lo, hi):
             m = samples[s]
-            k, i, j, n = _segment(frames[s], frames[s + 1], m, 1, s == len(frames) - 2, *args)
+            k, i, j, n = _segment(frames[s], frames[s + 1], m, 1, s == len(frames) - 2, False, *args)
             configs += n
             if k >= 0:
                 return (s, k / m, int(i), int(j)), s + 1, configs
         return None, hi, configs
 
     if side_by_side is not None and n_segments > 1 and (1 + sum(samples)) * len(faces) >= PARALLEL_CHECK_WORK:
-        # the later segments meanwhile; their verdict counts only when the earlier ones pass (so it
-        # is the verdict of checking them in order)
+        # the later segments meanwhile (from a whole check of their first frame); their verdict
+        # counts only when the earlier ones pass (so it is the verdict of checking them in order)
         mid = int(np.searchsorted(np.cumsum(samples), sum(samples) / 2)) + 1
         mid = min(max(mid, 1), n_segments - 1)
         (first, segments, configs), (later, later_segments, later_configs) = side_by_side(
-            lambda: run(0, mid, True), lambda: run(mid, n_segments, False))
-        if first is None:
-            first, segments, configs = later, later_segments, configs + later_configs
+            lambda: run(0, mid), lambda: run(mid, n_segments))
+        if first is None:  # (frame mid, the earlier half's last, counted once)
+            first, segments, configs = later, later_segments, configs + later_configs - 1
         return verdict(first, segments, configs)
-    return verdict(*run(0, n_segments, True))
+    return verdict(*run(0, n_segments))
 
 
 def _goal_error(goal_deg: np.ndarray, tree: _Tree, faces: np.ndarray, folded: np.ndarray) -> float:
