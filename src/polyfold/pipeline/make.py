@@ -151,8 +151,11 @@ MIN_DRAWN_MM = 1e-3  # a face narrower than this on paper (a micrometre) cannot 
 
 def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, splits: int, split: PageSplit,
                    seconds: float) -> LayoutReport:
+    from ..mesh.simplify import auto_face_count
+
     st = sheets.stats
     edge, face = smallest_printed(mesh, scale)
+    fewer = auto_face_count(mesh, opts.size)  # (what a user may simplify to where edges print short)
     x0, y0, x1, y1 = pack_box(sheets.width, sheets.height, opts)
     cut_area = sum(p.outline.area for p in sheets.pieces)  # faces and tabs (glue strips too), no labels
     return LayoutReport(
@@ -163,7 +166,8 @@ def _layout_report(mesh: Mesh, sheets: Sheets, opts: MakeOptions, scale: float, 
         small_labels=st.small_labels, open_edges=st.open_edges, smallest_edge_mm=edge, smallest_face_mm=face,
         reduced_tabs=st.reduced_tabs, labels_on_tabs=st.labels_on_tabs, labels_outside=st.labels_outside,
         seam_runs=st.seam_runs, min_label_mm=opts.min_label_mm, splits_for_packing=split.cuts, splits_for_labels=split.label_cuts,
-        packing_ran_out=split.ran_out or sheets.packing.ran_out, labels_ran_out=split.labels_ran_out)
+        packing_ran_out=split.ran_out or sheets.packing.ran_out, labels_ran_out=split.labels_ran_out,
+        faces_for_size=fewer if fewer < mesh.n_faces else 0)
 
 
 def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLike, opts: MakeOptions = MakeOptions(),

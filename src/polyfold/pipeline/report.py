@@ -157,6 +157,7 @@ class LayoutReport:
     min_label_mm: float = 2.0  # the least cap height asked for
     splits_for_packing: int = 0  # creases cut so that the pieces fill fewer pages
     splits_for_labels: int = 0  # creases cut where labels found no readable place (before the page split)
+    faces_for_size: int = 0  # --faces for faces ~12 mm across at this size (`auto_face_count`) if fewer; else 0
     packing_ran_out: bool = False  # the packer's time budget stopped its search
     labels_ran_out: bool = False  # the time limit stopped the cuts for labels with no readable place
 

@@ -132,6 +132,7 @@ def test_small_edges_are_said(models_dir, tmp_path):
     size = math.ceil(150.0 * 5.0 / edge)
     assert len(warnings) == 1 and warnings[0].startswith("polyfold: warning:"), proc.stderr
     assert f"is {edge:.3g} mm" in warnings[0] and f"--size {size} would" in warnings[0]
+    assert lay["faces_for_size"] == 0 and "--faces" not in warnings[0]  # (its faces are no finer than 12 mm ones)
     summary = proc.stderr.strip().splitlines()[-1]
     assert (f"smallest edge {lay['smallest_edge_mm']:.3g} mm, narrowest face {lay['smallest_face_mm']:.3g} mm"
             in summary)
@@ -140,6 +141,27 @@ def test_small_edges_are_said(models_dir, tmp_path):
     assert "smallest printed edge" not in proc.stderr
     lay = json.loads((tmp_path / "b" / "report.json").read_text())["stages"]["layout"]
     assert 5.0 <= lay["smallest_edge_mm"] < 5.0 * (size + 1) / size
+
+
+def test_slivers_are_told_to_simplify(models_dir, tmp_path):
+    """hull-ellipsoid-rand-236 has vertices 0.25 mm apart at 150 mm: its warning names --faces
+    for faces about 12 mm across (`auto_face_count`, fewer than it has) beside the --size that
+    no sheet holds, and at that face count its smallest printed edge is ten times longer."""
+    from polyfold.formats.meshes import load_mesh
+    from polyfold.mesh.simplify import auto_face_count
+
+    src = models_dir / "hull-ellipsoid-rand-236.obj"
+    proc = run_cli("make", src, "-o", tmp_path / "a", "--no-guide")
+    assert proc.returncode == 0, proc.stderr
+    lay = json.loads((tmp_path / "a" / "report.json").read_text())["stages"]["layout"]
+    fewer = auto_face_count(load_mesh(src).mesh, 150.0)
+    assert lay["faces_for_size"] == fewer < 236
+    warning = [ln for ln in proc.stderr.splitlines() if "smallest printed edge" in ln]
+    assert len(warning) == 1 and warning[0].endswith(f"faces about 12 mm across: --faces {fewer}"), proc.stderr
+    proc = run_cli("make", src, "-o", tmp_path / "b", "--no-guide", "--faces", fewer)
+    assert proc.returncode == 0, proc.stderr
+    simpler = json.loads((tmp_path / "b" / "report.json").read_text())["stages"]["layout"]
+    assert simpler["smallest_edge_mm"] > 10 * lay["smallest_edge_mm"] and simpler["faces_for_size"] == 0
 
 
 def test_a_mesh_too_fine_for_the_time_limit_stops_at_it(tmp_path):

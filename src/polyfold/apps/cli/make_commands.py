@@ -89,9 +89,14 @@ def make(
                 "printed over their face (try a larger --size or a smaller --min-label-mm"
                 f"{', or a longer --time-limit: it stopped the cuts that make room for them' if lay.labels_ran_out else ''})")
         if lay.smallest_edge_mm < BUILDABLE_EDGE_MM:
+            from ...mesh.simplify import AUTO_EDGE_MM
+
+            # a sliver's edge asks for a size no sheet holds: fewer, larger faces are the way out
+            simpler = (f", or simplify the mesh to faces about {AUTO_EDGE_MM:g} mm across: --faces {lay.faces_for_size}"
+                       if lay.faces_for_size else "")
             say(f"warning: the smallest printed edge is {lay.smallest_edge_mm:.3g} mm, under {BUILDABLE_EDGE_MM:g} mm "
                 f"(hard to fold and glue): --size {size_for_edge(size, lay.smallest_edge_mm)} would make it "
-                f"{BUILDABLE_EDGE_MM:g} mm")
+                f"{BUILDABLE_EDGE_MM:g} mm{simpler}")
         if lay.splits_for_page:
             say(f"split {lay.splits_for_page} crease(s) so every piece fits on {paper} paper at {size:g} mm")
         if lay.splits_for_labels:
