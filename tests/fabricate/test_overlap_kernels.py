@@ -151,9 +151,17 @@ def test_grown_box_meets_gives_shapelys_answers():
         assert _grown_box_hits(box, near) == expect
         quick = grown_box_meets(box, LABEL_PAD_MM, near[0][1], np.array([0, len(other)], dtype=np.int64))
         assert quick in (-1, int(expect))
+        if shapely.distance(grown, Polygon(other)) > 1e-9:  # apart: told, whatever the axis between them
+            assert quick == 0
         answers.append(quick)
     answers = np.array(answers)
     assert (answers == 1).mean() > 0.2 and (answers == 0).mean() > 0.2 and (answers == -1).mean() < 0.3
+    # a ring inside the grown box, and one around it, with no sides near each other: they meet
+    box = text_box(np.zeros(2), np.array([1.0, 0.0]), "88", 2.5)
+    for ring in (0.2 * box, 10.0 * box):
+        assert grown_box_meets(box, LABEL_PAD_MM, ring, np.array([0, 4], dtype=np.int64)) == 1
+        tiny = np.array([[0.0, 0.0], [1e-7, 0.0], [0.0, 1e-7]])  # inside, too small to count by area
+        assert grown_box_meets(box, LABEL_PAD_MM, tiny, np.array([0, 3], dtype=np.int64)) == -1
 
 
 def _crowded_piece(rng: np.random.Generator):

@@ -210,8 +210,8 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     """Whether the ring `box` (k, 2), convex, grown by `pad` with its corners cut by chords
     (shapely's buffer with quad_segs=1), meets any of the rings pts[ring_ptr[r]:ring_ptr[r + 1]]:
     1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
-    one of its sides; -1 when neither tells for some ring and none overlaps (a ring touching it,
-    or near it across a corner)."""
+    one of its sides or more than 1e-9 mm from it (`_rings_apart`); -1 when neither tells for
+    some ring and none overlaps (a ring touching it, or nearly)."""
     return _grown_box_meets(box, pad, pts, ring_ptr, np.arange(ring_ptr.shape[0] - 1))
 
 
@@ -251,8 +251,76 @@ def _grown_box_meets(box, pad, pts, ring_ptr, rings):
         b, m = _clip(bufs, 0, hi - lo, window, sign)
         if m >= 0 and _area(bufs, b, m) > 1e-12:
             return 1
-        unsure = True
+        if not _rings_apart(window, pts, lo, hi, 1e-9):
+            unsure = True
     return -1 if unsure else 0
+
+
+@njit(cache=True)
+def _segments_dist2(ax, ay, bx, by, cx, cy, dx, dy):
+    """Squared distance between the segments a-b and c-d: 0 when they cross, else the least of
+    their ends' distances to the other segment (where the least distance of two segments that do
+    not cross lies)."""
+    o1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    o2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    o3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    o4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and ((o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)):
+        return 0.0
+    best = np.inf
+    for k in range(4):
+        if k == 0:
+            px, py, qx, qy, rx, ry = ax, ay, cx, cy, dx, dy
+        elif k == 1:
+            px, py, qx, qy, rx, ry = bx, by, cx, cy, dx, dy
+        elif k == 2:
+            px, py, qx, qy, rx, ry = cx, cy, ax, ay, bx, by
+        else:
+            px, py, qx, qy, rx, ry = dx, dy, ax, ay, bx, by
+        ex, ey = rx - qx, ry - qy
+        l2 = ex * ex + ey * ey
+        t = 0.0 if l2 == 0.0 else min(1.0, max(0.0, ((px - qx) * ex + (py - qy) * ey) / l2))
+        fx, fy = qx + t * ex - px, qy + t * ey - py
+        best = min(best, fx * fx + fy * fy)
+    return best
+
+
+@njit(cache=True)
+def _rings_apart(window, pts, lo, hi, eps):
+    """True when the convex ring `window` (k, 2) and the ring pts[lo:hi] (any simple ring) are
+    more than eps apart: every side of one farther than eps from every side of the other, and
+    neither has a corner inside the other (so neither holds the other). False says nothing."""
+    k = window.shape[0]
+    for e in range(k):
+        ax, ay = window[e, 0], window[e, 1]
+        bx, by = window[(e + 1) % k, 0], window[(e + 1) % k, 1]
+        for i in range(lo, hi):
+            j = i + 1 if i + 1 < hi else lo
+            if _segments_dist2(ax, ay, bx, by, pts[i, 0], pts[i, 1], pts[j, 0], pts[j, 1]) <= eps * eps:
+                return False
+    # a corner of the ring inside the convex window: on the inner side of all its sides
+    sign = 1.0 if _orientation(window) >= 0 else -1.0
+    px, py = pts[lo, 0], pts[lo, 1]
+    inside = True
+    for e in range(k):
+        ax, ay = window[e, 0], window[e, 1]
+        ex, ey = window[(e + 1) % k, 0] - ax, window[(e + 1) % k, 1] - ay
+        if sign * (ex * (py - ay) - ey * (px - ax)) <= 0.0:
+            inside = False
+            break
+    if inside:
+        return False
+    # a corner of the window inside the ring (crossings of a ray to +x)
+    qx, qy = window[0, 0], window[0, 1]
+    crossings = 0
+    for i in range(lo, hi):
+        j = i + 1 if i + 1 < hi else lo
+        yi, yj = pts[i, 1], pts[j, 1]
+        if (yi > qy) != (yj > qy):
+            x = pts[i, 0] + (qy - yi) / (yj - yi) * (pts[j, 0] - pts[i, 0])
+            if x > qx:
+                crossings += 1
+    return crossings % 2 == 0
 
 
 @njit(cache=True)
