@@ -1011,17 +1011,19 @@ class PieceLabels:
 
     def _on_tab(self, text: str, u: np.ndarray, parts, folds, n_out: np.ndarray, h: float) -> bool:
         """2. On a part of the side's tab, along its fold line, inside it with LABEL_PAD_MM."""
+        import shapely
         from shapely.geometry import Polygon
 
+        depth = np.tile([LABEL_PAD_MM + h / 2, LABEL_PAD_MM + h], len(_ALONG))  # per spot along, both depths
+        along = np.repeat(_ALONG, 2)
         for part, fold in zip(parts, folds if folds is not None else ()):
             poly = Polygon(part).buffer(-LABEL_PAD_MM, quad_segs=1)
             if poly.is_empty:
                 continue
-            for t in (0.5, 0.35, 0.65, 0.2, 0.8):
-                for depth in (LABEL_PAD_MM + h / 2, LABEL_PAD_MM + h):
-                    center = fold[0] + t * (fold[1] - fold[0]) + n_out * depth
-                    box = text_box(center, u, text, self.size)
-                    if poly.contains(Polygon(box)) and not self._hits(box):
-                        self._put(text, center, u, self.size, "edge-label", box)
-                        return True
+            centers = fold[0] + along[:, None] * (fold[1] - fold[0]) + n_out * depth[:, None]
+            boxes = text_boxes(centers, u, text, self.size)
+            for i in np.flatnonzero(shapely.contains(poly, shapely.polygons(boxes))):
+                if not self._hits(boxes[i]):
+                    self._put(text, centers[i], u, self.size, "edge-label", boxes[i])
+                    return True
         return False
