@@ -257,6 +257,16 @@ def _grown_box_meets(box, pad, pts, ring_ptr, rings):
 
 
 @njit(cache=True)
+def _point_segment_dist2(px, py, qx, qy, rx, ry):
+    """Squared distance from the point p to the segment q-r."""
+    ex, ey = rx - qx, ry - qy
+    l2 = ex * ex + ey * ey
+    t = 0.0 if l2 == 0.0 else min(1.0, max(0.0, ((px - qx) * ex + (py - qy) * ey) / l2))
+    fx, fy = qx + t * ex - px, qy + t * ey - py
+    return fx * fx + fy * fy
+
+
+@njit(cache=True)
 def _segments_dist2(ax, ay, bx, by, cx, cy, dx, dy):
     """Squared distance between the segments a-b and c-d: 0 when they cross, else the least of
     their ends' distances to the other segment (where the least distance of two segments that do
@@ -267,22 +277,8 @@ def _segments_dist2(ax, ay, bx, by, cx, cy, dx, dy):
     o4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
     if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and ((o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)):
         return 0.0
-    best = np.inf
-    for k in range(4):
-        if k == 0:
-            px, py, qx, qy, rx, ry = ax, ay, cx, cy, dx, dy
-        elif k == 1:
-            px, py, qx, qy, rx, ry = bx, by, cx, cy, dx, dy
-        elif k == 2:
-            px, py, qx, qy, rx, ry = cx, cy, ax, ay, bx, by
-        else:
-            px, py, qx, qy, rx, ry = dx, dy, ax, ay, bx, by
-        ex, ey = rx - qx, ry - qy
-        l2 = ex * ex + ey * ey
-        t = 0.0 if l2 == 0.0 else min(1.0, max(0.0, ((px - qx) * ex + (py - qy) * ey) / l2))
-        fx, fy = qx + t * ex - px, qy + t * ey - py
-        best = min(best, fx * fx + fy * fy)
-    return best
+    return min(_point_segment_dist2(ax, ay, cx, cy, dx, dy), _point_segment_dist2(bx, by, cx, cy, dx, dy),
+               _point_segment_dist2(cx, cy, ax, ay, bx, by), _point_segment_dist2(dx, dy, ax, ay, bx, by))
 
 
 @njit(cache=True)
