@@ -124,10 +124,10 @@ def test_blocked_gives_shapelys_answers_near_contact(seed):
 def test_grown_box_meets_gives_shapelys_answers():
     # label boxes against boxes and leader strips placed 0-1 mm from their grown outline
     from polyfold.fabricate.labels import LABEL_PAD_MM, _grown_box_hits, text_box
-    from polyfold.fabricate.overlap_kernels import grown_box_meets
+    from polyfold.fabricate.overlap_kernels import grown_box_apart, grown_box_meets
 
     rng = np.random.default_rng(5)
-    answers = []
+    answers, unsure_apart = [], []
     for _ in range(600):
         turn = rng.uniform(0, 2 * np.pi)
         box = text_box(rng.normal(0.0, 20.0, 2), np.array([np.cos(turn), np.sin(turn)]), str(rng.integers(1, 999)), 2.5)
@@ -149,19 +149,20 @@ def test_grown_box_meets_gives_shapelys_answers():
         near = [(Polygon(other), np.ascontiguousarray(other))]
         expect = bool(shapely.intersects(grown, Polygon(other)))
         assert _grown_box_hits(box, near) == expect
-        quick = grown_box_meets(box, LABEL_PAD_MM, near[0][1], np.array([0, len(other)], dtype=np.int64))
+        ptr = np.array([0, len(other)], dtype=np.int64)
+        quick = grown_box_meets(box, LABEL_PAD_MM, near[0][1], ptr)
         assert quick in (-1, int(expect))
-        if shapely.distance(grown, Polygon(other)) > 1e-9:  # apart: told, whatever the axis between them
-            assert quick == 0
+        apart = grown_box_apart(box, LABEL_PAD_MM, near[0][1], ptr)
+        assert apart == (shapely.distance(grown, Polygon(other)) > 1e-9)  # whatever the axis between them
         answers.append(quick)
+        unsure_apart.append(quick == -1 and apart)
     answers = np.array(answers)
     assert (answers == 1).mean() > 0.2 and (answers == 0).mean() > 0.2 and (answers == -1).mean() < 0.3
-    # a ring inside the grown box, and one around it, with no sides near each other: they meet
+    assert sum(unsure_apart) >= 5  # (the distance test tells boxes the first cannot: 7 here)
+    # a ring inside the grown box, and one around it, with no sides near each other: not apart
     box = text_box(np.zeros(2), np.array([1.0, 0.0]), "88", 2.5)
-    for ring in (0.2 * box, 10.0 * box):
-        assert grown_box_meets(box, LABEL_PAD_MM, ring, np.array([0, 4], dtype=np.int64)) == 1
-        tiny = np.array([[0.0, 0.0], [1e-7, 0.0], [0.0, 1e-7]])  # inside, too small to count by area
-        assert grown_box_meets(box, LABEL_PAD_MM, tiny, np.array([0, 3], dtype=np.int64)) == -1
+    for ring in (0.2 * box, 10.0 * box, np.array([[0.0, 0.0], [1e-7, 0.0], [0.0, 1e-7]])):
+        assert not grown_box_apart(box, LABEL_PAD_MM, ring, np.array([0, len(ring)], dtype=np.int64))
 
 
 def _crowded_piece(rng: np.random.Generator):

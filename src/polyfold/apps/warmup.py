@@ -106,6 +106,11 @@ def _warm_crowded_labels() -> None:
     window = np.array([[0, 3, 0, 3]], dtype=np.int64)
     mark_rings(~free, np.zeros((3, 2)), np.ones((3, 2)), np.array([0, 3]), window)
     _refresh_free(free.copy(), ~free, window, 1, 1)
+    # a label box near another across its corner: `_grown_box_hits` asks the distance test
+    from ..fabricate.overlap_kernels import grown_box_apart
+
+    box = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]])
+    grown_box_apart(box, 0.25, box + 4.5, np.array([0, 4], dtype=np.int64))
     _warm_label_sides()
 
 

@@ -222,20 +222,23 @@ class _Boxes:
 def _grown_box_hits(box: np.ndarray, near: list) -> bool:
     """Whether the label box (4, 2) grown by LABEL_PAD_MM meets any of the geometries `near`
     ((shapely geometry, its ring or None) pairs; grown only when there are any: most candidate
-    spots have none around). Told by a compiled test (`overlap_kernels.grown_box_meets`) where it
-    can, else by shapely's buffer (quad_segs=1) and intersects."""
+    spots have none around). Told by compiled tests (`overlap_kernels.grown_box_meets`, then
+    `grown_box_apart`) where they can, else by shapely's buffer (quad_segs=1) and intersects."""
     if not near:
         return False
     import shapely
 
     if all(ring is not None for _geom, ring in near):
-        from .overlap_kernels import grown_box_meets
+        from .overlap_kernels import grown_box_apart, grown_box_meets
 
         rings = [ring for _geom, ring in near]
         ptr = np.array([0, *itertools.accumulate(len(r) for r in rings)], dtype=np.int64)
-        answer = grown_box_meets(np.ascontiguousarray(box, dtype=float), LABEL_PAD_MM, np.concatenate(rings), ptr)
+        box, pts = np.ascontiguousarray(box, dtype=float), np.concatenate(rings)
+        answer = grown_box_meets(box, LABEL_PAD_MM, pts, ptr)
         if answer >= 0:
             return bool(answer)
+        if grown_box_apart(box, LABEL_PAD_MM, pts, ptr):  # (a strip or box near a corner, not touching)
+            return False
     grown = shapely.Polygon(box).buffer(LABEL_PAD_MM, quad_segs=1)
     return bool(shapely.intersects(grown, np.array([geom for geom, _ring in near], dtype=object)).any())
 

@@ -210,8 +210,8 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     """Whether the ring `box` (k, 2), convex, grown by `pad` with its corners cut by chords
     (shapely's buffer with quad_segs=1), meets any of the rings pts[ring_ptr[r]:ring_ptr[r + 1]]:
     1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
-    one of its sides or more than 1e-9 mm from it (`_rings_apart`); -1 when neither tells for
-    some ring and none overlaps (a ring touching it, or nearly)."""
+    one of its sides; -1 when neither tells for some ring and none overlaps (a ring touching it,
+    or near it across a corner: `_labels_apart` tells the latter)."""
     return _grown_box_meets(box, pad, pts, ring_ptr, np.arange(ring_ptr.shape[0] - 1))
 
 
@@ -251,8 +251,7 @@ def _grown_box_meets(box, pad, pts, ring_ptr, rings):
         b, m = _clip(bufs, 0, hi - lo, window, sign)
         if m >= 0 and _area(bufs, b, m) > 1e-12:
             return 1
-        if not _rings_apart(window, pts, lo, hi, 1e-9):
-            unsure = True
+        unsure = True
     return -1 if unsure else 0
 
 
@@ -359,6 +358,44 @@ def _meets_labels(box, cx0, cx1, cy0, cy1, pad, a_pts, a_ring_ptr, a_cells, a_ha
 
 
 @njit(cache=True)
+def grown_box_apart(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.ndarray) -> bool:
+    """Whether every ring pts[ring_ptr[r]:ring_ptr[r + 1]] lies more than 1e-9 mm from the box
+    (k, 2) grown by `pad` as `grown_box_meets` grows it (`_rings_apart`): what an unsure answer of
+    that kernel turns out to be for a box near a bent leader strip or across a box's corner."""
+    window = offset_bounds(box, pad)[0]
+    for r in range(ring_ptr.shape[0] - 1):
+        if not _rings_apart(window, pts, ring_ptr[r], ring_ptr[r + 1], 1e-9):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _set_apart(window, pts, ring_ptr, cells, has_ring, n, cx0, cx1, cy0, cy1, near):
+    """Whether every item of one hashed set sharing a cell with cx0..cx1, cy0..cy1 has a ring
+    more than 1e-9 mm from the convex ring `window` (`_rings_apart`)."""
+    m = _near_cells(cells, has_ring, n, cx0, cx1, cy0, cy1, near)
+    if m < 0:
+        return False
+    for r in near[:m]:
+        if not _rings_apart(window, pts, ring_ptr[r], ring_ptr[r + 1], 1e-9):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _labels_apart(box, cx0, cx1, cy0, cy1, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
+                  b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, near_a, near_b):
+    """Whether the box (4, 2) grown by `pad` (`grown_box_meets`' outline) lies more than 1e-9 mm
+    from every label shape near it (`_meets_labels`' sets): what an unsure answer of
+    `_meets_labels` turns out to be for a box near a bent leader strip or across a box's corner
+    (4,484 times on the Loop-subdivided fish). False when an item near it has no ring, or one is
+    that close. (Only `first_clear_box` asks: a first run compiles it when a make needs it.)"""
+    window = offset_bounds(box, pad)[0]
+    return (_set_apart(window, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n, cx0, cx1, cy0, cy1, near_a)
+            and _set_apart(window, b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, cx0, cx1, cy0, cy1, near_b))
+
+
+@njit(cache=True)
 def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
                     b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, clear, least, pts, ring_ptr, ring_sign, obs_ptr,
                     face_bounds, extra_bounds, n_extras):
@@ -369,9 +406,10 @@ def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_ce
     obstacles of a piece's table (pts .. obs_ptr: the module docstring) whose bounds (x0, y0,
     x1, y1) meet its own grown by `clear`: the faces (face_bounds (F, 4), obstacles 0..F-1),
     then the first n_extras extras (extra_bounds, obstacles F..). The labels near a box are those
-    sharing a hash cell with it (box_cells[i], as the items'). As (j, 0); (j, 1) when that box is
-    one these tests cannot tell (an item without a ring near it, or an unsure answer: the caller
-    decides it); (len(order), -1) when none is clear."""
+    sharing a hash cell with it (box_cells[i], as the items'); where `grown_box_meets` is unsure,
+    they are told by distance (`_labels_apart`). As (j, 0); (j, 1) when that box is one these
+    tests cannot tell (an item without a ring near it, one touching it, or an unsure answer: the
+    caller decides it); (len(order), -1) when none is clear."""
     no_discs = np.zeros((0, 1, 2))
     near_a = np.empty(a_n, dtype=np.int64)
     near_b = np.empty(b_n, dtype=np.int64)
@@ -384,7 +422,9 @@ def first_clear_box(boxes, order, start, box_cells, pad, a_pts, a_ring_ptr, a_ce
                             near_a, near_b)
         if hit == 1:
             continue
-        if hit < 0:
+        if hit < 0 and not _labels_apart(box, box_cells[i, 0], box_cells[i, 1], box_cells[i, 2], box_cells[i, 3],
+                                         pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n, b_pts, b_ring_ptr,
+                                         b_cells, b_has_ring, b_n, near_a, near_b):
             return j, 1
         answer = _room_blocks(box, clear, no_discs, least, -1, pts, ring_ptr, ring_sign, obs_ptr, face_bounds,
                               extra_bounds, n_extras, obstacles)
