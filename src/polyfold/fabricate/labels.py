@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..jit import njit
-from .overlap_kernels import first_box_in_triangle, first_clear_box
+from .overlap_kernels import first_box_in_triangle, first_clear_box, point_segment_distance
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT
 from .tabs import OVERLAP_MM2, TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
@@ -276,23 +276,13 @@ def _nearer_than_others(pts, segments, own, pad):
         other[k] = not (same or swapped)
     out = np.ones(len(pts), dtype=np.bool_)
     for i in range(len(pts)):
-        limit = _segment_distance(pts[i, 0], pts[i, 1], own[0, 0], own[0, 1], own[1, 0], own[1, 1]) + pad
+        limit = point_segment_distance(pts[i, 0], pts[i, 1], own[0, 0], own[0, 1], own[1, 0], own[1, 1]) + pad
         for k in range(len(segments)):
-            if other[k] and not _segment_distance(pts[i, 0], pts[i, 1], segments[k, 0, 0], segments[k, 0, 1],
+            if other[k] and not point_segment_distance(pts[i, 0], pts[i, 1], segments[k, 0, 0], segments[k, 0, 1],
                                                   segments[k, 1, 0], segments[k, 1, 1]) > limit:
                 out[i] = False
                 break
     return out
-
-
-@njit(cache=True, inline="always")
-def _segment_distance(px, py, a0, a1, b0, b1):
-    """Distance from (px, py) to the segment (a0, a1)-(b0, b1), as `_nearer_than_others` says."""
-    ab0, ab1 = b0 - a0, b1 - a1
-    t = ((px - a0) * ab0 + (py - a1) * ab1) / max(ab0 * ab0 + ab1 * ab1, 1e-300)
-    t = min(max(t, 0.0), 1.0)
-    d0, d1 = a0 + t * ab0 - px, a1 + t * ab1 - py
-    return math.sqrt(d0 * d0 + d1 * d1)
 
 
 def _end_away(side: CutSide, neighbour: CutSide) -> np.ndarray:

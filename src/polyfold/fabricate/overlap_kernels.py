@@ -11,6 +11,8 @@ is the area of the subject within the window, for any simple subject ring.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..jit import njit
@@ -211,7 +213,7 @@ def grown_box_meets(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.n
     (shapely's buffer with quad_segs=1), meets any of the rings pts[ring_ptr[r]:ring_ptr[r + 1]]:
     1 when one overlaps it by more than 1e-12 mm², 0 when each lies more than 1e-9 mm beyond
     one of its sides; -1 when neither tells for some ring and none overlaps (a ring touching it,
-    or near it across a corner: `_labels_apart` tells the latter)."""
+    or near it across a corner: `grown_box_apart` tells the latter)."""
     return _grown_box_meets(box, pad, pts, ring_ptr, np.arange(ring_ptr.shape[0] - 1))
 
 
@@ -255,29 +257,31 @@ def _grown_box_meets(box, pad, pts, ring_ptr, rings):
     return -1 if unsure else 0
 
 
-@njit(cache=True)
-def _point_segment_dist2(px, py, qx, qy, rx, ry):
-    """Squared distance from the point p to the segment q-r."""
-    ex, ey = rx - qx, ry - qy
-    l2 = ex * ex + ey * ey
-    t = 0.0 if l2 == 0.0 else min(1.0, max(0.0, ((px - qx) * ex + (py - qy) * ey) / l2))
-    fx, fy = qx + t * ex - px, qy + t * ey - py
-    return fx * fx + fy * fy
+@njit(cache=True, inline="always")
+def point_segment_distance(px, py, a0, a1, b0, b1):
+    """Distance from (px, py) to the segment (a0, a1)-(b0, b1): numpy's of the nearest point on
+    it, to the last bit: t = ((p - a) . ab) / max(ab . ab, 1e-300) clipped to [0, 1], then the
+    norm of a + t ab - p (`labels._nearer_than_others` compares such distances)."""
+    ab0, ab1 = b0 - a0, b1 - a1
+    t = ((px - a0) * ab0 + (py - a1) * ab1) / max(ab0 * ab0 + ab1 * ab1, 1e-300)
+    t = min(max(t, 0.0), 1.0)
+    d0, d1 = a0 + t * ab0 - px, a1 + t * ab1 - py
+    return math.sqrt(d0 * d0 + d1 * d1)
 
 
 @njit(cache=True)
-def _segments_dist2(ax, ay, bx, by, cx, cy, dx, dy):
-    """Squared distance between the segments a-b and c-d: 0 when they cross, else the least of
-    their ends' distances to the other segment (where the least distance of two segments that do
-    not cross lies)."""
+def _segments_distance(ax, ay, bx, by, cx, cy, dx, dy):
+    """Distance between the segments a-b and c-d: 0 when they cross, else the least of their
+    ends' distances to the other segment (where the least distance of two segments that do not
+    cross lies)."""
     o1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
     o2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
     o3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
     o4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
     if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and ((o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)):
         return 0.0
-    return min(_point_segment_dist2(ax, ay, cx, cy, dx, dy), _point_segment_dist2(bx, by, cx, cy, dx, dy),
-               _point_segment_dist2(cx, cy, ax, ay, bx, by), _point_segment_dist2(dx, dy, ax, ay, bx, by))
+    return min(point_segment_distance(ax, ay, cx, cy, dx, dy), point_segment_distance(bx, by, cx, cy, dx, dy),
+               point_segment_distance(cx, cy, ax, ay, bx, by), point_segment_distance(dx, dy, ax, ay, bx, by))
 
 
 @njit(cache=True)
@@ -291,7 +295,7 @@ def _rings_apart(window, pts, lo, hi, eps):
         bx, by = window[(e + 1) % k, 0], window[(e + 1) % k, 1]
         for i in range(lo, hi):
             j = i + 1 if i + 1 < hi else lo
-            if _segments_dist2(ax, ay, bx, by, pts[i, 0], pts[i, 1], pts[j, 0], pts[j, 1]) <= eps * eps:
+            if _segments_distance(ax, ay, bx, by, pts[i, 0], pts[i, 1], pts[j, 0], pts[j, 1]) <= eps:
                 return False
     # a corner of the ring inside the convex window: on the inner side of all its sides
     sign = 1.0 if _orientation(window) >= 0 else -1.0
@@ -357,35 +361,39 @@ def _meets_labels(box, cx0, cx1, cy0, cy1, pad, a_pts, a_ring_ptr, a_cells, a_ha
     return -1 if unsure else 0
 
 
+APART_MM = 1e-9  # a label shape farther than this from a grown box does not meet it (shapely would agree)
+
+
 @njit(cache=True)
-def grown_box_apart(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.ndarray) -> bool:
-    """Whether every ring pts[ring_ptr[r]:ring_ptr[r + 1]] lies more than 1e-9 mm from the box
-    (k, 2) grown by `pad` as `grown_box_meets` grows it (`_rings_apart`): what an unsure answer of
-    that kernel turns out to be for a box near a bent leader strip or across a box's corner."""
-    window = offset_bounds(box, pad)[0]
-    for r in range(ring_ptr.shape[0] - 1):
-        if not _rings_apart(window, pts, ring_ptr[r], ring_ptr[r + 1], 1e-9):
+def _all_apart(window, pts, ring_ptr, rings):
+    """Whether every ring pts[ring_ptr[r]:ring_ptr[r + 1]], r in `rings`, lies more than APART_MM
+    from the convex ring `window` (`_rings_apart`)."""
+    for r in rings:
+        if not _rings_apart(window, pts, ring_ptr[r], ring_ptr[r + 1], APART_MM):
             return False
     return True
+
+
+@njit(cache=True)
+def grown_box_apart(box: np.ndarray, pad: float, pts: np.ndarray, ring_ptr: np.ndarray) -> bool:
+    """Whether every ring pts[ring_ptr[r]:ring_ptr[r + 1]] lies more than APART_MM from the box
+    (k, 2) grown by `pad` as `grown_box_meets` grows it (`_all_apart`): what an unsure answer of
+    that kernel turns out to be for a box near a bent leader strip or across a box's corner."""
+    return _all_apart(offset_bounds(box, pad)[0], pts, ring_ptr, np.arange(ring_ptr.shape[0] - 1))
 
 
 @njit(cache=True)
 def _set_apart(window, pts, ring_ptr, cells, has_ring, n, cx0, cx1, cy0, cy1, near):
     """Whether every item of one hashed set sharing a cell with cx0..cx1, cy0..cy1 has a ring
-    more than 1e-9 mm from the convex ring `window` (`_rings_apart`)."""
+    more than APART_MM from the convex ring `window` (`_all_apart`)."""
     m = _near_cells(cells, has_ring, n, cx0, cx1, cy0, cy1, near)
-    if m < 0:
-        return False
-    for r in near[:m]:
-        if not _rings_apart(window, pts, ring_ptr[r], ring_ptr[r + 1], 1e-9):
-            return False
-    return True
+    return m >= 0 and _all_apart(window, pts, ring_ptr, near[:m])
 
 
 @njit(cache=True)
 def _labels_apart(box, cx0, cx1, cy0, cy1, pad, a_pts, a_ring_ptr, a_cells, a_has_ring, a_n,
                   b_pts, b_ring_ptr, b_cells, b_has_ring, b_n, near_a, near_b):
-    """Whether the box (4, 2) grown by `pad` (`grown_box_meets`' outline) lies more than 1e-9 mm
+    """Whether the box (4, 2) grown by `pad` (`grown_box_meets`' outline) lies more than APART_MM
     from every label shape near it (`_meets_labels`' sets): what an unsure answer of
     `_meets_labels` turns out to be for a box near a bent leader strip or across a box's corner
     (4,484 times on the Loop-subdivided fish). False when an item near it has no ring, or one is
