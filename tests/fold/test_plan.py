@@ -5,12 +5,16 @@ without creases."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
 from conftest import straight, subdivided_box, whole_net
 from fold_checker import check_fold
 from path_checker import FoldNet, check_path
+from polyfold.deadline import Deadline
+from polyfold.fold import sequential
 from polyfold.fold.plan import is_linearly_foldable, plan_fold
 from polyfold.formats.fold import fold_tree, net_to_fold, with_path
 from polyfold.formats.meshes import load_mesh
@@ -72,15 +76,29 @@ def test_sequential_planner_folds_the_whole_horse(models_dir):
     assert plan_fold(tree, planner="lazy-prm", time_limit=3, seed=1) is None
 
 
-def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_dir):
-    """Horse net 13: nine creases of a curled strip carrying a 67-face flap can open neither alone,
+def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_dir, monkeypatch):
+    """Horse net 13: a dozen creases of a curled strip carrying a large flap can open neither alone,
     nor first, nor together in the discrete domain (this seed had no path before). The
     RRT-Connect search over those creases opens them; its frames (the path's first ones, off the
-    discrete domain) are re-checked by the independent checker, the rest is discrete."""
+    discrete domain) are re-checked by the independent checker, the rest is discrete. The first
+    restart locks on another set, whose search (RRT_FIRST_S) fails; it once had half the time
+    limit (30 s) before that restart came."""
+    searches = []  # (creases, seconds given, found)
+    search = sequential.rrt_connect
+
+    def recorded(check, start, moving, deadline, rng):
+        given = deadline.left()
+        rest = search(check, start, moving, deadline, rng)
+        searches.append((len(moving), given, rest is not None))
+        return rest
+
+    monkeypatch.setattr(sequential, "rrt_connect", recorded)
     fold = whole_net(models_dir, "horse-302", 13, 302)
     tree = fold_tree(fold)
     path = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
     assert path is not None and path.planner == "sequential-rrt"
+    assert len(searches) >= 2 and not searches[0][2] and searches[-1][2]
+    assert all(given <= sequential.RRT_FIRST_S + 1e-3 for _n, given, _found in searches)
     goal = tree.goal[tree.creases]
     cr = path.frames[:, tree.creases]
     discrete = np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal), axis=1)
@@ -96,6 +114,35 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     for s in range(k):
         _, hit = net.segment_collision(deg[s], deg[s + 1], 0.5, skip_start=s > 0)
         assert hit is None, f"segment {s} collides at {hit}"
+
+
+def test_a_stuck_sets_search_gets_twice_as_long_each_time_it_recurs(models_dir, monkeypatch):
+    """Every restart locks on the same creases and their continuous search finds nothing: it is
+    given RRT_FIRST_S, then twice the last each time, never more than half the time left, and the
+    planner gives up at its deadline. (RRT_FIRST_S made 0.05 s, the limit 1 s.)"""
+    tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
+    stuck = np.zeros(len(tree.creases), dtype=bool)
+    stuck[:3] = True
+    deadline = Deadline.after(1.0)
+    given = []  # (seconds the search is given, seconds the planner has left, creases)
+
+    def locked(tree, check, prio, until):
+        return [tree.goal.copy()], ~stuck
+
+    def fails(check, start, moving, until, rng):
+        given.append((until.left(), deadline.left(), len(moving)))
+        time.sleep(max(0.0, until.left()))
+        return None
+
+    monkeypatch.setattr(sequential, "RRT_FIRST_S", 0.05)
+    monkeypatch.setattr(sequential, "_open_in_order", locked)
+    monkeypatch.setattr(sequential, "rrt_connect", fails)
+    assert sequential.plan_sequential(tree, None, deadline, np.random.default_rng(1)) is None
+    assert len(given) >= 5 and all(n == 3 for _g, _l, n in given)
+    for k, (seconds, left, _n) in enumerate(given):
+        assert seconds == pytest.approx(min(0.05 * 2 ** k, left / 2), abs=2e-3)
+    # 0.05, 0.1 and 0.2 s; then half of the 0.65 s left, not 0.4
+    assert [g for g, _l, _n in given[:4]] == pytest.approx([0.05, 0.1, 0.2, 0.325], abs=3e-3)
 
 
 # ----------------------------------------------------------------------------------------------
