@@ -192,3 +192,65 @@ def test_choose_tab_takes_the_tab_the_one_by_one_rule_takes(monkeypatch):
                 assert np.array_equal(np.concatenate(got.polygons), poly)
             kinds.append("none" if expect is None else expect[0])
     assert {"none", "whole", "clipped"} <= set(kinds)
+
+
+def _crowded_rooms(rng: np.random.Generator):
+    """Two random grid rooms (`_grid_room`) with tabs (or labels) already beside some of their
+    outlines, and their outline sides."""
+    (room0, sides0), (room1, sides1) = _grid_room(rng, 0.0), _grid_room(rng, 100.0)
+    for room, sides in ((room0, sides0), (room1, sides1)):
+        for side in sides:
+            if rng.random() < 0.4:
+                n, u = side.outward(), (side.p1 - side.p0) / side.length
+                w = rng.uniform(0.5, 3.0)
+                at = side.p0 + rng.uniform(0.0, 1.0) * (side.p1 - side.p0) + n * rng.uniform(0.2, 4.0)
+                room.add([Polygon([at - u * w, at + u * w, at + u * w + n * w, at - u * w + n * w])])
+    return [room0, room1], sides0, sides1
+
+
+def test_the_memo_takes_a_tab_again_beside_the_same_things_on_a_cut_piece():
+    # choose_tab's memo keys a pair by what lies near its sides: the same pair on pieces that lost
+    # their faces and tabs far from it (faces renumbered, their order kept, as a cut piece's are)
+    # gets the tab found before, and choosing it afresh there gives the very same tab; a tab
+    # added beside a side makes it look again
+    from polyfold.fabricate.tabs import NEAR_MM, _choose_tab
+
+    rng = np.random.default_rng(5)
+    hits = misses = 0
+    for trial in range(20):
+        rooms, sides0, sides1 = _crowded_rooms(rng)
+        memo: dict = {}
+        pair = (sides0[rng.integers(len(sides0))], sides1[rng.integers(len(sides1))])
+        first = choose_tab(pair, rooms, memo)
+        cut_rooms, cut_pair = [], []
+        for side, room in zip(pair, rooms):
+            reach = full_depth(side.length) + TAB_CLEAR_MM + NEAR_MM + 0.5
+            lo, hi = np.minimum(side.p0, side.p1) - reach, np.maximum(side.p0, side.p1) + reach
+            near = np.array([b[0] <= hi[0] and lo[0] <= b[2] and b[1] <= hi[1] and lo[1] <= b[3]
+                             for b in shapely.bounds(room.faces)])
+            kept = np.flatnonzero(near | (rng.random(len(near)) < 0.3))  # and some far ones
+            cut = Room(room.faces[kept])
+            cut.add([g for g in room.extra if (lambda b: b[0] <= hi[0] and lo[0] <= b[2] and b[1] <= hi[1]
+                                                and lo[1] <= b[3])(g.bounds)])
+            cut.add([Polygon([(500.0, 500.0), (510.0, 500.0), (505.0, 509.0)])])  # far away
+            cut_rooms.append(cut)
+            cut_pair.append(CutSide(side.piece, int(np.searchsorted(kept, side.face)), side.k, side.p0, side.p1,
+                                    side.tri))
+        again = choose_tab(tuple(cut_pair), cut_rooms, memo)
+        fresh = _choose_tab(tuple(cut_pair), cut_rooms)
+        assert again is first and len(memo) == 1
+        if first is None:
+            assert fresh is None
+        else:
+            assert (fresh.side, fresh.reason, fresh.depth) == (first.side, first.reason, first.depth)
+            assert all(np.array_equal(a, b) for a, b in zip(fresh.polygons, first.polygons))
+            assert np.array_equal(fresh.folds, first.folds)
+        hits += 1
+        # something new right beside the first side: looked at again
+        side = cut_pair[0]
+        n = side.outward()
+        mid = (side.p0 + side.p1) / 2
+        cut_rooms[0].add([Polygon([mid + n * 0.6, mid + n * 0.6 + [0.3, 0.0], mid + n * 0.9])])
+        choose_tab(tuple(cut_pair), cut_rooms, memo)
+        misses += len(memo) == 2
+    assert hits == 20 and misses == 20

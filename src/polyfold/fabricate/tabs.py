@@ -201,6 +201,8 @@ class Room:
     _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
     _bounds_array: np.ndarray | None = None  # _bounds as an array, made when asked (None: stale)
     _table: _Obstacles = field(init=False)  # the faces' and extras' rings (`blocked`)
+    _extra_wkb: list = field(default_factory=list)  # each extra's WKB (`near_key`)
+    _face_wkb: np.ndarray | None = None  # each face's WKB, made when `near_key` first asks
 
     def __post_init__(self) -> None:
         import shapely
@@ -217,6 +219,7 @@ class Room:
         """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
         out = copy.copy(self)
         out.extra, out._bounds, out._bounds_array = list(self.extra), list(self._bounds), None
+        out._extra_wkb = list(self._extra_wkb)
         out._table = self._table.copy()
         return out
 
@@ -226,12 +229,36 @@ class Room:
 
         digest = hashlib.blake2b(self.key, digest_size=16)
         for g in geoms:
+            wkb = shapely.to_wkb(g)
             self.extra.append(g)
             self._bounds.append(g.bounds)
+            self._extra_wkb.append(wkb)
             self._table.add(g)
-            digest.update(shapely.to_wkb(g))
+            digest.update(wkb)
         self.key = digest.digest()
         self._bounds_array = None
+
+    def near_key(self, bounds: tuple[float, float, float, float], skip_face: int) -> bytes:
+        """A digest of what lies near `bounds` (x0, y0, x1, y1): the faces and extras whose bounds
+        meet them, each by its coordinates, the faces in their order, then the extras in theirs,
+        and which of those faces is `skip_face`. Equal digests of a region that holds every
+        obstacle a test of the room could meet: equal answers, whatever lies elsewhere on the
+        piece and however its faces are numbered (`choose_tab`'s memo)."""
+        import shapely
+
+        region = shapely.box(*bounds)
+        faces = np.sort(self.tree.query(region))
+        extras = self._extras_near(region)
+        if self._face_wkb is None:
+            self._face_wkb = shapely.to_wkb(self.faces)
+        skip = np.flatnonzero(faces == skip_face)
+        digest = hashlib.blake2b(np.array([len(faces), len(extras), skip[0] if len(skip) else -1],
+                                          dtype=np.int64).tobytes(), digest_size=16)
+        for f in faces.tolist():
+            digest.update(self._face_wkb[f])
+        for e in extras.tolist():
+            digest.update(self._extra_wkb[e])
+        return digest.digest()
 
     def obstacle_table(self) -> tuple:
         """What `overlap_kernels.first_clear_box` reads of the room: its obstacles' table (points,
@@ -250,7 +277,7 @@ class Room:
     def obstacle_ids(self, region, skip_face: int | None = None) -> np.ndarray:
         """The obstacles whose bounds meet `region`'s, as the table numbers them (faces, but
         `skip_face`, then len(faces) + the extras' indices)."""
-        faces = self.tree.query(region)
+        faces = np.sort(self.tree.query(region))  # (in the tree's order they would depend on the whole piece)
         if skip_face is not None:
             faces = faces[faces != skip_face]
         return np.concatenate([faces, len(self.faces) + self._extras_near(region)]).astype(np.int64)
@@ -294,7 +321,7 @@ class Room:
 
         x0, y0, x1, y1 = poly.bounds
         region = shapely.box(x0 - clear, y0 - clear, x1 + clear, y1 + clear)  # holds the grown poly
-        faces = self.tree.query(region)
+        faces = np.sort(self.tree.query(region))  # (sums in an order that only what is near decides)
         if skip_face is not None:
             faces = faces[faces != skip_face]
         extras = self._extras_near(region)
@@ -404,16 +431,30 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | N
     first), else the larger clipped tab of the two sides; None when nothing fits (see the module
     docstring). A tab may touch the faces beside its fold line at the corners, nothing else.
 
-    It depends on nothing but the two sides and what is on their pieces, so `memo` (a dict kept
-    across drawings of one model's pieces: make draws them again after cutting some) keeps it by
-    the sides' data and the two rooms' keys: a pair drawn again beside the same faces, tabs and
-    labels gets the tab found before, untested."""
+    It depends on nothing but the two sides and what lies near them on their pieces: every tab
+    tried on a side lies within its full depth of the side's ends (trapezoids taper inwards), and
+    the tests meet only obstacles whose bounds come within TAB_CLEAR_MM of a tab's. So `memo` (a
+    dict kept across drawings of one model's pieces: make draws them again after cutting some)
+    keeps it by the sides' coordinates and what lies within NEAR_MM more than that of each side
+    (`Room.near_key`): a pair drawn again beside the same faces and tabs gets the tab found
+    before, untested, though its piece was cut elsewhere and its faces renumbered."""
     if memo is None:
         return _choose_tab(sides, rooms)
-    key = (sides[0].key(), sides[1].key(), rooms[sides[0].piece].key, rooms[sides[1].piece].key)
+    key = tuple(_side_key(side, rooms[side.piece]) for side in sides)
     if key not in memo:
         memo[key] = _choose_tab(sides, rooms)
     return memo[key]
+
+
+NEAR_MM = 0.01  # margin of `choose_tab`'s memo key around the region its tests can reach
+
+
+def _side_key(side: CutSide, room: Room) -> tuple:
+    """A side's coordinates and what lies near it on its piece (`choose_tab`'s memo key)."""
+    reach = full_depth(side.length) + TAB_CLEAR_MM + NEAR_MM
+    lo, hi = np.minimum(side.p0, side.p1) - reach, np.maximum(side.p0, side.p1) + reach
+    return (side.k, side.p0.tobytes(), side.p1.tobytes(), side.tri.tobytes(),
+            room.near_key((float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])), side.face))
 
 
 def _choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> Tab | None:
