@@ -198,8 +198,9 @@ class Room:
     face_bounds: np.ndarray = field(init=False)  # (F, 4) x0, y0, x1, y1 of every face
     key: bytes = field(init=False)
     extra: list = field(default_factory=list)
-    _bounds: list = field(default_factory=list)  # (x0, y0, x1, y1) of each extra
-    _bounds_array: np.ndarray | None = None  # _bounds as an array, made when asked (None: stale)
+    # (x0, y0, x1, y1) of each extra in the first len(extra) rows (room to grow below them: a
+    # piece's rooms take hundreds of tabs and labels one by one, and are asked after each)
+    _bounds: np.ndarray = field(default_factory=lambda: np.zeros((16, 4)))
     _table: _Obstacles = field(init=False)  # the faces' and extras' rings (`blocked`)
     _extra_wkb: list = field(default_factory=list)  # each extra's WKB (`near_key`)
     _face_wkb: np.ndarray | None = None  # each face's WKB, made when `near_key` first asks
@@ -218,7 +219,7 @@ class Room:
     def copy(self) -> Room:
         """The same room, its placed geometries in lists of their own (the faces and tree shared)."""
         out = copy.copy(self)
-        out.extra, out._bounds, out._bounds_array = list(self.extra), list(self._bounds), None
+        out.extra, out._bounds = list(self.extra), self._bounds.copy()
         out._extra_wkb = list(self._extra_wkb)
         out._table = self._table.copy()
         return out
@@ -230,13 +231,14 @@ class Room:
         digest = hashlib.blake2b(self.key, digest_size=16)
         for g in geoms:
             wkb = shapely.to_wkb(g)
+            if len(self.extra) == len(self._bounds):
+                self._bounds = np.concatenate([self._bounds, np.zeros_like(self._bounds)])
+            self._bounds[len(self.extra)] = g.bounds
             self.extra.append(g)
-            self._bounds.append(g.bounds)
             self._extra_wkb.append(wkb)
             self._table.add(g)
             digest.update(wkb)
         self.key = digest.digest()
-        self._bounds_array = None
 
     def near_key(self, bounds: tuple[float, float, float, float], skip_face: int) -> bytes:
         """A digest of what lies near `bounds` (x0, y0, x1, y1): the faces and extras whose bounds
@@ -265,14 +267,11 @@ class Room:
         ring pointers and signs, obstacle pointers), the faces' bounds (F, 4), the extras'
         bounds (E, 4) and E."""
         t = self._table
-        return t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._extra_bounds(), len(self._bounds)
+        return t.pts, t.ring_ptr, t.ring_sign, t.obs_ptr, self.face_bounds, self._extra_bounds(), len(self.extra)
 
     def _extra_bounds(self) -> np.ndarray:
-        """(E, 4) x0, y0, x1, y1 of every extra, made when asked for after an addition (it is
-        asked about a dozen times between two)."""
-        if self._bounds_array is None:
-            self._bounds_array = np.asarray(self._bounds, dtype=float).reshape(-1, 4)
-        return self._bounds_array
+        """(E, 4) x0, y0, x1, y1 of every extra (a view: later additions leave its rows as they are)."""
+        return self._bounds[:len(self.extra)]
 
     def obstacle_ids(self, region, skip_face: int | None = None) -> np.ndarray:
         """The obstacles whose bounds meet `region`'s, as the table numbers them (faces, but
@@ -293,7 +292,7 @@ class Room:
 
     def _extras_near(self, region) -> np.ndarray:
         """Indices of the extras whose bounds meet `region`'s."""
-        if not self._bounds:
+        if not self.extra:
             return np.zeros(0, dtype=np.int64)
         x0, y0, x1, y1 = region.bounds
         b = self._extra_bounds()
