@@ -120,3 +120,53 @@ def test_flat_regions_are_never_cut(models_dir, name):
     opened, stats = open_notches(net)
     assert opened.n_pieces == 1
     assert_flat_regions_whole(opened)
+
+
+def test_the_moved_faces_alone_give_the_full_layouts_verdict(models_dir):
+    # `_moved_clear` lays out only the faces a swap moves (the rest keep their corners): on random
+    # swaps of a net's tree (cut a crease, glue a cut edge across its subtree's border) its verdict
+    # is that of laying the whole swapped tree out from its root and testing the moved faces
+    # against the others; both verdicts occur
+    from polyfold.collide.flat import face_bounds, overlapping_pairs_between
+    from polyfold.unfold import kernels as K
+    from polyfold.unfold.net import _dfs_intervals
+    from polyfold.unfold.problem import UnfoldProblem
+    from polyfold.unfold.tabroom import _laid, _moved_clear
+
+    mesh = load_mesh(models_dir / "fish-472.obj").mesh
+    net, _ = unfold(mesh, seed=2, time_limit=20, max_pieces=1)
+    problem = UnfoldProblem.from_mesh(mesh, base=int(net.order[0]))
+    laid = _laid(net, problem)
+    assert np.array_equal(laid.coords, net.coords)  # (the search lays its nets out the same way)
+    topo = mesh.topology
+    inner = (topo.edge_faces >= 0).all(axis=1)
+    tin, tout = _dfs_intervals(net.parent)
+    rng = np.random.default_rng(7)
+    verdicts = []
+    for _ in range(300):
+        crease = net.crease_mask.copy()
+        e2 = int(rng.choice(np.flatnonzero(crease)))
+        a, b = topo.edge_faces[e2]
+        child = a if net.parent[a] == b else b
+        moved = (tin >= tin[child]) & (tin < tout[child])
+        fa, fb = topo.edge_faces[:, 0], topo.edge_faces[:, 1]
+        across = np.flatnonzero(inner & ~crease & (moved[np.maximum(fa, 0)] != moved[np.maximum(fb, 0)]))
+        if not len(across):
+            continue
+        g = int(rng.choice(across))
+        crease[e2], crease[g] = False, True
+        n = mesh.n_faces
+        parent, parent_edge, order = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
+        assert K.tree_from_creases(crease, int(net.order[0]), problem.adj_ptr, problem.adj_face, problem.adj_edge,
+                                   parent, parent_edge, order) == n
+        coords = np.empty((n, 3, 2))
+        K.layout_tree(order, parent, parent_edge, mesh.faces, topo.face_edges, problem.local, coords)
+        bounds = [np.empty(n) for _ in range(4)]
+        face_bounds(coords, order, *bounds)
+        full = not len(overlapping_pairs_between(coords, parent, np.flatnonzero(moved), np.flatnonzero(~moved),
+                                                 *bounds, problem.tol, np.int64(1)))
+        assert np.array_equal(coords[~moved], laid.coords[~moved])  # the others keep their corners
+        assert _moved_clear(net, laid, problem, crease, moved, np.flatnonzero(moved), np.flatnonzero(~moved),
+                            g) == full
+        verdicts.append(full)
+    assert len(verdicts) > 200 and any(verdicts) and not all(verdicts)

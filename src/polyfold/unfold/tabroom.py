@@ -187,6 +187,56 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndar
                piece=np.zeros(n, dtype=np.int64))
 
 
+@dataclass(frozen=True, eq=False)
+class _Laid:
+    """A net's faces as `_relaid` lays them out from its root: corners (F, 3, 2) and bounds (F,)."""
+
+    coords: np.ndarray
+    xmin: np.ndarray
+    xmax: np.ndarray
+    ymin: np.ndarray
+    ymax: np.ndarray
+
+
+def _laid(net: Net, problem: UnfoldProblem) -> _Laid:
+    """`_Laid` of the net's tree, laid out as `_relaid` lays out a net (`layout_tree` from its root)."""
+    n = net.mesh.n_faces
+    coords = np.empty((n, 3, 2))
+    K.layout_tree(net.order, net.parent, net.parent_edge, net.mesh.faces, net.mesh.topology.face_edges, problem.local,
+                  coords)
+    bounds = tuple(np.empty(n) for _ in range(4))
+    face_bounds(coords, net.order, *bounds)
+    return _Laid(coords, *bounds)
+
+
+def _moved_clear(net: Net, laid: _Laid, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndarray,
+                 moved_ids: np.ndarray, rest_ids: np.ndarray, glued: int) -> bool:
+    """The answer of `_relaid`'s first test (no moved face overlaps another face) for the swap
+    that glues edge `glued` and cut the crease above the moved faces (`moved` (F,) bool, their
+    ids, the others' ids; `crease` already swapped), from the moved faces alone: the others keep
+    their parents and corners (`laid`: net laid out from its root), the moved ones hang from
+    `glued` and are placed from there, as `layout_tree` places them (the same arithmetic, face
+    by face from its parent). Most swaps fail here; only the others are laid out in full."""
+    mesh = net.mesh
+    a, b = mesh.topology.edge_faces[glued]
+    top, below = (a, b) if moved[a] else (b, a)
+    parent, parent_edge = net.parent.copy(), net.parent_edge.copy()
+    parent[top], parent_edge[top] = below, glued
+    order = np.empty(len(moved_ids), np.int64)
+    order[0] = top
+    mark = np.zeros(mesh.n_faces, np.int64)
+    mark[top] = 1
+    if K.crease_bfs(crease, moved, mark, np.int64(1), problem.adj_ptr, problem.adj_face, problem.adj_edge, parent,
+                    parent_edge, order, np.int64(0)) != len(moved_ids):
+        return False  # (`_relaid` would not reach every face either)
+    coords = laid.coords.copy()
+    K.place_children(order, parent, parent_edge, mesh.faces, mesh.topology.face_edges, problem.local, coords)
+    xmin, xmax, ymin, ymax = laid.xmin.copy(), laid.xmax.copy(), laid.ymin.copy(), laid.ymax.copy()
+    face_bounds(coords, order, xmin, xmax, ymin, ymax)
+    return not len(overlapping_pairs_between(coords, parent, moved_ids, rest_ids, xmin, xmax, ymin, ymax,
+                                             problem.tol, np.int64(1)))
+
+
 def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = Deadline.never()
                  ) -> tuple[Net, TabRoomStats]:
     """The net with fewer narrow corners (see the module docstring); `keep` (E,) bool: creases no
@@ -204,6 +254,8 @@ def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = 
     inner = (edge_faces >= 0).all(axis=1)
     merged = merged_edges(net.mesh)  # flat polygons stay whole
     keep = merged if keep is None else keep | merged
+    mid = net.mesh.vertices[edges].mean(axis=1)
+    laid = _laid(net, problem)
     swaps, timed_out = 0, False
     for _ in range(MAX_PASSES):  # a swap can open room for another: pass again while one helps
         done = swaps
@@ -213,18 +265,20 @@ def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = 
             if deadline.expired():
                 timed_out = True
                 break
-            swapped = _open_one(int(v), net, crease, fans, pen, problem, edges, edge_faces, inner, keep)
+            swapped = _open_one(int(v), net, laid, crease, fans, pen, problem, edges, edge_faces, inner, keep, mid)
             if swapped is not None:
                 net = swapped
+                laid = _laid(net, problem)
                 swaps += 1
         if swaps == done or timed_out:
             break
     return net, TabRoomStats(before, int(np.count_nonzero(pen > 0)), swaps, timed_out)
 
 
-def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep) -> Net | None:
+def _open_one(v, net, laid, crease, fans, pen, problem, edges, edge_faces, inner, keep, mid) -> Net | None:
     """One swap at vertex v's narrowest corner, if one lowers the penalty and keeps the net
-    overlap-free; updates crease and pen in place. Returns the new net or None."""
+    overlap-free; updates crease and pen in place. Returns the new net or None. laid: `_laid`
+    of net; mid (E, 3): the edges' midpoints."""
     corners = fans.corners(v, crease)
     if not corners:
         return None
@@ -236,9 +290,7 @@ def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep
     target = held / 2
     walk.sort(key=lambda ea: abs(ea[1] - target))
     tin, tout = _dfs_intervals(net.parent)
-    verts = net.mesh.vertices
-    mid = verts[edges].mean(axis=1)
-    here = verts[v]
+    here = net.mesh.vertices[v]
     for e2, _ in walk[:MAX_CUTS]:
         if keep[e2]:
             continue
@@ -252,9 +304,11 @@ def _open_one(v, net, crease, fans, pen, problem, edges, edge_faces, inner, keep
                   for c in np.flatnonzero(delta < -1e-9)]
         # equal gains: the cut edge nearest v first (the moved half turns least, overlaps least)
         scored.sort(key=lambda s: (round(s[0], 2), float(np.linalg.norm(mid[s[1]] - here)), s[1]))
+        moved_ids, rest_ids = np.flatnonzero(in_sub), np.flatnonzero(~in_sub)
         for delta, g, new in scored[:MAX_TRIES]:
             crease[e2], crease[g] = False, True
-            relaid = _relaid(net, problem, crease, in_sub)
+            clear = _moved_clear(net, laid, problem, crease, in_sub, moved_ids, rest_ids, g)
+            relaid = _relaid(net, problem, crease, in_sub) if clear else None
             if relaid is not None:
                 for u, p in new.items():
                     pen[u] = p
