@@ -512,6 +512,20 @@ def _note_spot(side, name: str, size: float, smallest: float, taken: list) -> Te
     return None
 
 
+def _outline(body, tabs: list[np.ndarray], outside: list):
+    """A piece's outline (its faces' union `body` with its tabs) and footprint (with its labels
+    printed off the faces, `outside`)."""
+    import shapely
+
+    tab_polys = [shapely.Polygon(t) for t in tabs]
+    # a clipped tab meets its face mid-edge, where float noise would leave a hair-thin gap:
+    # each tab is grown by 10 nm (invisible) so it overlaps its face, then all is unioned on a grid
+    grown = [t.buffer(1e-5, join_style="mitre") for t in tab_polys]
+    outline = shapely.union_all([body, *grown], grid_size=1e-6) if tab_polys else body
+    outline = _without_specks(outline)
+    return outline, (shapely.union_all([outline, *outside]) if outside else outline)
+
+
 def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True,
                        min_label_mm: float = MIN_LABEL_MM, deadline: Deadline = Deadline.never(),
                        by_run: bool = False, memo: dict | None = None
@@ -523,9 +537,9 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     by_run: per seam run at once (a redraw of pieces whose drawing needed them: the failed try
     took a third of a dense model's drawing). OutOfTime past `deadline` (checked between pieces,
     tabs and labels). memo: one dict for all drawings of one model's pieces at one scale (make
-    draws them again after cutting some): a glued pair's tab (`choose_tab`) and a piece's labels
-    (`_labels`) found before are taken again where all they depend on is the same; the same
-    drawings with or without it."""
+    draws them again after cutting some): a glued pair's tab (`choose_tab`), a piece's labels
+    (`_labels`) and its outline and footprint (`_outline`) found before are taken again where all
+    they depend on is the same; the same drawings with or without it."""
     import shapely
 
     drawn = []
@@ -534,6 +548,7 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         drawn.append(_draw(inp, i, scale))
     pairs, open_edges = _pair_sides(drawn)
     rooms = [Room(shapely.polygons(d.faces_xy)) for d in drawn]
+    faces_keys = [room.key for room in rooms]  # (the faces' coordinates: before tabs join the rooms)
     rho, flat = seam_fold_angles(inputs)
     # a flat polygon whose faces close a cycle keeps one edge out of its tree: both sides lie on
     # each other in the plane, one polygon on paper, not a seam (no slit, label or tab)
@@ -559,14 +574,18 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
             for i in run:
                 g.glue[i] = replace(g.glue[i], printed=str(min(run) + 1))
     pieces = []
+    shapes = None if memo is None else memo.setdefault("outlines", {})
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
-        tab_polys = [shapely.Polygon(t) for t in g.tabs[i]]
-        # a clipped tab meets its face mid-edge, where float noise would leave a hair-thin gap:
-        # each tab is grown by 10 nm (invisible) so it overlaps its face, then all is unioned on a grid
-        grown = [t.buffer(1e-5, join_style="mitre") for t in tab_polys]
-        outline = shapely.union_all([d.body, *grown], grid_size=1e-6) if tab_polys else d.body
-        outline = _without_specks(outline)
-        footprint = shapely.union_all([outline, *placed[i].outside]) if placed[i].outside else outline
+        # (a piece drawn again with the same faces, tabs and off-face labels: its outline and
+        # footprint found before, by those as a key)
+        key = (faces_keys[i], tuple(np.asarray(t).tobytes() for t in g.tabs[i]),
+               tuple(shapely.to_wkb(placed[i].outside).tolist()) if placed[i].outside else ())
+        if shapes is not None and key in shapes:
+            outline, footprint = shapes[key]
+        else:
+            outline, footprint = _outline(d.body, g.tabs[i], placed[i].outside)
+            if shapes is not None:
+                shapes[key] = outline, footprint
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
             outline=outline, mountain=d.mountain.reshape(-1, 2, 2), valley=d.valley.reshape(-1, 2, 2),
