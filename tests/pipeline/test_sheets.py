@@ -108,7 +108,8 @@ def test_same_seed_same_pages(models_dir, tmp_path):
 
 def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_afresh(models_dir):
     """split_for_pages draws a model's pieces again after cutting some, with one memo: what it
-    takes from the memo (a pair's tab, a piece's labels) is what drawing afresh gives."""
+    takes from the memo (a pair's tab, a piece's labels, outline and footprint) is what drawing
+    afresh gives."""
     from polyfold.fabricate.split import PagePlan
     from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
 
@@ -129,12 +130,13 @@ def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_a
     cuts = tuple(np.array([creases[len(creases) // 2]] if i == big else [], dtype=np.int64) for i in range(len(before)))
     after = part_piece_inputs(mesh, _cut_plan(fitted, before, PagePlan(cuts, (), 0))[0])
     assert len(after) == len(before) + 1
-    tabs_before, labels_before = len(memo["tabs"]), len(memo["labels"])
+    tabs_before, labels_before, outlines_before = len(memo["tabs"]), len(memo["labels"]), len(memo["outlines"])
     taken, glue_taken, stats_taken = build_sheet_pieces(after, scale, memo=memo)
     fresh, glue_fresh, stats_fresh = build_sheet_pieces(after, scale)
     # the memo was used: fewer new entries than pairs and pieces drawn
     assert len(memo["tabs"]) - tabs_before < stats_fresh.glue_edges
     assert len(memo["labels"]) - labels_before < len(after)
+    assert len(memo["outlines"]) - outlines_before < len(after)
     assert glue_taken == glue_fresh and stats_taken == stats_fresh
     for p, q in zip(taken, fresh, strict=True):
         assert p.outline.equals_exact(q.outline, 0.0) and p.footprint.equals_exact(q.footprint, 0.0)
