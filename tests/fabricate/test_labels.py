@@ -279,3 +279,30 @@ def test_a_free_map_refreshed_in_windows_is_the_free_map_made_anew():
             windows.append([r0, r1, c0, c1])
         _refresh_free(free, taken, np.array(windows, dtype=np.int64), hw, hh)
         assert np.array_equal(free, _box_free(taken, hw, hh))
+
+
+def test_the_free_spot_rasters_dilation_and_enclosed_cells_are_scipys():
+    # `_Taken` grows the face sides by a disc and finds the cells they enclose with two compiled
+    # kernels (make imports no scipy for them): on random rasters of sparse and dense walls, discs of
+    # radius 0-3, they give scipy.ndimage's binary_dilation and the components of its `label`
+    # (4 neighbours) that touch no border
+    from scipy import ndimage
+
+    from polyfold.fabricate.labels import _dilated, _enclosed
+
+    rng = np.random.default_rng(11)
+    enclosed_seen = 0
+    for trial in range(60):
+        ny, nx = rng.integers(1, 40, 2)
+        cells = rng.random((ny, nx)) < rng.choice([0.05, 0.2, 0.5])
+        r = int(rng.integers(0, 4))
+        disc = np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r
+        grown = _dilated(cells, disc)
+        assert np.array_equal(grown, ndimage.binary_dilation(cells, structure=disc))
+        parts, n = ndimage.label(~grown)
+        outer = np.zeros(n + 1, dtype=bool)
+        outer[np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])] = True
+        want = ~grown & ~outer[parts]
+        assert np.array_equal(_enclosed(grown), want)
+        enclosed_seen += int(want.any())
+    assert enclosed_seen >= 10

@@ -92,8 +92,8 @@ def _warm_make(mesh) -> None:
 def _warm_crowded_labels() -> None:
     """The label kernels that only crowded pieces reach (the warm-up's sphere has room for every
     label beside its edge), with the argument types `labels._Taken` gives them."""
-    from ..fabricate.labels import (_box_free, _clear_leaders, _free_cells_near, _grid_bfs, _path_back, _path_turns,
-                                    _refresh_free)
+    from ..fabricate.labels import (_box_free, _clear_leaders, _dilated, _enclosed, _free_cells_near, _grid_bfs,
+                                    _path_back, _path_turns, _refresh_free)
     from ..fabricate.pack import mark_rings
 
     free = np.ones((8, 8), dtype=bool)
@@ -103,6 +103,7 @@ def _warm_crowded_labels() -> None:
     _path_turns(np.ones((3, 2)), ~free, np.zeros(2), 5.0, 0.4)
     _free_cells_near(free, free, free, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, 4.0)
     _box_free(~free, 1, 1)
+    _enclosed(_dilated(~free, np.ones((3, 3), dtype=bool)))
     window = np.array([[0, 3, 0, 3]], dtype=np.int64)
     mark_rings(~free, np.zeros((3, 2)), np.ones((3, 2)), np.array([0, 3]), window)
     _refresh_free(free.copy(), ~free, window, 1, 1)

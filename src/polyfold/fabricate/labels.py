@@ -475,6 +475,55 @@ def _free_cells_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, 
     return centres, d2, counts
 
 
+@njit(cache=True)
+def _dilated(cells, disc):
+    """(ny, nx) bool: `cells` (ny, nx) bool grown by the symmetric structure `disc` (2r + 1, 2r + 1)
+    bool centred on each True cell, nothing beyond the raster (scipy.ndimage's binary_dilation)."""
+    ny, nx = cells.shape
+    r = disc.shape[0] // 2
+    out = np.zeros((ny, nx), dtype=np.bool_)
+    for y in range(ny):
+        for x in range(nx):
+            if cells[y, x]:
+                for dy in range(-r, r + 1):
+                    for dx in range(-r, r + 1):
+                        yy, xx = y + dy, x + dx
+                        if disc[dy + r, dx + r] and 0 <= yy < ny and 0 <= xx < nx:
+                            out[yy, xx] = True
+    return out
+
+
+@njit(cache=True)
+def _enclosed(walls):
+    """(ny, nx) bool: the cells not in `walls` (ny, nx) bool that no path of such cells, from each
+    to one of its 4 side neighbours, joins to the raster's border (the components of scipy.ndimage's
+    `label` that touch no border)."""
+    ny, nx = walls.shape
+    outer = np.zeros((ny, nx), dtype=np.bool_)
+    stack = np.empty((ny * nx, 2), dtype=np.int32)
+    n = 0
+    for y in range(ny):
+        for x in range(nx):
+            if (y == 0 or y == ny - 1 or x == 0 or x == nx - 1) and not walls[y, x] and not outer[y, x]:
+                outer[y, x] = True
+                stack[n, 0], stack[n, 1] = y, x
+                n += 1
+    while n:
+        n -= 1
+        y, x = stack[n, 0], stack[n, 1]
+        for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+            yy, xx = y + dy, x + dx
+            if 0 <= yy < ny and 0 <= xx < nx and not walls[yy, xx] and not outer[yy, xx]:
+                outer[yy, xx] = True
+                stack[n, 0], stack[n, 1] = yy, xx
+                n += 1
+    out = np.zeros((ny, nx), dtype=np.bool_)
+    for y in range(ny):
+        for x in range(nx):
+            out[y, x] = not walls[y, x] and not outer[y, x]
+    return out
+
+
 @njit(cache=True, inline="always")
 def _taken_at(texts, x, y, origin, inv_cell):
     """Whether the cell (column, row) = int((x, y) - origin) inv_cell of texts (ny, nx), clipped to
@@ -518,7 +567,6 @@ class _Taken:
 
     def __init__(self, labels: "PieceLabels") -> None:
         import shapely
-        from scipy import ndimage
 
         x0, y0, x1, y1 = labels.allowed.bounds
         self.origin = np.array([x0, y0])
@@ -552,13 +600,10 @@ class _Taken:
         lines[ij[:, 1], ij[:, 0]] = True
         r = int(round(LABEL_PAD_MM / FREE_CELL_MM))
         disc = np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r
-        lines = ndimage.binary_dilation(lines, structure=disc)
+        lines = _dilated(lines, disc)
         self.grid |= lines
         # inside the faces: the cells the face sides enclose (not joined to the raster's border)
-        parts, n_parts = ndimage.label(~lines)
-        outer = np.zeros(n_parts + 1, dtype=bool)
-        outer[np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]])] = True
-        self.in_faces = ~lines & ~outer[parts]
+        self.in_faces = _enclosed(lines)
         for g in labels.room.extra:
             self.mark(g, TAB_CLEAR_MM)
         everywhere = np.array([[x0, y0], [x1, y1]])

@@ -9,7 +9,6 @@ side carries the glue tab (`tabs.choose_tab`).
 
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass, field, replace
 
@@ -363,8 +362,6 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
             for i in range(len(drawn))]
     order = sorted((i for i in range(len(drawn)) if memo is None or keys[i] not in memo), key=lambda i: -len(jobs[i]))
     n_labels = sum(len(jobs[i]) for i in order)
-    if n_labels >= PARALLEL_LABELS:  # the free-spot rasters' module: imported here once, not in every worker
-        importlib.import_module("scipy.ndimage")
     done = fork_map(place, order, usable_cores() if n_labels >= PARALLEL_LABELS else 1)
     if failed.value or any(p is None for p in done):
         return None
