@@ -575,13 +575,14 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
         # (a piece drawn again with the same faces, tabs and off-face labels: its outline and
         # footprint found before, by those as a key)
-        key = (faces_keys[i], tuple(np.asarray(t).tobytes() for t in g.tabs[i]),
-               tuple(shapely.to_wkb(placed[i].outside).tolist()) if placed[i].outside else ())
-        if shapes is not None and key in shapes:
+        key = None if shapes is None else (
+            faces_keys[i], tuple(np.asarray(t).tobytes() for t in g.tabs[i]),
+            tuple(shapely.to_wkb(placed[i].outside).tolist()) if placed[i].outside else ())
+        if key is not None and key in shapes:
             outline, footprint = shapes[key]
         else:
             outline, footprint = _outline(d.body, g.tabs[i], placed[i].outside)
-            if shapes is not None:
+            if key is not None:
                 shapes[key] = outline, footprint
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,

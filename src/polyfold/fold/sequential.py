@@ -26,7 +26,7 @@ RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much
 # pieces of 60-673 faces from 48 makes (8 Loop-subdivided shared models at 800-2,500 faces, seeds
 # 1-3) the successes took 0.01-0.95 s, a few 2.9-4.1 s; the failures ran the whole half of the time
 # left (10 s of a 20 s limit) and the next restart, on other creases first, then folded the piece in
-# 0.1-1 s. The horse at 800 faces: pieces of 157 and 213 faces 10 s -> 0.6-1.1 s, one of 320 faces
+# 0.1-1 s. The horse at 800 faces: pieces of 157 and 213 faces 10 s -> 0.9-1.2 s, one of 320 faces
 # 11-15 s -> 1.9-9.9 s (seeds 1-3, 20 s).
 RRT_FIRST_S = 1.0
 

@@ -160,11 +160,10 @@ def _swap_gains(e2, cand, crease, edges, pen, ptr, inc_face, inc_corner, face_ed
     return delta, touched, new
 
 
-def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndarray) -> Net | None:
-    """The single-piece net of `crease` rooted where `net` is, or None when it overlaps. moved
-    (F,) bool: the faces a swap turned (a subtree of `net`, now hung from another edge): their
-    pairs with the other faces are tested first, as only those can start to overlap, and every
-    pair only when none does."""
+def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray) -> Net | None:
+    """The single-piece net of `crease` rooted where `net` is, or None when it overlaps (any pair
+    of its faces: asked only for swaps whose moved faces overlap none of the others,
+    `_moved_clear`)."""
     mesh = net.mesh
     n = mesh.n_faces
     parent = np.empty(n, np.int64)
@@ -175,11 +174,6 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndar
         return None
     coords = np.empty((n, 3, 2))
     K.layout_tree(order, parent, parent_edge, mesh.faces, mesh.topology.face_edges, problem.local, coords)
-    xmin, xmax, ymin, ymax = (np.empty(n) for _ in range(4))
-    face_bounds(coords, order, xmin, xmax, ymin, ymax)
-    if len(overlapping_pairs_between(coords, parent, np.flatnonzero(moved), np.flatnonzero(~moved),
-                                     xmin, xmax, ymin, ymax, problem.tol, np.int64(1))):  # (any pair will do)
-        return None
     count, _ = overlapping_pairs(coords, parent, problem.tol, 0)
     if count:
         return None
@@ -189,7 +183,7 @@ def _relaid(net: Net, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndar
 
 @dataclass(frozen=True, eq=False)
 class _Laid:
-    """A net's faces as `_relaid` lays them out from its root: corners (F, 3, 2) and bounds (F,)."""
+    """A net's faces as `layout_tree` lays them out from its root: corners (F, 3, 2) and bounds (F,)."""
 
     coords: np.ndarray
     xmin: np.ndarray
@@ -198,12 +192,15 @@ class _Laid:
     ymax: np.ndarray
 
 
-def _laid(net: Net, problem: UnfoldProblem) -> _Laid:
-    """`_Laid` of the net's tree, laid out as `_relaid` lays out a net (`layout_tree` from its root)."""
+def _laid(net: Net, problem: UnfoldProblem, laid_out: bool = False) -> _Laid:
+    """`_Laid` of the net's tree, laid out as `_relaid` lays out a net (`layout_tree` from its root);
+    laid_out: net.coords are that already (a net `_relaid` made)."""
     n = net.mesh.n_faces
-    coords = np.empty((n, 3, 2))
-    K.layout_tree(net.order, net.parent, net.parent_edge, net.mesh.faces, net.mesh.topology.face_edges, problem.local,
-                  coords)
+    coords = net.coords
+    if not laid_out:
+        coords = np.empty((n, 3, 2))
+        K.layout_tree(net.order, net.parent, net.parent_edge, net.mesh.faces, net.mesh.topology.face_edges,
+                      problem.local, coords)
     bounds = tuple(np.empty(n) for _ in range(4))
     face_bounds(coords, net.order, *bounds)
     return _Laid(coords, *bounds)
@@ -211,7 +208,7 @@ def _laid(net: Net, problem: UnfoldProblem) -> _Laid:
 
 def _moved_clear(net: Net, laid: _Laid, problem: UnfoldProblem, crease: np.ndarray, moved: np.ndarray,
                  moved_ids: np.ndarray, rest_ids: np.ndarray, glued: int) -> bool:
-    """The answer of `_relaid`'s first test (no moved face overlaps another face) for the swap
+    """Whether no moved face overlaps another face (where a swap's overlaps start) for the swap
     that glues edge `glued` and cut the crease above the moved faces (`moved` (F,) bool, their
     ids, the others' ids; `crease` already swapped), from the moved faces alone: the others keep
     their parents and corners (`laid`: net laid out from its root), the moved ones hang from
@@ -228,7 +225,7 @@ def _moved_clear(net: Net, laid: _Laid, problem: UnfoldProblem, crease: np.ndarr
     mark[top] = 1
     if K.crease_bfs(crease, moved, mark, np.int64(1), problem.adj_ptr, problem.adj_face, problem.adj_edge, parent,
                     parent_edge, order, np.int64(0)) != len(moved_ids):
-        return False  # (`_relaid` would not reach every face either)
+        return False  # (the swapped creases do not make a tree: `_relaid` would say None)
     coords = laid.coords.copy()
     K.place_children(order, parent, parent_edge, mesh.faces, mesh.topology.face_edges, problem.local, coords)
     xmin, xmax, ymin, ymax = laid.xmin.copy(), laid.xmax.copy(), laid.ymin.copy(), laid.ymax.copy()
@@ -268,7 +265,7 @@ def open_notches(net: Net, keep: np.ndarray | None = None, deadline: Deadline = 
             swapped = _open_one(int(v), net, laid, crease, fans, pen, problem, edges, edge_faces, inner, keep, mid)
             if swapped is not None:
                 net = swapped
-                laid = _laid(net, problem)
+                laid = _laid(net, problem, laid_out=True)
                 swaps += 1
         if swaps == done or timed_out:
             break
@@ -308,7 +305,7 @@ def _open_one(v, net, laid, crease, fans, pen, problem, edges, edge_faces, inner
         for delta, g, new in scored[:MAX_TRIES]:
             crease[e2], crease[g] = False, True
             clear = _moved_clear(net, laid, problem, crease, in_sub, moved_ids, rest_ids, g)
-            relaid = _relaid(net, problem, crease, in_sub) if clear else None
+            relaid = _relaid(net, problem, crease) if clear else None
             if relaid is not None:
                 for u, p in new.items():
                     pen[u] = p
