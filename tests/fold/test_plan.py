@@ -141,8 +141,41 @@ def test_a_stuck_sets_search_gets_twice_as_long_each_time_it_recurs(models_dir, 
     assert len(given) >= 5 and all(n == 3 for _g, _l, n in given)
     for k, (seconds, left, _n) in enumerate(given):
         assert seconds == pytest.approx(min(0.05 * 2 ** k, left / 2), abs=2e-3)
-    # 0.05, 0.1 and 0.2 s; then half of the 0.65 s left, not 0.4
+    # 0.05, 0.1 and 0.2 s; then half of the 0.65 s left, not 0.4 (the first time the set is met the
+    # restarts have taken no time: no allowance, no search)
     assert [g for g, _l, _n in given[:4]] == pytest.approx([0.05, 0.1, 0.2, 0.325], abs=3e-3)
+
+
+def test_a_set_met_for_the_first_time_is_searched_only_within_the_restarts_allowance(models_dir, monkeypatch):
+    """Restarts of 0.1 s that lock on a new set of creases every time (never round in circles), and
+    searches that find nothing: the searches together take at most RRT_SHARE of the restarts' time
+    (each at most RRT_FIRST_S, none under RRT_MIN_S: not after the first restart's 0.015 s), so
+    the restarts go on at almost their full pace."""
+    tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
+    n = len(tree.creases)
+    deadline = Deadline.after(1.5)
+    restarts, given = [], []  # seconds each restart took; each search's (seconds given, restarts before it)
+
+    def locked(tree, check, prio, until):
+        t0 = time.perf_counter()
+        stuck = np.zeros(n, dtype=bool)
+        stuck[[len(restarts) % n, (len(restarts) + 1) % n]] = True  # a new pair each time
+        time.sleep(0.1)
+        restarts.append(time.perf_counter() - t0)
+        return [tree.goal.copy()], ~stuck
+
+    def fails(check, start, moving, until, rng):
+        given.append((until.left(), len(restarts)))
+        time.sleep(max(0.0, until.left()))
+        return None
+
+    monkeypatch.setattr(sequential, "_open_in_order", locked)
+    monkeypatch.setattr(sequential, "rrt_connect", fails)
+    assert sequential.plan_sequential(tree, None, deadline, np.random.default_rng(1)) is None
+    assert len(restarts) >= 8 and len(given) >= 2
+    assert given[0][1] >= 2  # after the first restart: 0.015 s allowed, under RRT_MIN_S
+    assert all(sequential.RRT_MIN_S - 1e-3 <= g <= sequential.RRT_FIRST_S for g, _k in given)
+    assert sum(g for g, _k in given) <= sequential.RRT_SHARE * sum(restarts) + 5e-3
 
 
 # ----------------------------------------------------------------------------------------------

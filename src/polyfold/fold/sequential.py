@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..deadline import Deadline
+from ..deadline import Deadline, clock
 
 from .checker import ValidityChecker, shortcut
 from .tree import FoldTree, crease_depth_size
@@ -21,14 +21,21 @@ from .tree import FoldTree, crease_depth_size
 RRT_MAX_DOF = 32  # stuck sets of up to this many creases get one
 RRT_STEP_DEG = 15.0  # longest extension of a tree, per crease
 RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much on either side
-# seconds of a stuck set's first continuous search, doubled each time the restarts lock on that set
-# again (never more than half the time left). Searches that succeed mostly do so at once: over 81
-# pieces of 60-673 faces from 48 makes (8 Loop-subdivided shared models at 800-2,500 faces, seeds
-# 1-3) the successes took 0.01-0.95 s, a few 2.9-4.1 s; the failures ran the whole half of the time
-# left (10 s of a 20 s limit) and the next restart, on other creases first, then folded the piece in
-# 0.1-1 s. The horse at 800 faces: pieces of 157 and 213 faces 10 s -> 0.9-1.2 s, one of 320 faces
-# 11-15 s -> 1.9-9.9 s (seeds 1-3, 20 s).
+# A continuous search costs far more than a restart (a second, where a restart of a 382-face net
+# takes 0.2-0.35 s and most take 0.01-0.1 s), and restarts alone unlock nearly every net: of the 12
+# pieces (from 96 makes of 8 Loop-subdivided shared models, 800-2,500 faces, seeds 1-3) whose restarts
+# ever locked on a set of at most RRT_MAX_DOF creases, 11 fold without any search, in 0.08-3.3 s;
+# with a search at every such lock they took 0.08-15 s (bench_start's decimated bunny's 382-face
+# piece 6-15 s: nine 1 s searches that all failed, while its twelfth restart folds it). So a set the
+# restarts meet for the first time is searched only from an allowance, RRT_SHARE of the seconds the
+# restarts have taken less those the searches took, at most RRT_FIRST_S, none under RRT_MIN_S; a
+# set they lock on again (they go round in circles) gets RRT_FIRST_S, twice the last each further
+# time, never more than half the time left. The one piece that needs the search, the horse's
+# 320-face one at 800 faces, folds in 1.8-7.6 s (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7
+# whole-horse nets that use the search take 53-54 s in all (before 102 s).
 RRT_FIRST_S = 1.0
+RRT_SHARE = 0.15
+RRT_MIN_S = 0.02
 
 
 def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
@@ -50,10 +57,11 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
     When a restart is stuck with at most RRT_MAX_DOF creases left closed, their continuous
     subspace is searched by `rrt_connect` from the stuck state to flat: some creases can open
     neither alone, nor first, nor together in the discrete domain (a tightly curled strip carrying
-    a large flap, say) but can by partial, coordinated moves. A search that does not succeed at
-    once seldom does later, while the next restart often unlocks the net: the search of a stuck
-    set gets RRT_FIRST_S seconds, twice as long as the last each time the restarts lock on that
-    set again, never more than half the time left.
+    a large flap, say) but can by partial, coordinated moves. Restarts are cheap and usually
+    unlock the net, a search is costly: a set met for the first time is searched only within an
+    allowance (RRT_SHARE of the restarts' time less the searches'); a set the restarts lock on
+    again gets RRT_FIRST_S seconds, twice as long as the last each further time, never more than
+    half the time left.
     Such a path leaves the discrete domain in its first frames (`continuous?` is then True).
     Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
     """
@@ -66,12 +74,15 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
     tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
     tried: list[set[frozenset]] = [set(), set()]
     searched: dict[frozenset, float] = {}  # seconds given to each stuck set's last continuous search
+    restarts_s = searches_s = 0.0  # seconds the restarts, and the continuous searches, have taken
     restart = 0
     while not deadline.expired():
         track = restart % 2
         prio = tracks[track]
         restart += 1
+        t0 = clock()
         opened = _open_in_order(tree, check, prio, deadline)
+        restarts_s += clock() - t0
         if opened is None:
             return None
         frames, is_open = opened
@@ -84,10 +95,17 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
         key = frozenset(stuck)
         if len(stuck) <= RRT_MAX_DOF:
             # Locked in the discrete domain, but only a few creases are left: search their
-            # continuous subspace (briefly the first time, see RRT_FIRST_S)
-            seconds = searched[key] = 2.0 * searched.get(key, 0.5 * RRT_FIRST_S)
-            rest = rrt_connect(check, frames[-1], creases[stuck], deadline.within(min(seconds, 0.5 * deadline.left())),
-                               rng)
+            # continuous subspace (see RRT_SHARE), longer each time the restarts lock on them again
+            if key in tried[track]:
+                seconds = searched[key] = 2.0 * searched.get(key, 0.5 * RRT_FIRST_S)
+            else:
+                seconds = min(RRT_FIRST_S, RRT_SHARE * restarts_s - searches_s)
+            rest = None
+            if seconds >= RRT_MIN_S:
+                t0 = clock()
+                rest = rrt_connect(check, frames[-1], creases[stuck],
+                                   deadline.within(min(seconds, 0.5 * deadline.left())), rng)
+                searches_s += clock() - t0
             if rest is not None:
                 frames += rest
                 frames.reverse()
