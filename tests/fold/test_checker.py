@@ -122,3 +122,35 @@ def test_a_finer_segment_check_includes_the_resolutions_samples(tree):
     before = check.configs
     check.segment(np.zeros(tree.n_edges), q)
     assert check.configs - before == 14
+
+
+def test_a_move_is_its_ends_validity_and_its_segment(tree):
+    """`ValidityChecker.move(qa, qb)` from a valid qa (a planner's step from where it is) tests qb
+    as a sample of the motion, skipping the pairs the motion keeps in one pose: its verdict is
+    `valid(qb) and segment(qa, qb)` (checked on a separate checker), on steps that open, close or
+    partly turn a few creases of valid configurations, both verdicts occurring; it tests qb first."""
+    import math
+
+    from polyfold.fold.checker import ValidityChecker
+
+    check, fresh = ValidityChecker(tree, math.radians(1.0)), ValidityChecker(tree, math.radians(1.0))
+    rng = np.random.default_rng(3)
+    cr, goal = tree.creases, tree.goal
+    verdicts = []
+    for q in configurations(tree, rng, 160):
+        if not fresh.valid(q):
+            continue
+        for _ in range(3):
+            nxt = q.copy()
+            few = rng.choice(cr, size=min(int(rng.integers(1, 4)), len(cr)), replace=False)
+            nxt[few] = rng.choice([0.0, 1.0, rng.random()], size=len(few)) * goal[few]
+            step = math.radians(rng.choice([0.5, 1.0]))
+            verdict = check.move(q, nxt, step)
+            assert verdict == (fresh.valid(nxt) and fresh.segment(q, nxt, step))
+            verdicts.append(verdict)
+    assert len(verdicts) >= 60 and 0 < sum(verdicts) < len(verdicts)
+    # qb first: an end that collides is found by its first sample
+    bad = next(q for q in configurations(tree, rng, 400) if not fresh.valid(q))
+    before = check.configs
+    assert not check.move(np.zeros(tree.n_edges), bad)
+    assert check.configs - before == 1

@@ -148,9 +148,9 @@ def _open_in_order(tree: FoldTree, check: ValidityChecker, prio: list[int],
                 return None
             nxt = q.copy()
             nxt[creases[move]] = 0.0
-            # the new state itself first (segments assume valid endpoints), then the motion,
-            # at half the resolution straight away: the path needs no re-validation
-            if check.valid(nxt) and check.segment(q, nxt, fine):
+            # the new state itself first (as a sample of the motion), then the motion, at half
+            # the resolution straight away: the path needs no re-validation
+            if check.move(q, nxt, fine):
                 is_open[move] = True
                 q = nxt  # a fresh array: frames may keep it
                 frames.append(q)
@@ -200,7 +200,7 @@ def rrt_connect(check: ValidityChecker, start: np.ndarray, moving: np.ndarray, d
         y = pts[i]
         d = float(np.abs(x - y).max())
         z = x if d <= step else y + (x - y) * (step / d)
-        if not check.valid(state(z)) or not check.segment(state(y), state(z), fine):
+        if not check.move(state(y), state(z), fine):
             return -1, False
         nodes[t].append(z)
         parents[t].append(i)
