@@ -182,7 +182,8 @@ def segment_free(qa, qb, m, order, parent, crease, axis, flat, piece, tol, q, ma
     if end:
         first = np.empty(len(ks) + 1, dtype=np.int64)
         first[0] = m
-        first[1:] = ks
+        for i in range(len(ks)):  # (a loop: an array assignment compiles numba's shape-mismatch error)
+            first[i + 1] = ks[i]
         ks = first
     hit, checked = segment_collides(qa, qb, ks, m, order, parent, crease, axis, flat, piece, rigid, tol, work, q)
     return not hit, checked
