@@ -22,17 +22,18 @@ RRT_MAX_DOF = 32  # stuck sets of up to this many creases get one
 RRT_STEP_DEG = 15.0  # longest extension of a tree, per crease
 RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much on either side
 # A continuous search costs far more than a restart (a second, where a restart of a 382-face net
-# takes 0.2-0.35 s and most take 0.01-0.1 s), and restarts alone unlock nearly every net: of the 12
-# pieces (from 96 makes of 8 Loop-subdivided shared models, 800-2,500 faces, seeds 1-3) whose restarts
-# ever locked on a set of at most RRT_MAX_DOF creases, 11 fold without any search, in 0.08-3.3 s;
-# with a search at every such lock they took 0.08-15 s (bench_start's decimated bunny's 382-face
-# piece 6-15 s: nine 1 s searches that all failed, while its twelfth restart folds it). So a set the
-# restarts meet for the first time is searched only from an allowance, RRT_SHARE of the seconds the
-# restarts have taken less those the searches took, at most RRT_FIRST_S, none under RRT_MIN_S; a
-# set they lock on again (they go round in circles) gets RRT_FIRST_S, twice the last each further
-# time, never more than half the time left. The one piece that needs the search, the horse's
-# 320-face one at 800 faces, folds in 1.8-7.6 s (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7
-# whole-horse nets that use the search take 53-54 s in all (before 102 s).
+# takes 0.2-0.35 s and most take 0.01-0.1 s), and restarts alone unlock nearly every net: of the 184
+# pieces that needed this planner in 96 makes (8 Loop-subdivided shared models at 800-2,500 faces,
+# seeds 1-5) and bench_start's decimated bunny's 382-face piece, planned with seeds 1-3, 12 ever
+# locked on a set of at most RRT_MAX_DOF creases; 11 of them fold without any search, in 0.08-3.3 s,
+# while with a search at every such lock they took 0.08-15 s (the 382-face piece 6-15 s: nine 1 s
+# searches that all failed, while its twelfth restart folds it). So a set the restarts meet for the
+# first time is searched only from an allowance, RRT_SHARE of the seconds the restarts have taken
+# less those the searches took, at most RRT_FIRST_S, none under RRT_MIN_S; a set they lock on again
+# (they go round in circles) gets RRT_FIRST_S, twice the last each further time, never more than
+# half the time left. The one piece that needs the search, the horse's 320-face one at 800 faces,
+# folds in 1.8-7.6 s over two runs (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7 whole-horse
+# nets that use the search take 53-54 s in all (before 102 s).
 RRT_FIRST_S = 1.0
 RRT_SHARE = 0.15
 RRT_MIN_S = 0.02
