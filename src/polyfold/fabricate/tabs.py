@@ -249,7 +249,7 @@ class Room:
         import shapely
 
         region = shapely.box(*bounds)
-        faces = np.sort(self.tree.query(region))
+        faces = self._faces_near(region)
         extras = self._extras_near(region)
         if self._face_wkb is None:
             self._face_wkb = shapely.to_wkb(self.faces)
@@ -276,10 +276,14 @@ class Room:
     def obstacle_ids(self, region, skip_face: int | None = None) -> np.ndarray:
         """The obstacles whose bounds meet `region`'s, as the table numbers them (faces, but
         `skip_face`, then len(faces) + the extras' indices)."""
-        faces = np.sort(self.tree.query(region))  # (in the tree's order they would depend on the whole piece)
-        if skip_face is not None:
-            faces = faces[faces != skip_face]
+        faces = self._faces_near(region, skip_face)
         return np.concatenate([faces, len(self.faces) + self._extras_near(region)]).astype(np.int64)
+
+    def _faces_near(self, region, skip_face: int | None = None) -> np.ndarray:
+        """Indices of the faces (but `skip_face`) whose bounds meet `region`'s, in index order (in
+        the tree's order they would depend on the whole piece, and so would `blocked`'s sums)."""
+        faces = np.sort(self.tree.query(region))
+        return faces if skip_face is None else faces[faces != skip_face]
 
     def geometries(self, ids: np.ndarray) -> list:
         """The faces and extras numbered as the table numbers them (`obstacle_ids`)."""
@@ -320,9 +324,7 @@ class Room:
 
         x0, y0, x1, y1 = poly.bounds
         region = shapely.box(x0 - clear, y0 - clear, x1 + clear, y1 + clear)  # holds the grown poly
-        faces = np.sort(self.tree.query(region))  # (sums in an order that only what is near decides)
-        if skip_face is not None:
-            faces = faces[faces != skip_face]
+        faces = self._faces_near(region, skip_face)
         extras = self._extras_near(region)
         if not len(faces) and not len(extras):
             return False
