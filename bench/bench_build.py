@@ -70,12 +70,18 @@ def loop_subdivided(path: Path, iterations: int) -> tuple[np.ndarray, np.ndarray
 
 
 def decimated(path: Path, faces: int) -> tuple[np.ndarray, np.ndarray]:
-    """A shared model Loop-subdivided twice (16 times its faces) and collapsed back to about
-    `faces` faces by quadric edge collapse (fast-simplification, polyfold's own simplifier's):
-    faces of every size and shape, as a scan decimated for papercraft has."""
+    """A shared model Loop-subdivided twice (16 times its faces; more where that is under 3 times
+    `faces`) and collapsed back to about `faces` faces by quadric edge collapse
+    (fast-simplification, polyfold's own simplifier's): faces of every size and shape, as a scan
+    decimated for papercraft has."""
     import fast_simplification
+    import trimesh
 
-    v, f = loop_subdivided(path, 2)
+    n = len(trimesh.load(str(path), process=False, force="mesh").faces)
+    times = 2
+    while n * 4 ** times < 3 * faces:
+        times += 1
+    v, f = loop_subdivided(path, times)
     out_v, out_f = fast_simplification.simplify(v.astype(np.float32), f.astype(np.int32), 1.0 - faces / len(f))
     return np.asarray(out_v, dtype=float), np.asarray(out_f, dtype=np.int64)
 

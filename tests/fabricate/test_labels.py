@@ -74,7 +74,8 @@ def test_a_label_beside_its_edge_is_nearer_that_edge_than_any_other() -> None:
 @pytest.mark.parametrize("name,size,paper", [("bunny-128", 150.0, "a4"), ("fish-472", 60.0, "80x80mm")])
 def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, name, size, paper) -> None:
     """`pieces._labels` places each piece on its own, in forked processes from PARALLEL_LABELS
-    labels on: the sheets are the same as in one process, when every edge gets its label (the
+    labels on, with its outline (made there, after its labels): the sheets, outlines and footprints
+    included, are the same as in one process, when every edge gets its label (the
     bunny) and when that fails and seam runs are labelled instead (the fish at 60 mm, cut to fit
     80 mm pages: 11 pieces). Asked to label by seam run at once (`by_run`, a redraw of such
     pieces), the fish's sheets are the same again, without the failed try."""

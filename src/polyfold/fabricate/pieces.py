@@ -10,6 +10,7 @@ side carries the glue tab (`tabs.choose_tab`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -310,18 +311,20 @@ PARALLEL_LABELS = 250
 class _Placed:
     """What `labels.PieceLabels` placed on one piece: its texts, the shapely geometries of its
     off-face labels and their leaders, its leader lines (2, 2), where labels with no readable
-    place went, and the counts."""
+    place went, and the counts; and what `_labels`' shape gave for them (the piece's outline)."""
 
     items: list
     outside: list
     leaders: list
     crowded: list
     stats: LabelStats
+    shape: object = None
 
 
 def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
             min_label_mm: float, runs: list[list[int]], deadline: Deadline, all_or_none: bool = False,
-            memo: dict | None = None) -> tuple[list[_Placed], LabelStats] | None:
+            memo: dict | None = None, shape: Callable[[int, list], object] | None = None
+            ) -> tuple[list[_Placed], LabelStats] | None:
     """Every piece's name, then one glue label per copy of every run of glued pairs (a run of
     one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
     all_or_none: None when a glue label finds no readable place.
@@ -331,7 +334,10 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     placed in processes forked from this one (`processes.fork_map`, the most labels first): the
     same labels in the same places whatever the number of processes. `memo` keeps every piece's
     labels by all they depend on (its room's key, name, cut sides, font size, and its labels'
-    texts and sides with their tabs, in order): a piece met again is not placed again."""
+    texts and sides with their tabs, in order): a piece met again is not placed again.
+    shape(i, off-face geometries), when given, is asked of every piece placed, where it was placed
+    (the piece's outline, which waits for its labels: made beside the other pieces' labels), and
+    kept with them; it may depend on nothing but the piece's room and those geometries."""
     from multiprocessing import RawValue
 
     from ..processes import fork_map, usable_cores
@@ -356,7 +362,8 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
             if all_or_none and labels.stats.unplaced > before:
                 failed.value = 1
                 return None
-        return _Placed(labels.items, labels.outside, labels.leaders, labels.crowded, labels.stats)
+        return _Placed(labels.items, labels.outside, labels.leaders, labels.crowded, labels.stats,
+                       None if shape is None else shape(i, labels.outside))
 
     keys = [None if memo is None else _labels_key(drawn[i], i, rooms[i], size, all_or_none, jobs[i])
             for i in range(len(drawn))]
@@ -553,10 +560,23 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     tab_memo = None if memo is None else memo.setdefault("tabs", {})
     label_memo = None if memo is None else memo.setdefault("labels", {})
     g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline, tab_memo)
+    shapes = None if memo is None else memo.setdefault("outlines", {})
+
+    def shape(i: int, outside: list) -> tuple:
+        """(memo key or None, outline, footprint) of piece i with its tabs and these off-face labels
+        (`_outline`; a piece drawn again with the same faces, tabs and off-face labels: found
+        before, by those as a key)."""
+        key = None if shapes is None else (
+            faces_keys[i], tuple(np.asarray(t).tobytes() for t in g.tabs[i]),
+            tuple(shapely.to_wkb(outside).tolist()) if outside else ())
+        if key is not None and key in shapes:
+            return (key, *shapes[key])
+        return (key, *_outline(drawn[i].body, g.tabs[i], outside))
+
     bare = [room.copy() for room in rooms]
     per_edge = None if by_run else _labels(pairs, drawn, rooms, chosen, min_label_mm,
                                            [[i] for i in range(len(pairs))], deadline, all_or_none=True,
-                                           memo=label_memo)
+                                           memo=label_memo, shape=shape)
     if per_edge is not None:
         placed, label_stats = per_edge
     else:
@@ -566,24 +586,16 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
         runs = _split_at(runs, {int(label) - 1 for label in g.untabbed})
         # the shortest runs first: they sit where the mesh is densest and have the fewest places
         runs.sort(key=lambda run: sum(pairs[i][1][0].length for i in run))
-        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs, deadline, memo=label_memo)
+        placed, label_stats = _labels(pairs, drawn, bare, chosen, min_label_mm, runs, deadline, memo=label_memo,
+                                      shape=shape)
         for run in runs:
             for i in run:
                 g.glue[i] = replace(g.glue[i], printed=str(min(run) + 1))
     pieces = []
-    shapes = None if memo is None else memo.setdefault("outlines", {})
     for i, (inp, d) in enumerate(zip(inputs, drawn)):
-        # (a piece drawn again with the same faces, tabs and off-face labels: its outline and
-        # footprint found before, by those as a key)
-        key = None if shapes is None else (
-            faces_keys[i], tuple(np.asarray(t).tobytes() for t in g.tabs[i]),
-            tuple(shapely.to_wkb(placed[i].outside).tolist()) if placed[i].outside else ())
-        if key is not None and key in shapes:
-            outline, footprint = shapes[key]
-        else:
-            outline, footprint = _outline(d.body, g.tabs[i], placed[i].outside)
-            if key is not None:
-                shapes[key] = outline, footprint
+        key, outline, footprint = placed[i].shape
+        if key is not None:
+            shapes[key] = outline, footprint
         pieces.append(SheetPiece(
             name=piece_name(i), part=inp.part, face_ids=np.asarray(inp.face_ids), faces_xy=d.faces_xy, body=d.body,
             outline=outline, mountain=d.mountain.reshape(-1, 2, 2), valley=d.valley.reshape(-1, 2, 2),
