@@ -1,7 +1,7 @@
 """`polyfold make` of many meshes of one size that nobody tuned for (issue 23, item 4), not a test.
 
     .venv/bin/python bench/bench_make_many.py [--faces 1500] [--hull-seeds 1,2,3] [--rounds 1]
-                                              [--limit 8] [--only NAME ...]
+                                              [--limit 8] [--only NAME ...] [--markdown]
 
 Every closed shared model (../shared/models/*.obj or $POLYFOLD_MODELS, the paper's and the
 rest: boxes, prisms, stars, tori, random hulls), Loop-subdivided to at least three times
@@ -10,7 +10,8 @@ rest: boxes, prisms, stars, tori, random hulls), Loop-subdivided to at least thr
 user runs it (a fresh `polyfold` process, warm kernels, defaults: fold on, A4 at 150 mm), timed
 wall-clock, --rounds times. Prints per mesh its seconds, the layout stage's share, pieces, pages
 and the labels left small (crowding: the slow case), then how many meshes took at most --limit
-seconds (by their median round), the median and the slowest.
+seconds (by their median round), the median and the slowest. --markdown: the table as the
+README has it.
 """
 
 from __future__ import annotations
@@ -74,11 +75,15 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=1, help="makes per mesh (the median counts)")
     ap.add_argument("--limit", type=float, default=8.0, help="the target, seconds")
     ap.add_argument("--only", nargs="*", default=[], help="meshes whose name contains one of these")
+    ap.add_argument("--markdown", action="store_true", help="the table in Markdown")
     a = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench-many-"))
     todo = meshes(tmp, a.faces, [int(s) for s in a.hull_seeds.split(",") if s], a.only)
     subprocess.run([*CLI, "make", str(ROOT / "examples" / "bunny-128.obj"), "-o", str(tmp / "prime"), "-q"])
-    print(f"{'mesh':44s} {'faces':>5s} {'wall s':>14s} {'layout':>6s} {'pieces':>6s} {'pages':>5s} {'small':>5s}")
+    if a.markdown:
+        print("| mesh | faces | wall s | layout s | pieces | pages | labels left small |\n|---|---|---|---|---|---|---|")
+    else:
+        print(f"{'mesh':44s} {'faces':>5s} {'wall s':>14s} {'layout':>6s} {'pieces':>6s} {'pages':>5s} {'small':>5s}")
     medians: list[tuple[float, str]] = []
     for name, path in todo:
         walls, report, error = [], None, ""
@@ -88,14 +93,19 @@ def main() -> None:
             if report is None:
                 break
         if report is None:
-            print(f"{name:44s} failed: {error}")
+            print(f"| {name} | failed: {error} |" if a.markdown else f"{name:44s} failed: {error}")
             continue
         lay = report["stages"]["layout"]
         faces = sum(p["faces"] for p in report["pieces"])
         med = statistics.median(walls)
         medians.append((med, name))
-        print(f"{name:44s} {faces:5d} {' '.join(f'{w:.2f}' for w in walls):>14s} {lay['seconds']:6.2f} "
-              f"{len(report['pieces']):6d} {lay['pages']:5d} {lay['small_labels']:5d}", flush=True)
+        runs = " / ".join(f"{w:.2f}" for w in walls)
+        if a.markdown:
+            print(f"| {name} | {faces:,} | {runs} | {lay['seconds']:.2f} | {len(report['pieces'])} | {lay['pages']} | "
+                  f"{lay['small_labels']} |", flush=True)
+        else:
+            print(f"{name:44s} {faces:5d} {runs.replace(' / ', ' '):>14s} {lay['seconds']:6.2f} "
+                  f"{len(report['pieces']):6d} {lay['pages']:5d} {lay['small_labels']:5d}", flush=True)
     if medians:
         within = sum(m <= a.limit for m, _ in medians)
         slowest = max(medians)
