@@ -318,12 +318,12 @@ class _Placed:
     leaders: list
     crowded: list
     stats: LabelStats
-    shape: object = None
+    shape: tuple | None = None  # (memo key or None, outline, footprint): `build_sheet_pieces`' shape
 
 
 def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | None],
             min_label_mm: float, runs: list[list[int]], deadline: Deadline, all_or_none: bool = False,
-            memo: dict | None = None, shape: Callable[[int, list], object] | None = None
+            memo: dict | None = None, shape: Callable[[int, list], tuple] | None = None
             ) -> tuple[list[_Placed], LabelStats] | None:
     """Every piece's name, then one glue label per copy of every run of glued pairs (a run of
     one: the edge's own label on both sides; of several: its lowest label, `PieceLabels.run`).
