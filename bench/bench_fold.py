@@ -126,11 +126,11 @@ def collision_table() -> None:
         segments = [(a, b, max(1, int(math.ceil(np.abs(b - a).max() / math.radians(0.5) - 1e-12))))
                     for a, b in zip(frames[:-1], frames[1:])]
         checked = sum(segment_free(a, b, m, t.order, t.parent, t.crease, t.axis, t.flat, t.piece,
-                                   t.tol, q, 1 << 40, work)[1] for a, b, m in segments)
+                                   t.tol, q, 1 << 40, work, False)[1] for a, b, m in segments)
 
         def run():
             for a, b, m in segments:
-                segment_free(a, b, m, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, q, 1 << 40, work)
+                segment_free(a, b, m, t.order, t.parent, t.crease, t.axis, t.flat, t.piece, t.tol, q, 1 << 40, work, False)
         return best_of(run) / checked * 1e6
 
     nets = []

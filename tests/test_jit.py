@@ -144,6 +144,41 @@ def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path):
     assert not stale["ready"] and stale["numba"] is True and stale["sums"] == got["sums"]
 
 
+_START = r"""
+import json, os, sys
+import numpy as np
+import numba  # (as a first run's make has, from `apps.warmup.kernels_cached`)
+from polyfold import jit
+out = {"set up before": "numba.np.arraymath" in sys.modules}
+jit.start_compiler()
+out["set up after"] = "numba.np.arraymath" in sys.modules
+read, write = os.pipe()
+if os.fork() == 0:  # a forked process compiles a kernel with what it inherited
+    import jit_kernels as K
+    before = {m for m in sys.modules if m.startswith("numba.")}
+    sums = K.row_sums_of_squares(np.arange(6.0).reshape(2, 3)).tolist()
+    os.write(write, json.dumps({"sums": sums, "numba modules imported": sorted(
+        m for m in sys.modules if m.startswith("numba.") and m not in before)}).encode())
+    os._exit(0)
+os.close(write)
+out.update(json.loads(os.read(read, 1 << 16)))
+os.wait()
+print(json.dumps(out))
+"""
+
+
+def test_start_compiler_sets_numba_up_once_for_forked_processes_and_caches_nothing(tmp_path):
+    """`start_compiler` does numba's one-time set-up here (its registries of array functions
+    loaded), caching nothing: a process forked after it compiles a kernel into the cache without
+    importing any more of numba (forked after a bare `import numba`, it imports its array
+    functions, ufuncs and more: about 70 modules)."""
+    got = _python(_START, tmp_path, POLYFOLD_AHEAD="off")
+    assert not got["set up before"] and got["set up after"]
+    assert got["sums"] == [5.0, 50.0] and got["numba modules imported"] == []
+    cached = {p.name.split(".")[0] for p in tmp_path.rglob("*.nbi")}
+    assert cached == {"jit_kernels"}, cached  # (the child's kernel; nothing of start_compiler's)
+
+
 def test_the_stamp_holds_the_cpu(monkeypatch):
     """Code built for this CPU (its instruction set) is stale on another: the stamp says which."""
     here = jit.stamp()

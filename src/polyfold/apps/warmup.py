@@ -369,6 +369,10 @@ def compile_beside() -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
     `kernels_cached()` False); else None."""
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
+        if can_fork():  # (numba's set-up once, here: the forked process inherits it)
+            from ..jit import start_compiler
+
+            start_compiler()
         # the guide's kernels here, with the path check, while the second process compiles the
         # planners: its `tabs` section grew by 2 s with the compiled tests of tabs and labels (the
         # thirteenth session), and with the guide there too this process waited for it (cold make
