@@ -77,11 +77,9 @@ def decimated(path: Path, faces: int) -> tuple[np.ndarray, np.ndarray]:
     import fast_simplification
     import trimesh
 
-    n = len(trimesh.load(str(path), process=False, force="mesh").faces)
-    times = 2
-    while n * 4 ** times < 3 * faces:
-        times += 1
-    v, f = loop_subdivided(path, times)
+    v, f = loop_subdivided(path, 2)
+    while len(f) < 3 * faces:
+        v, f = trimesh.remesh.subdivide_loop(v, f)
     out_v, out_f = fast_simplification.simplify(v.astype(np.float32), f.astype(np.int32), 1.0 - faces / len(f))
     return np.asarray(out_v, dtype=float), np.asarray(out_f, dtype=np.int64)
 

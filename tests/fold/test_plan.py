@@ -100,7 +100,8 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     monkeypatch.setattr(sequential, "rrt_connect", recorded)
     fold = whole_net(models_dir, "horse-302", 13, 302)
     tree = fold_tree(fold)
-    path = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
+    resolution = 1.0  # degrees
+    path = plan_fold(tree, planner="sequential", resolution_deg=resolution, time_limit=60, seed=13)
     assert path is not None and path.planner == "sequential-rrt"
     assert len(searches) >= 2 and not searches[0][2] and searches[-1][2]
     assert all(given <= sequential.RRT_FIRST_S + 1e-3 for _n, given, _found in searches)
@@ -118,7 +119,7 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     deg = np.asarray(path.degrees_fold())
     for s in range(k):
         span = float(np.abs(deg[s + 1] - deg[s]).max())
-        samples = 2 * math.ceil(span / 1.0 - 1e-9)  # (resolution_deg 1: plan_fold's default)
+        samples = 2 * math.ceil(span / resolution - 1e-9)
         _, hit = net.segment_collision(deg[s], deg[s + 1], span / samples, skip_start=s > 0)
         assert hit is None, f"segment {s} collides at {hit}"
 
