@@ -83,18 +83,20 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     RRT-Connect search over those creases opens them; its frames (the path's first ones, off the
     discrete domain) are re-checked by the independent checker at the samples the planner checked
     them at (half the resolution: twice the resolution's count ceil(span / 1 degree) per move, a
-    grid that holds the resolution's, which make writes and verifies), the rest is discrete. The
-    first restart locks on another set, whose search (RRT_FIRST_S) fails; it once had half the
-    time limit (30 s) before that restart came. (A check at 0.5 degree by ceil(span / 0.5 degree)
-    instead samples elsewhere: on a move of 18.09 degrees, 37 samples against the planner's 38, one
-    of which met a collision 0.35 degree wide between the planner's samples.)"""
-    searches = []  # (creases, seconds given, found)
+    grid that holds the resolution's, which make writes and verifies), the rest is discrete. An
+    earlier restart locks on another set, whose search fails within its allowance. The searches'
+    budgets are work (configurations checked), so this seed's path is the same on every machine:
+    with budgets in seconds, a loaded machine's searches ran out sooner and the restarts went on to
+    another path. (A check at 0.5 degree by ceil(span / 0.5 degree) instead samples elsewhere: on a
+    move of 18.09 degrees, 37 samples against the planner's 38, one of which met a collision 0.35
+    degree wide between the planner's samples.)"""
+    searches = []  # (creases, configurations checked, found)
     search = sequential.rrt_connect
 
     def recorded(check, start, moving, deadline, rng):
-        given = deadline.left()
+        done = check.configs
         rest = search(check, start, moving, deadline, rng)
-        searches.append((len(moving), given, rest is not None))
+        searches.append((len(moving), check.configs - done, rest is not None))
         return rest
 
     monkeypatch.setattr(sequential, "rrt_connect", recorded)
@@ -103,8 +105,9 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
     resolution = 1.0  # degrees
     path = plan_fold(tree, planner="sequential", resolution_deg=resolution, time_limit=60, seed=13)
     assert path is not None and path.planner == "sequential-rrt"
-    assert len(searches) >= 2 and not searches[0][2] and searches[-1][2]
-    assert all(given <= sequential.RRT_FIRST_S + 1e-3 for _n, given, _found in searches)
+    assert len(searches) >= 2 and not any(found for _n, _w, found in searches[:-1]) and searches[-1][2]
+    # a search stops at the first check of its budget past it: one move, at most 2 * 720 samples
+    assert all(work <= sequential.RRT_FIRST + 1440 for _n, work, _found in searches)
     goal = tree.goal[tree.creases]
     cr = path.frames[:, tree.creases]
     discrete = np.all(np.isclose(cr, 0.0) | np.isclose(cr, goal), axis=1)
@@ -124,68 +127,105 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
         assert hit is None, f"segment {s} collides at {hit}"
 
 
-def test_a_stuck_sets_search_gets_twice_as_long_each_time_it_recurs(models_dir, monkeypatch):
+class _Work:
+    """A stand-in for the ValidityChecker where `_open_in_order` and `rrt_connect` are faked: the
+    planner reads only its count of configurations checked."""
+
+    def __init__(self) -> None:
+        self.configs = 0
+
+
+def _works_until(check: _Work, until: Deadline, chunk: int = 100) -> int:
+    """A search that finds nothing: checks `chunk` configurations at a time until its deadline."""
+    done = check.configs
+    while not until.expired():
+        check.configs += chunk
+    return check.configs - done
+
+
+def test_a_stuck_sets_search_gets_twice_as_much_work_each_time_it_recurs(models_dir, monkeypatch):
     """Every restart locks on the same creases and their continuous search finds nothing: it is
-    given RRT_FIRST_S, then twice the last each time, never more than half the time left, and the
-    planner gives up at its deadline. (RRT_FIRST_S made 0.05 s, the limit 1 s.)"""
+    given RRT_FIRST configurations, then twice the last each time, and the planner gives up at its
+    deadline (here 1,000,000 configurations: the first time the set is met the restarts have
+    checked none, no allowance, no search)."""
+    tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
+    stuck = np.zeros(len(tree.creases), dtype=bool)
+    stuck[:3] = True
+    check = _Work()
+    deadline = Deadline.never().or_when(lambda: check.configs >= 1_000_000)
+    given = []  # (configurations the search checked, creases)
+
+    def locked(tree, check, prio, until):
+        return [tree.goal.copy()], ~stuck
+
+    def fails(check, start, moving, until, rng):
+        given.append((_works_until(check, until), len(moving)))
+        return None
+
+    monkeypatch.setattr(sequential, "_open_in_order", locked)
+    monkeypatch.setattr(sequential, "rrt_connect", fails)
+    assert sequential.plan_sequential(tree, check, deadline, np.random.default_rng(1)) is None
+    first = sequential.RRT_FIRST
+    assert [w for w, _n in given] == [first, 2 * first, 4 * first, 8 * first, 1_000_000 - 15 * first]
+    assert all(n == 3 for _w, n in given)
+
+
+def test_a_search_never_gets_more_than_half_the_time_left(models_dir, monkeypatch):
+    """The same recurring set with an RRT_FIRST no search can use up: each search is given half the
+    seconds the planner has left (the limit 1 s), and the planner gives up at its deadline."""
     tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
     stuck = np.zeros(len(tree.creases), dtype=bool)
     stuck[:3] = True
     deadline = Deadline.after(1.0)
-    given = []  # (seconds the search is given, seconds the planner has left, creases)
+    given = []  # (seconds the search is given, seconds the planner has left)
 
     def locked(tree, check, prio, until):
         return [tree.goal.copy()], ~stuck
 
     def fails(check, start, moving, until, rng):
-        given.append((until.left(), deadline.left(), len(moving)))
+        given.append((until.left(), deadline.left()))
         time.sleep(max(0.0, until.left()))
         return None
 
-    monkeypatch.setattr(sequential, "RRT_FIRST_S", 0.05)
+    monkeypatch.setattr(sequential, "RRT_FIRST", 10 ** 15)
     monkeypatch.setattr(sequential, "_open_in_order", locked)
     monkeypatch.setattr(sequential, "rrt_connect", fails)
-    assert sequential.plan_sequential(tree, None, deadline, np.random.default_rng(1)) is None
-    assert len(given) >= 5 and all(n == 3 for _g, _l, n in given)
-    for k, (seconds, left, _n) in enumerate(given):
-        assert seconds == pytest.approx(min(0.05 * 2 ** k, left / 2), abs=2e-3)
-    # 0.05, 0.1 and 0.2 s; then half of the 0.65 s left, not 0.4 (the first time the set is met the
-    # restarts have taken no time: no allowance, no search)
-    assert [g for g, _l, _n in given[:4]] == pytest.approx([0.05, 0.1, 0.2, 0.325], abs=3e-3)
+    assert sequential.plan_sequential(tree, _Work(), deadline, np.random.default_rng(1)) is None
+    assert len(given) >= 3
+    assert [g for g, _l in given] == pytest.approx([left / 2 for _g, left in given], abs=2e-3)
 
 
 def test_a_set_met_for_the_first_time_is_searched_only_within_the_restarts_allowance(models_dir, monkeypatch):
-    """Restarts of 0.1 s that lock on a new set of creases every time (never round in circles), and
-    searches that find nothing: the searches together take at most RRT_SHARE of the restarts' time
-    (each at most RRT_FIRST_S, none under RRT_MIN_S: made 0.05 s here, so that not after the first
-    restart's 0.015 s even when a loaded machine sleeps long), so the restarts go on at almost their
-    full pace."""
+    """Restarts that each check 10,000 configurations and lock on a new set of creases every time
+    (never round in circles), and searches that find nothing: a search is given RRT_SHARE of the
+    restarts' configurations less what the searches checked, none under RRT_MIN (made 2,000 here:
+    the first restart's allowance, 1,500, is under it), so the searches together check at most
+    RRT_SHARE of what the restarts did and the restarts go on at almost their full pace."""
     tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
     n = len(tree.creases)
-    monkeypatch.setattr(sequential, "RRT_MIN_S", 0.05)
-    deadline = Deadline.after(2.0)
-    restarts, given = [], []  # seconds each restart took; each search's (seconds given, restarts before it)
+    monkeypatch.setattr(sequential, "RRT_MIN", 2_000)
+    check = _Work()
+    deadline = Deadline.never().or_when(lambda: check.configs >= 250_000)
+    restarts, given = [], []  # each search's (configurations checked, restarts before it)
 
     def locked(tree, check, prio, until):
-        t0 = time.perf_counter()
         stuck = np.zeros(n, dtype=bool)
         stuck[[len(restarts) % n, (len(restarts) + 1) % n]] = True  # a new pair each time
-        time.sleep(0.1)
-        restarts.append(time.perf_counter() - t0)
+        check.configs += 10_000
+        restarts.append(10_000)
         return [tree.goal.copy()], ~stuck
 
     def fails(check, start, moving, until, rng):
-        given.append((until.left(), len(restarts)))
-        time.sleep(max(0.0, until.left()))
+        given.append((_works_until(check, until), len(restarts)))
         return None
 
     monkeypatch.setattr(sequential, "_open_in_order", locked)
     monkeypatch.setattr(sequential, "rrt_connect", fails)
-    assert sequential.plan_sequential(tree, None, deadline, np.random.default_rng(1)) is None
-    assert len(restarts) >= 8 and len(given) >= 2
-    assert given[0][1] >= 2  # after the first restart: about 0.015 s allowed, under RRT_MIN_S
-    assert all(sequential.RRT_MIN_S - 1e-3 <= g <= sequential.RRT_FIRST_S for g, _k in given)
-    assert sum(g for g, _k in given) <= sequential.RRT_SHARE * sum(restarts) + 5e-3
+    assert sequential.plan_sequential(tree, check, deadline, np.random.default_rng(1)) is None
+    # 15 % of 20,000 after the second restart, 15 % of 40,000 less 3,000 after the fourth, ...
+    assert given[:3] == [(3_000, 2), (3_000, 4), (3_000, 6)]
+    assert len(restarts) >= 20 and all(w <= sequential.RRT_FIRST for w, _k in given)
+    assert sum(w for w, _k in given) <= sequential.RRT_SHARE * sum(restarts)
 
 
 # ----------------------------------------------------------------------------------------------

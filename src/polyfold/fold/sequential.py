@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..deadline import Deadline, clock
+from ..deadline import Deadline
 
 from .checker import ValidityChecker, shortcut
 from .tree import FoldTree, crease_depth_size
@@ -28,16 +28,25 @@ RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much
 # locked on a set of at most RRT_MAX_DOF creases; 11 of them fold without any search, in 0.08-3.3 s,
 # while with a search at every such lock they took 0.08-15 s (the 382-face piece 6-15 s: nine 1 s
 # searches that all failed, while its twelfth restart folds it). So a set the restarts meet for the
-# first time is searched only from an allowance, RRT_SHARE of the seconds the restarts have taken
-# less those the searches took, at most RRT_FIRST_S, none under RRT_MIN_S; a set they lock on again
-# (they go round in circles) gets RRT_FIRST_S, twice the last each further time, never more than
-# half the time left. The one piece that needs the search, the horse's 320-face one at 800 faces,
-# folds in 1.8-7.6 s over two runs (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7 whole-horse
-# nets that use the search take 53-54 s in all (before 102 s).
-RRT_FIRST_S = 1.0
+# first time is searched only from an allowance, RRT_SHARE of the work the restarts have done less
+# that of the searches, at most RRT_FIRST, none under RRT_MIN; a set they lock on again (they go
+# round in circles) gets RRT_FIRST, twice the last each further time, never more than half the
+# time left. The one piece that needs the search, the horse's 320-face one at 800 faces, folds in
+# 1.8-7.6 s over two runs (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7 whole-horse nets that
+# use the search take 53-54 s in all (before 102 s).
+# Work is counted in configurations checked (`ValidityChecker.configs`), not in seconds as it
+# was: with seconds, whether a search found its path within its allowance depended on the
+# machine's speed and load, and so did the path (and the random numbers the restarts drew after
+# it). Those 19 nets x 3 seeds, planned twice on an idle machine, gave 12 of the 57 paths
+# differently the second time; in work, 4 runs (one beside three busy processes, twice as slow)
+# gave the same 57 paths. A search checks 20-135 thousand configurations a second on those nets
+# (0.3-1.3 times the restarts' rate), so RRT_FIRST is about the second it was. The 57 plans take
+# 36-37 s in all (seconds: 38-50 s, the slowest 3.8-12 s; now 3.6-3.7 s); of RRT_SHARE 0.075,
+# 0.1, 0.15, 0.2 and 0.3 with RRT_FIRST 25,000-100,000, 0.15 and 0.2 with 50,000 were fastest
+# (35.6-37.2 s, 0.2 within noise).
+RRT_FIRST = 50_000
 RRT_SHARE = 0.15
-RRT_MIN_S = 0.02
-
+RRT_MIN = 1_000
 
 def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
                     rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
@@ -60,9 +69,10 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
     neither alone, nor first, nor together in the discrete domain (a tightly curled strip carrying
     a large flap, say) but can by partial, coordinated moves. Restarts are cheap and usually
     unlock the net, a search is costly: a set met for the first time is searched only within an
-    allowance (RRT_SHARE of the restarts' time less the searches'); a set the restarts lock on
-    again gets RRT_FIRST_S seconds, twice as long as the last each further time, never more than
-    half the time left.
+    allowance of work, configurations checked (RRT_SHARE of the restarts' less the searches'); a
+    set the restarts lock on again gets RRT_FIRST, twice as much as the last each further time,
+    never more than half the time left. Counted in work, not seconds, the path a seed gives is
+    the same on every machine, however loaded, unless the deadline cuts the planning short.
     Such a path leaves the discrete domain in its first frames (`continuous?` is then True).
     Not in the paper: it finds paths for whole meshes (horse, fish) where the Lazy PRM finds none.
     """
@@ -74,16 +84,16 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
     # larger smaller side first), which unlocks some nets the first order cannot.
     tracks = [list(np.lexsort((depth, -smaller_side))), list(np.lexsort((-smaller_side, depth)))]
     tried: list[set[frozenset]] = [set(), set()]
-    searched: dict[frozenset, float] = {}  # seconds given to each stuck set's last continuous search
-    restarts_s = searches_s = 0.0  # seconds the restarts, and the continuous searches, have taken
+    searched: dict[frozenset, int] = {}  # configurations given to each stuck set's last search
+    restarts_work = searches_work = 0  # configurations the restarts, and the searches, have checked
     restart = 0
     while not deadline.expired():
         track = restart % 2
         prio = tracks[track]
         restart += 1
-        t0 = clock()
+        done = check.configs
         opened = _open_in_order(tree, check, prio, deadline)
-        restarts_s += clock() - t0
+        restarts_work += check.configs - done
         if opened is None:
             return None
         frames, is_open = opened
@@ -98,15 +108,17 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
             # Locked in the discrete domain, but only a few creases are left: search their
             # continuous subspace (see RRT_SHARE), longer each time the restarts lock on them again
             if key in tried[track]:
-                seconds = searched[key] = 2.0 * searched.get(key, 0.5 * RRT_FIRST_S)
+                work = searched[key] = 2 * searched.get(key, RRT_FIRST // 2)
             else:
-                seconds = min(RRT_FIRST_S, RRT_SHARE * restarts_s - searches_s)
+                work = min(RRT_FIRST, int(RRT_SHARE * restarts_work) - searches_work)
             rest = None
-            if seconds >= RRT_MIN_S:
-                t0 = clock()
+            if work >= RRT_MIN:
+                done = check.configs
+                until = done + work
                 rest = rrt_connect(check, frames[-1], creases[stuck],
-                                   deadline.within(min(seconds, 0.5 * deadline.left())), rng)
-                searches_s += clock() - t0
+                                   deadline.within(0.5 * deadline.left()).or_when(lambda: check.configs >= until),
+                                   rng)
+                searches_work += check.configs - done
             if rest is not None:
                 frames += rest
                 frames.reverse()
