@@ -127,6 +127,28 @@ def test_sequential_planner_unlocks_stuck_creases_by_a_continuous_search(models_
         assert hit is None, f"segment {s} collides at {hit}"
 
 
+def test_a_seed_gives_the_same_path_on_a_slower_machine(models_dir, monkeypatch):
+    """Horse net 13 (a continuous search unlocks it, see above) planned again with every move of
+    the planner's checker slowed by 0.2 ms, as on a loaded or slower machine: the searches' budgets
+    are work, not seconds, so the same seed gives the same path frame for frame. (With budgets in
+    seconds the slowed searches ran out sooner, and the restarts went on to another path.)"""
+    from polyfold.fold.checker import ValidityChecker
+
+    tree = fold_tree(whole_net(models_dir, "horse-302", 13, 302))
+    path = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
+    move = ValidityChecker.move
+
+    def slowed(self, qa, qb, step=None):
+        time.sleep(2e-4)
+        return move(self, qa, qb, step)
+
+    monkeypatch.setattr(ValidityChecker, "move", slowed)
+    again = plan_fold(tree, planner="sequential", time_limit=60, seed=13)
+    assert path is not None and again is not None and path.planner == again.planner == "sequential-rrt"
+    assert np.array_equal(path.frames, again.frames)
+    assert again.seconds > path.seconds + 0.2  # slowed indeed
+
+
 class _Work:
     """A stand-in for the ValidityChecker where `_open_in_order` and `rrt_connect` are faked: the
     planner reads only its count of configurations checked."""
