@@ -48,6 +48,7 @@ RRT_FIRST = 50_000
 RRT_SHARE = 0.15
 RRT_MIN = 1_000
 
+
 def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
                     rng: np.random.Generator) -> tuple[np.ndarray, bool] | None:
     """Reverse sequential unfolding: (frames flat -> goal, continuous?), or None (stuck or out of time).
@@ -116,7 +117,7 @@ def plan_sequential(tree: FoldTree, check: ValidityChecker, deadline: Deadline,
                 done = check.configs
                 until = done + work
                 rest = rrt_connect(check, frames[-1], creases[stuck],
-                                   deadline.within(0.5 * deadline.left()).or_when(lambda: check.configs >= until),
+                                   deadline.within(0.5 * deadline.left()).or_when(lambda end=until: check.configs >= end),
                                    rng)
                 searches_work += check.configs - done
             if rest is not None:
