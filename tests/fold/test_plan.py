@@ -167,28 +167,36 @@ def _works_until(check: _Work, until: Deadline, chunk: int = 100) -> int:
     return check.configs - done
 
 
+def _planned(monkeypatch, tree: FoldTree, check, deadline: Deadline, restart, search):
+    """`plan_sequential` with its restarts (`_open_in_order`) and searches (`rrt_connect`) replaced
+    by `restart` and `search`."""
+    monkeypatch.setattr(sequential, "_open_in_order", restart)
+    monkeypatch.setattr(sequential, "rrt_connect", search)
+    return sequential.plan_sequential(tree, check, deadline, np.random.default_rng(1))
+
+
+def _locked_on_three(tree: FoldTree):
+    """A restart that locks on the same three creases every time, without checking anything."""
+    stuck = np.zeros(len(tree.creases), dtype=bool)
+    stuck[:3] = True
+    return lambda tree, check, prio, until: ([tree.goal.copy()], ~stuck)
+
+
 def test_a_stuck_sets_search_gets_twice_as_much_work_each_time_it_recurs(models_dir, monkeypatch):
     """Every restart locks on the same creases and their continuous search finds nothing: it is
     given RRT_FIRST configurations, then twice the last each time, and the planner gives up at its
     deadline (here 1,000,000 configurations: the first time the set is met the restarts have
     checked none, no allowance, no search)."""
     tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
-    stuck = np.zeros(len(tree.creases), dtype=bool)
-    stuck[:3] = True
     check = _Work()
     deadline = Deadline.never().or_when(lambda: check.configs >= 1_000_000)
     given = []  # (configurations the search checked, creases)
-
-    def locked(tree, check, prio, until):
-        return [tree.goal.copy()], ~stuck
 
     def fails(check, start, moving, until, rng):
         given.append((_works_until(check, until), len(moving)))
         return None
 
-    monkeypatch.setattr(sequential, "_open_in_order", locked)
-    monkeypatch.setattr(sequential, "rrt_connect", fails)
-    assert sequential.plan_sequential(tree, check, deadline, np.random.default_rng(1)) is None
+    assert _planned(monkeypatch, tree, check, deadline, _locked_on_three(tree), fails) is None
     first = sequential.RRT_FIRST
     assert [w for w, _n in given] == [first, 2 * first, 4 * first, 8 * first, 1_000_000 - 15 * first]
     assert all(n == 3 for _w, n in given)
@@ -198,13 +206,8 @@ def test_a_search_never_gets_more_than_half_the_time_left(models_dir, monkeypatc
     """The same recurring set with an RRT_FIRST no search can use up: each search is given half the
     seconds the planner has left (the limit 1 s), and the planner gives up at its deadline."""
     tree = fold_tree(whole_net(models_dir, "bunny-128", 1, 128))
-    stuck = np.zeros(len(tree.creases), dtype=bool)
-    stuck[:3] = True
     deadline = Deadline.after(1.0)
     given = []  # (seconds the search is given, seconds the planner has left)
-
-    def locked(tree, check, prio, until):
-        return [tree.goal.copy()], ~stuck
 
     def fails(check, start, moving, until, rng):
         given.append((until.left(), deadline.left()))
@@ -212,9 +215,7 @@ def test_a_search_never_gets_more_than_half_the_time_left(models_dir, monkeypatc
         return None
 
     monkeypatch.setattr(sequential, "RRT_FIRST", 10 ** 15)
-    monkeypatch.setattr(sequential, "_open_in_order", locked)
-    monkeypatch.setattr(sequential, "rrt_connect", fails)
-    assert sequential.plan_sequential(tree, _Work(), deadline, np.random.default_rng(1)) is None
+    assert _planned(monkeypatch, tree, _Work(), deadline, _locked_on_three(tree), fails) is None
     assert len(given) >= 3
     assert [g for g, _l in given] == pytest.approx([left / 2 for _g, left in given], abs=2e-3)
 
@@ -243,9 +244,7 @@ def test_a_set_met_for_the_first_time_is_searched_only_within_the_restarts_allow
         given.append((_works_until(check, until), len(restarts)))
         return None
 
-    monkeypatch.setattr(sequential, "_open_in_order", locked)
-    monkeypatch.setattr(sequential, "rrt_connect", fails)
-    assert sequential.plan_sequential(tree, check, deadline, np.random.default_rng(1)) is None
+    assert _planned(monkeypatch, tree, check, deadline, locked, fails) is None
     # 15 % of 20,000 after the second restart, 15 % of 40,000 less 3,000 after the fourth, ...
     assert given[:3] == [(3_000, 2), (3_000, 4), (3_000, 6)]
     assert len(restarts) >= 20 and all(w <= sequential.RRT_FIRST for w, _k in given)
