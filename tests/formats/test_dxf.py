@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+import os
+import pickle
+import subprocess
+import sys
+import time
+
 import ezdxf
 import numpy as np
 
 from conftest import PAGE_TOL
 from polyfold.fabricate.page import Page
 from polyfold.formats import sheet_style
-from polyfold.formats.dxf import write_dxf_page
+from polyfold.formats.dxf import dxf_string, write_dxf_page
 
 
 def test_dxf_layers_units_entities_and_flip(page: Page, tmp_path) -> None:
@@ -51,6 +57,23 @@ def test_dxf_layers_units_entities_and_flip(page: Page, tmp_path) -> None:
     anchor = np.array([texts[0].dxf.align_point.x, texts[0].dxf.align_point.y])
     bx, by = sheet_style.text_baseline(page.texts[0])
     np.testing.assert_allclose(anchor, [bx, page.height - by], atol=PAGE_TOL)
+
+
+def test_the_same_page_gives_the_same_dxf_text(page: Page, tmp_path) -> None:
+    """No time of writing, no random GUID, no order from a set of strings: a make run again writes
+    the same DXF files (as it writes the same PDF bytes), in processes of other hash seeds too; and
+    ezdxf's own option is left as it was."""
+    first = dxf_string(page)
+    time.sleep(0.01)  # (ezdxf's stamp holds microseconds)
+    assert dxf_string(page) == first
+    assert not ezdxf.options.write_fixed_meta_data_for_testing
+    (tmp_path / "page.pkl").write_bytes(pickle.dumps(page))
+    code = ("import pickle, sys; from polyfold.formats.dxf import dxf_string; "
+            "sys.stdout.write(dxf_string(pickle.loads(open(sys.argv[1], 'rb').read())))")
+    for seed in ("1", "2", "3"):
+        out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "page.pkl")], capture_output=True,
+                             text=True, check=True, env={**os.environ, "PYTHONHASHSEED": seed}).stdout
+        assert out == first, f"PYTHONHASHSEED={seed}"
 
 
 def test_dxf_header_is_the_page_in_mm(page: Page, tmp_path) -> None:

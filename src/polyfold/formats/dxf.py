@@ -95,9 +95,25 @@ def dxf_document(page: Page):
 
 def dxf_string(page: Page) -> str:
     """One page as DXF text (R2010, mm, layers CUT / MOUNTAIN / VALLEY / LABELS): what a .dxf file
-    holds (R2007+ DXF is UTF-8 text)."""
+    holds (R2007+ DXF is UTF-8 text). The same page gives the same text, as the PDF the same bytes:
+    ezdxf's fixed metadata (its option for comparing documents) instead of the time of writing
+    and random GUIDs ($TDCREATE, $TDUPDATE, $VERSIONGUID, $FINGERPRINTGUID, its own stamp), and
+    its CLASSES in one order, so a make run again with the same seed writes every file but
+    report.json alike."""
+    import ezdxf
+
     buf = _io.StringIO()
-    dxf_document(page).write(buf)
+    kept = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True  # (stamps are made at ezdxf.new and at write)
+    try:
+        doc = dxf_document(page)
+        # ezdxf adds a CLASS for each entity type in use in the order of a set of strings, which
+        # Python's hash seed changes from process to process: added sorted first, they keep it
+        for dxftype in sorted(doc.entitydb.dxf_types_in_use()):
+            doc.classes.add_class(dxftype)
+        doc.write(buf)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = kept
     return buf.getvalue()
 
 
