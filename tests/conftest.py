@@ -74,9 +74,11 @@ def models_dir() -> Path:
 CLI = [sys.executable, "-m", "polyfold"]
 
 
-def run_cli(*args, timeout: float = 300) -> subprocess.CompletedProcess:
-    """`python -m polyfold ARGS...` (arguments made strings), output captured as text."""
-    return subprocess.run([*CLI, *map(str, args)], capture_output=True, text=True, timeout=timeout)
+def run_cli(*args, timeout: float = 300, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    """`python -m polyfold ARGS...` (arguments made strings), output captured as text; env: variables
+    set for it on top of this process's."""
+    return subprocess.run([*CLI, *map(str, args)], capture_output=True, text=True, timeout=timeout,
+                          env=None if env is None else {**os.environ, **env})
 
 
 def one_line(stderr: str) -> str:

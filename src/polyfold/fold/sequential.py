@@ -31,9 +31,10 @@ RRT_MARGIN_DEG = 30.0  # a crease may overshoot its range [0, goal] by this much
 # first time is searched only from an allowance, RRT_SHARE of the work the restarts have done less
 # that of the searches, at most RRT_FIRST, none under RRT_MIN; a set they lock on again (they go
 # round in circles) gets RRT_FIRST, twice the last each further time, never more than half the
-# time left. The one piece that needs the search, the horse's 320-face one at 800 faces, folds in
-# 1.8-7.6 s over two runs (before: 1.9-9.9 s); the 12 pieces x 3 seeds and 7 whole-horse nets that
-# use the search take 53-54 s in all (before 102 s).
+# time left. With that allowance in seconds (as it first was), the one piece that needs the search,
+# the horse's 320-face one at 800 faces, folded in 1.8-7.6 s over two runs (a search at every lock:
+# 1.9-9.9 s); the 12 pieces x 3 seeds and 7 whole-horse nets that use the search took 53-54 s in
+# all (102 s).
 # Work is counted in configurations checked (`ValidityChecker.configs`), not in seconds as it
 # was: with seconds, whether a search found its path within its allowance depended on the
 # machine's speed and load, and so did the path (and the random numbers the restarts drew after

@@ -7,16 +7,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
-import subprocess
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import CLI, check_sheet, one_line, read_sheet, run_cli
+from conftest import check_sheet, one_line, read_sheet, run_cli
 from fold_checker import check_fold, read_mesh
 from path_checker import check_path
 
@@ -198,8 +196,7 @@ def test_the_same_seed_makes_the_same_files(models_dir, tmp_path):
     outs = []
     for seed in ("1", "2"):
         out = tmp_path / seed
-        proc = subprocess.run([*CLI, "make", str(models_dir / "bunny-128.obj"), "-o", str(out), "-q"], capture_output=True,
-                              text=True, timeout=300, env={**os.environ, "PYTHONHASHSEED": seed})
+        proc = run_cli("make", models_dir / "bunny-128.obj", "-o", out, "-q", env={"PYTHONHASHSEED": seed})
         assert proc.returncode == 0, proc.stderr
         outs.append(out)
     names = sorted(p.name for p in outs[0].iterdir())
