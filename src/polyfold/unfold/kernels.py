@@ -324,6 +324,10 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     best = score
     it = 0
     path = np.empty(n, dtype=np.int64)
+    saved_depth = np.empty(n, dtype=np.int64)
+    # a move changes the depths of the faces it moves alone: kept up to date with them
+    tree_depths(parent, order, depth)
+    candidates = np.empty(n_e, dtype=np.int64)
     while it < iterations and best > 0:
         it += 1
         npairs = pairs.shape[0]
@@ -332,7 +336,6 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         r = np.random.randint(npairs)
         f = pairs[r, 0]
         g = pairs[r, 1]
-        tree_depths(parent, order, depth)
         plen = tree_path(f, g, parent, depth, path, 0)
         free = 0  # the path's creases that may be cut, moved to its front
         for k in range(plen):
@@ -344,8 +347,7 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         x = path[np.random.randint(free)]
         c = parent_edge[x]
         # faces of the subtree under x
-        for idx in range(n):
-            in_sub[order[idx]] = False
+        in_sub[:] = False
         in_sub[x] = True
         n_sub = 0
         for idx in range(n):
@@ -354,12 +356,30 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                 in_sub[y] = True
                 sub[n_sub] = y
                 n_sub += 1
-        # reservoir-sample a reconnecting cut edge, and one at an end of c (NEAR_MOVES)
+        # reservoir-sample a reconnecting cut edge, and one at an end of c (NEAR_MOVES), in edge
+        # order: from the edges of the subtree's faces, sorted, when they are the fewer (each edge
+        # that reconnects has one face in the subtree), else from every edge
+        n_cand = np.int64(0)
+        if 12 * n_sub < n_e:
+            for idx in range(n_sub):
+                for k in range(3):
+                    e = face_edges[sub[idx], k]
+                    f0 = edge_faces[e, 0]
+                    f1 = edge_faces[e, 1]
+                    if f0 >= 0 and f1 >= 0 and in_sub[f0] != in_sub[f1]:
+                        candidates[n_cand] = e
+                        n_cand += 1
+            candidates[:n_cand].sort()
+        else:
+            for e in range(n_e):
+                candidates[n_cand] = e
+                n_cand += 1
         pick = np.int64(-1)  # (not a literal: see prim_tree's size)
         seen = 0
         near_pick = np.int64(-1)
         near_seen = 0
-        for e in range(n_e):
+        for ci in range(n_cand):
+            e = candidates[ci]
             if crease[e] or e == c or merged[e]:
                 continue
             f0 = edge_faces[e, 0]
@@ -390,8 +410,12 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                 saved[f, k, 1] = tris[f, k, 1]
             saved_parent[f] = parent[f]
             saved_edge[f] = parent_edge[f]
+            saved_depth[f] = depth[f]
         n_rest = _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face,
                          adj_edge, hung, it)
+        for idx in range(n_rest, n):  # (parents first: the subtree hangs from a face outside it)
+            y = new_order[idx]
+            depth[y] = depth[parent[y]] + 1
         place_children(new_order[n_rest:], parent, parent_edge, faces, face_edges, local, tris)
         face_bounds(tris, moved, xmin, xmax, ymin, ymax)
         keep = np.empty(npairs, dtype=np.bool_)
@@ -443,6 +467,7 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                     tris[f, k, 1] = saved[f, k, 1]
                 parent[f] = saved_parent[f]
                 parent_edge[f] = saved_edge[f]
+                depth[f] = saved_depth[f]
             face_bounds(tris, moved, xmin, xmax, ymin, ymax)
     for e in range(crease.shape[0]):
         crease[e] = best_crease[e]
