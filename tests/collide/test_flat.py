@@ -88,6 +88,25 @@ def test_sweep_finds_all_pairs_of_brute_force():
         assert got == want
 
 
+def test_every_pair_of_a_crowded_net_in_one_sweep_as_counted_and_capped():
+    """`all_overlapping_pairs` collects in one sweep, its buffer doubling past 64 pairs: on
+    triangles crowded into a small square (hundreds of pairs: three doublings), the oracle's pairs, as many as
+    the counting sweep (max_pairs 0) counts, and the capped sweep's pairs are its first ones."""
+    from polyfold.collide.flat import overlapping_pairs
+
+    rng = np.random.default_rng(11)
+    n = 120
+    tris = rng.random((n, 1, 2)) * 3 + rng.random((n, 3, 2)) - 0.5
+    parent = np.full(n, -1, dtype=np.int64)
+    every = find_overlaps(tris, parent, 0.0)
+    want = {(i, j) for i in range(n) for j in range(i + 1, n) if oracle_overlap(tris[i].tolist(), tris[j].tolist())}
+    assert len(want) > 256 and {tuple(p) for p in every} == want and len(every) == len(want)
+    count, none = overlapping_pairs(tris, parent, 0.0, 0)
+    assert count == len(want) and len(none) == 0
+    count, first = overlapping_pairs(tris, parent, 0.0, 100)
+    assert count == len(want) and np.array_equal(first, every[:100])
+
+
 def test_crease_pairs_are_skipped():
     a = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     tris = np.stack([a, a + 0.1])

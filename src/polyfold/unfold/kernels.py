@@ -327,6 +327,9 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     saved_depth = np.empty(n, dtype=np.int64)
     # a move changes the depths of the faces it moves alone: kept up to date with them
     tree_depths(parent, order, depth)
+    pos = np.empty(n, dtype=np.int64)  # each face's place in `order`
+    for idx in range(n):
+        pos[order[idx]] = idx
     candidates = np.empty(n_e, dtype=np.int64)
     while it < iterations and best > 0:
         it += 1
@@ -350,7 +353,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         in_sub[:] = False
         in_sub[x] = True
         n_sub = 0
-        for idx in range(n):
+        px = pos[x]
+        for idx in range(px, n):  # (no face of the subtree comes before x in `order`)
             y = order[idx]
             if y == x or (parent[y] >= 0 and in_sub[parent[y]]):
                 in_sub[y] = True
@@ -454,6 +458,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             score = new_score
             pairs = new_pairs
             order, new_order = new_order, order
+            for idx in range(px, n):  # (the faces before x keep their places)
+                pos[order[idx]] = idx
             if score < best:
                 best = score
                 for e in range(crease.shape[0]):  # (element by element: an array assignment compiles
