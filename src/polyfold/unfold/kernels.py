@@ -325,7 +325,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
     it = 0
     path = np.empty(n, dtype=np.int64)
     saved_depth = np.empty(n, dtype=np.int64)
-    # a move changes the depths of the faces it moves alone: kept up to date with them
+    # only the faces a move turns change depth: theirs are updated with them (restored when the
+    # move is turned down), not every face's recomputed at every move
     tree_depths(parent, order, depth)
     pos = np.empty(n, dtype=np.int64)  # each face's place in `order`
     for idx in range(n):
@@ -364,7 +365,8 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
         # order: from the edges of the subtree's faces, sorted, when they are the fewer (each edge
         # that reconnects has one face in the subtree), else from every edge
         n_cand = np.int64(0)
-        if 12 * n_sub < n_e:
+        from_sub = 12 * n_sub < n_e
+        if from_sub:
             for idx in range(n_sub):
                 for k in range(3):
                     e = face_edges[sub[idx], k]
@@ -374,16 +376,12 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                         candidates[n_cand] = e
                         n_cand += 1
             candidates[:n_cand].sort()
-        else:
-            for e in range(n_e):
-                candidates[n_cand] = e
-                n_cand += 1
         pick = np.int64(-1)  # (not a literal: see prim_tree's size)
         seen = 0
         near_pick = np.int64(-1)
         near_seen = 0
-        for ci in range(n_cand):
-            e = candidates[ci]
+        for ci in range(n_cand if from_sub else n_e):
+            e = candidates[ci] if from_sub else ci
             if crease[e] or e == c or merged[e]:
                 continue
             f0 = edge_faces[e, 0]
