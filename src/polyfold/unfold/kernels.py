@@ -414,7 +414,7 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             saved_edge[f] = parent_edge[f]
             saved_depth[f] = depth[f]
         n_rest = _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face,
-                         adj_edge, hung, it)
+                         adj_edge, hung, it, px)
         for idx in range(n_rest, n):  # (parents first: the subtree hangs from a face outside it)
             y = new_order[idx]
             depth[y] = depth[parent[y]] + 1
@@ -480,14 +480,16 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
 
 @njit(cache=True)
 def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face, adj_edge,
-            hung, stamp):
+            hung, stamp, first):
     """Hang the subtree (in_sub) from the crease `pick` that now joins it to the other faces: its
     faces' parents by a BFS over creases from its end of `pick` (hung[f] = stamp marks those
     reached). new_order: the other faces in `order`'s order, then the subtree's in BFS order (parents
-    first). Returns the number of other faces."""
+    first). first: no face of the subtree comes before order[first] (its top's place). Returns the
+    number of other faces."""
     hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
-    n_rest = np.int64(0)  # (not a literal: see prim_tree's size)
-    for idx in range(order.shape[0]):
+    new_order[:first] = order[:first]
+    n_rest = np.int64(first)  # (not a literal: see prim_tree's size)
+    for idx in range(first, order.shape[0]):
         if not in_sub[order[idx]]:
             new_order[n_rest] = order[idx]
             n_rest += 1
