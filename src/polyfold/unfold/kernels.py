@@ -362,8 +362,9 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                 sub[n_sub] = y
                 n_sub += 1
         # reservoir-sample a reconnecting cut edge, and one at an end of c (NEAR_MOVES), in edge
-        # order: from the edges of the subtree's faces, sorted, when they are the fewer (each edge
-        # that reconnects has one face in the subtree), else from every edge
+        # order: from the edges of the subtree's faces, sorted (each edge that reconnects has one
+        # face in the subtree), when their 3 n_sub, sort included, cost less than a pass over
+        # every edge (12 n_sub < E), else from every edge
         n_cand = np.int64(0)
         from_sub = 12 * n_sub < n_e
         if from_sub:
@@ -415,9 +416,7 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
             saved_depth[f] = depth[f]
         n_rest = _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_faces, adj_ptr, adj_face,
                          adj_edge, hung, it, px)
-        for idx in range(n_rest, n):  # (parents first: the subtree hangs from a face outside it)
-            y = new_order[idx]
-            depth[y] = depth[parent[y]] + 1
+        tree_depths(parent, new_order[n_rest:], depth)  # (the subtree hangs from a face outside it)
         place_children(new_order[n_rest:], parent, parent_edge, faces, face_edges, local, tris)
         face_bounds(tris, moved, xmin, xmax, ymin, ymax)
         keep = np.empty(npairs, dtype=np.bool_)
@@ -503,8 +502,8 @@ def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_fa
 
 @njit(cache=True)
 def tree_depths(parent, order, depth):
-    """Fill depth (F,): each face's number of creases below its root (roots 0). Parents must
-    precede children in `order`."""
+    """Fill depth (F,) for the faces of `order`: each one's number of creases below its root (roots
+    0). A face's parent must precede it in `order`, or lie outside it with its depth set."""
     for idx in range(order.shape[0]):
         f = order[idx]
         depth[f] = depth[parent[f]] + 1 if parent[f] >= 0 else 0
