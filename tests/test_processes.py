@@ -1,7 +1,8 @@
 """processes.py: `fork_map` runs a function over items in forked processes, in order, and raises
 what it raises; `beside` runs one function in a forked process while another runs here;
-`Forked` waits for, polls and kills a forked process as Popen does a spawned one; `usable_cores`
-counts this process's cores."""
+`Forked` waits for, polls and kills a forked process as Popen does a spawned one; `Standby`
+prepares in a forked process and then runs the calls it is sent there; `usable_cores` counts
+this process's cores."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from polyfold.errors import OutOfTime
-from polyfold.processes import beside, fork_map, usable_cores
+from polyfold.processes import Standby, beside, fork_map, usable_cores
 
 BIG = np.arange(1_000_000)  # read by the children through the fork, never pickled
 
@@ -215,3 +216,81 @@ def test_calls_in_the_roomy_stack_map_no_frame_chunks() -> None:
     assert outside > 1000, outside  # (the churn this guards against, as CPython 3.11 has it)
     assert inside < outside / 20, (inside, outside)
     assert in_roomy_stack(lambda: _down(50)) == 50
+
+
+# module-level: a Standby's calls are pickled by reference
+_PREPARED: list[int] = []
+
+
+def _prepare() -> None:
+    _PREPARED.append(os.getpid())
+
+
+def _prepared_where(big: np.ndarray) -> tuple[list[int], int, int, np.ndarray]:
+    """What prepare() did in this process, this process, the argument's sum, a large answer."""
+    return list(_PREPARED), os.getpid(), int(big.sum()), np.ones(2_000_000)
+
+
+def _fail(why: str) -> None:
+    raise OutOfTime("out of time", why)
+
+
+def _exit_there(parent: int) -> int:
+    """Ends the process it runs in unless that is `parent` (a standby dying mid-call)."""
+    if os.getpid() != parent:
+        os._exit(3)
+    return parent
+
+
+def _pid() -> int:
+    return os.getpid()
+
+
+def test_standby_prepares_then_runs_the_calls_sent_in_order_with_large_data_both_ways() -> None:
+    """prepare() ran in the standby process before its calls; several calls sent at once, each
+    with megabytes going there and coming back (the process answers one while the next is still
+    being sent: nothing waits for the other side), answered in order whichever is asked first."""
+    if os.uname().sysname != "Linux":
+        pytest.skip("forking is Linux only")
+    standby = Standby(_prepare)
+    try:
+        big = np.arange(3_000_000)
+        tickets = [standby.submit(_prepared_where, big + k) for k in range(3)]
+        last = standby.result(tickets[2])
+        firsts = [standby.result(t) for t in tickets[:2]]
+        for k, (prepared, pid, total, answer) in enumerate([*firsts, last]):
+            assert pid != os.getpid() and prepared == [pid]
+            assert total == int(big.sum()) + k * len(big) and answer.sum() == 2_000_000
+        assert _PREPARED == []  # prepare() never ran here
+    finally:
+        standby.close()
+
+
+def test_standby_raises_here_what_a_call_raised_there_and_goes_on() -> None:
+    standby = Standby(_prepare)
+    try:
+        with pytest.raises(OutOfTime) as err:
+            standby.result(standby.submit(_fail, "writing"))
+        assert err.value.doing == "writing"
+        assert standby.result(standby.submit(_pid)) != os.getpid() or os.uname().sysname != "Linux"
+    finally:
+        standby.close()
+
+
+def test_standby_runs_here_what_it_cannot_send_or_answer() -> None:
+    """A call that does not pickle (a lambda), or one sent to a process that died (killed, out of
+    memory: here it exits mid-call), is run in this process; nothing waits for ever."""
+    standby = Standby(_prepare)
+    try:
+        assert standby.result(standby.submit(lambda: os.getpid())) == os.getpid()
+        assert standby.result(standby.submit(_pid)) == os.getpid()  # (the process was ended: all here)
+    finally:
+        standby.close()
+    standby = Standby(_prepare)
+    try:
+        died = standby.submit(_exit_there, os.getpid())
+        after = standby.submit(_pid)
+        assert standby.result(after) == os.getpid()
+        assert standby.result(died) == os.getpid()
+    finally:
+        standby.close()

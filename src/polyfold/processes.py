@@ -242,3 +242,112 @@ def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]
     if not ok:
         raise far
     return near, far
+
+
+class Standby:
+    """A process forked now that runs prepare() at once (imports the work it will be given needs)
+    while this one goes on, then the calls it is sent, one at a time in the order sent:
+    `submit(fn, *args)` pickles fn (a module-level function) and its arguments to it and returns
+    a ticket, `result(ticket)` waits for fn(*args) (pickled back; what fn raised is raised here).
+    For work whose libraries take long to import next to the data it needs: they load on a core
+    this process leaves idle, and a process forked later (`beside`) would load them again.
+    A call the process cannot answer (it died: killed, out of memory) is run here. It ignores
+    Ctrl-C (this process reports it and ends it); `close` ends it, as does this process ending
+    (its pipe closes). Check `can_fork` first."""
+
+    def __init__(self, prepare: Callable[[], Any]) -> None:
+        import multiprocessing as mp
+
+        ctx = mp.get_context("fork")
+        self._conn, theirs = ctx.Pipe()
+        self._sent: list[tuple[Callable[..., Any], tuple]] = []  # every call submitted, by ticket
+        self._answers: dict[int, tuple[bool, Any]] = {}
+        self._received = 0  # answers read from the pipe (they come in the order sent)
+        self._senders: list[Any] = []
+        self._gone = False
+
+        def serve() -> None:
+            import signal
+
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            self._conn.close()
+            try:
+                prepare()
+            except Exception:  # (what it failed to load, the calls load themselves or fail there)
+                pass
+            while True:
+                try:
+                    call = theirs.recv()
+                except (EOFError, OSError):  # the parent is gone
+                    return
+                if call is None:
+                    return
+                fn, args = call
+                try:
+                    answer = (True, fn(*args))
+                except BaseException as exc:  # (raised in the parent instead)
+                    answer = (False, exc)
+                try:
+                    theirs.send(answer)
+                except (OSError, ValueError):  # the parent is gone
+                    return
+
+        gc.freeze()  # (see fork_map)
+        try:
+            self._proc = ctx.Process(target=serve, daemon=True)
+            self._proc.start()
+        except OSError:
+            self._gone = True
+        finally:
+            gc.unfreeze()
+        theirs.close()
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> int:
+        """Send fn(*args) to the process (from a thread of this one: a large call waits for the
+        pipe while the process finishes the one before) and return its ticket."""
+        import threading
+
+        self._sent.append((fn, args))
+        if not self._gone:
+            before = self._senders[-1] if self._senders else None  # (sent after it: one stream)
+            sender = threading.Thread(target=self._send, args=((fn, args), before), daemon=True)
+            sender.start()
+            self._senders.append(sender)
+        return len(self._sent) - 1
+
+    def _send(self, call: tuple, before: Any) -> None:
+        if before is not None:
+            before.join()
+        if self._gone:
+            return
+        try:
+            self._conn.send(call)
+        except Exception:  # the process is gone, or the call does not pickle: `result` runs it here
+            self.close()
+
+    def result(self, ticket: int) -> Any:
+        """fn(*args) of the call with this ticket (waits for it and for the calls before it; reads
+        while a sender may still be writing: the process may be sending an answer as large)."""
+        while ticket not in self._answers:
+            if self._gone:
+                fn, args = self._sent[ticket]
+                return fn(*args)
+            try:
+                self._answers[self._received] = self._conn.recv()
+                self._received += 1
+            except (EOFError, OSError):
+                self._gone = True
+        ok, value = self._answers.pop(ticket)
+        if not ok:
+            raise value
+        return value
+
+    def close(self) -> None:
+        """End the process (at once: calls not yet answered are run here if asked for)."""
+        if not self._gone:
+            self._gone = True
+            try:
+                self._proc.kill()
+                self._proc.join()
+            except (OSError, ValueError, AttributeError):
+                pass

@@ -10,6 +10,7 @@ and path checkers: apps/cli/test_make_commands.py.)"""
 from __future__ import annotations
 
 import json
+import os
 from collections import Counter
 from pathlib import Path
 
@@ -127,6 +128,30 @@ def test_mesh_in_memory_makes_the_same_folder(models_dir, tmp_path):
     # nothing staged left: beside the outputs only the manifest of what make wrote and its lock file
     assert sorted(p.name for p in (tmp_path / "mesh").iterdir() if p.name.startswith(".")) == [
         ".polyfold-manifest.json", ".polyfold.lock"]
+
+
+def test_the_writer_process_writes_what_this_one_would(models_dir, tmp_path, monkeypatch):
+    """The sheets' files and guide.pdf made in make's writer process (`processes.Standby`, where
+    it can fork) are byte for byte those made without it (forked at the export, or here)."""
+    import polyfold.pipeline.make as make_module
+    from polyfold.processes import can_fork, usable_cores
+
+    opts = MakeOptions(time_limit=30)
+    with_writer = make(models_dir / "bunny-128.obj", tmp_path / "writer", opts)
+    monkeypatch.setattr(make_module, "_writer_process", lambda: None)
+    without = make(models_dir / "bunny-128.obj", tmp_path / "plain", opts)
+    assert with_writer.files == without.files and "guide.pdf" in without.files
+    for name in without.files:
+        if name != "report.json":  # (timings)
+            assert (tmp_path / "writer" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes(), name
+    if usable_cores() >= 2 and can_fork():
+        assert make_module._writer_process() is None  # (patched) and the real one forks:
+        monkeypatch.undo()
+        writer = make_module._writer_process()
+        try:
+            assert writer is not None and writer.result(writer.submit(os.getpid)) != os.getpid()
+        finally:
+            writer.close()
 
 
 def test_unnamed_mesh_is_called_model(models_dir, tmp_path):

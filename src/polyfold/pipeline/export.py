@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from ..fabricate.page import Page, footer, page_of, registration_marks
 from ..formats.dxf import dxf_string
 from ..formats.files import StagedFolder
 from ..formats.fold import dumps, piece_fold
+from ..formats.guide_pdf import guide_pdf_bytes
 from ..formats.meshes import look_glb, obj_text
 from ..formats.pdf import pdf_bytes
 from ..formats.svg import cut_svg_string, svg_page_string
@@ -41,6 +42,10 @@ from .parts import Part
 from .report import (Assembly, AssemblyPart, AssemblyPiece, AssemblyStep, GlueRow, GuideReport, MakeReport,
                      PieceReport)
 from .sheets import Sheets, pack_box
+
+if TYPE_CHECKING:
+    from ..guide.guide import Guide
+    from ..processes import Standby
 
 # pictures from which guide.pdf is written in a forked process while instructions.html is written
 # here (a 1,280-face sphere's 154: 0.24 and 0.52 s; the bunny's 69: 0.04 and 0.13 s, its make
@@ -127,73 +132,100 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
         steps=steps)
 
 
+def load_writers() -> None:
+    """Import the libraries the file writers load when first used (ezdxf 0.13 s, reportlab's
+    platypus 0.09 s here): the prepare() of make's writer process (`processes.Standby`), which
+    loads them while the model is laid out."""
+    import ezdxf  # noqa: F401
+    import PIL.JpegImagePlugin  # noqa: F401
+    import reportlab.lib.styles  # noqa: F401
+    import reportlab.pdfgen.canvas  # noqa: F401
+    import reportlab.platypus  # noqa: F401
+
+
+def sheet_files(pages: list[Page], svgs: list[str], model: str) -> list[tuple[str, str | bytes]]:
+    """sheets.pdf, then per page its SVG (named svgs[k]), cut SVG and DXF: (name, contents)."""
+    out: list[tuple[str, str | bytes]] = [("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))]
+    for k, page in enumerate(pages):
+        out += [(svgs[k], svg_page_string(page)), (f"cut-{k + 1:02d}.svg", cut_svg_string(page)),
+                (f"sheet-{k + 1:02d}.dxf", dxf_string(page))]
+    return out
+
+
 def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOptions, parts: list[Part],
                       folded: list[FoldedPiece], sheets: Sheets,
                       finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int, GuideReport | None],
                                        MakeReport],
                       inputs: tuple[Path, ...] = (), look: Appearance | None = None, original: Mesh | None = None,
-                      contacts: tuple[tuple[int, int], ...] = ()) -> tuple[tuple[str, ...], MakeReport]:
+                      contacts: tuple[tuple[int, int], ...] = (), writer: Standby | None = None
+                      ) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
     written, and the report. finish(piece rows, outputs so far, what the sheets print of the
     model's `look`, sheets.pdf's size in bytes, the guide's report or None) gives the report,
     written last. inputs: the files make read (never replaced). original: the mesh a convex
     approximation (`--approximate hulls`) stands for, written as original.obj (the viewer shows
-    it beside the parts); contacts: the pairs of parts glued face to face (the guide says which)."""
+    it beside the parts); contacts: the pairs of parts glued face to face (the guide says which).
+    writer: a process that has the writers' libraries loaded (`load_writers`): the sheets' files
+    and guide.pdf are made there while the guide and instructions.html are made here; without
+    one, the sheets' files are made in a process forked now."""
     from ..processes import beside, usable_cores
 
     pages, printed = sheet_pages(sheets, model, opts, look)
     rows = piece_reports(folded, sheets)
     svgs = [f"sheet-{k + 1:02d}.svg" for k in range(len(pages))]  # (instructions.html shows them)
 
-    def guide_files() -> tuple[str, str, bytes | None, GuideReport | None]:
-        """assembly.json, instructions.html, guide.pdf and the guide's report (no guide: None)."""
-        guide = None
-        if opts.guide:
-            from ..guide.guide import build_guide
+    def build() -> Guide | None:
+        if not opts.guide:
+            return None
+        from ..guide.guide import build_guide
 
-            guide = build_guide(mesh, sheets.pieces, sheets.glue, sheets.page_of_piece(), folded, sheets.scale)
+        return build_guide(mesh, sheets.pieces, sheets.glue, sheets.page_of_piece(), folded, sheets.scale)
 
-        def html_file() -> str:
-            return instructions_html(model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue,
-                                     sheets.page_of_piece(), sheets.packing.n_pages, opts, svgs, guide, contacts)
+    def html_file(guide: Guide | None) -> str:
+        return instructions_html(model, mesh, [p.faces for p in parts], sheets.pieces, sheets.glue,
+                                 sheets.page_of_piece(), sheets.packing.n_pages, opts, svgs, guide, contacts)
 
-        def pdf_file() -> tuple[bytes, int]:
-            from ..formats.guide_pdf import guide_pdf_bytes
+    def pdf_args(guide: Guide) -> tuple:
+        intro = guide_intro(opts, sheets.packing.n_pages, len(parts), sheets.pieces,
+                            any(g.printed != g.label for g in sheets.glue), contacts)
+        return guide, f"Building {model}", (sheets.width, sheets.height), intro
 
-            intro = guide_intro(opts, sheets.packing.n_pages, len(parts), sheets.pieces,
-                                any(g.printed != g.label for g in sheets.glue), contacts)
-            return guide_pdf_bytes(guide, f"Building {model}", (sheets.width, sheets.height), intro)
-
-        guide_pdf, guide_report = None, None
-        if guide is None:
-            html = html_file()
-        elif usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
-            # side by side: guide.pdf in a forked process (the sheets' process is done by then),
-            # instructions.html here meanwhile
-            html, (guide_pdf, guide_pages) = beside(html_file, pdf_file)
-        else:
-            html, (guide_pdf, guide_pages) = html_file(), pdf_file()
-        if guide is not None:
-            closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
-            guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=guide.pictures,
-                                       pdf_pages=guide_pages, closing_seams=closing)
-        return assembly(model, opts, parts, sheets, rows, guide).to_json(), html, guide_pdf, guide_report
-
-    def sheet_files() -> list[tuple[str, str | bytes]]:
-        """sheets.pdf, then per page its SVG, cut SVG and DXF: (name, contents)."""
-        out: list[tuple[str, str | bytes]] = [("sheets.pdf", pdf_bytes(pages, title=f"{model}: polyfold sheets"))]
-        for k, page in enumerate(pages):
-            out += [(svgs[k], svg_page_string(page)), (f"cut-{k + 1:02d}.svg", cut_svg_string(page)),
-                    (f"sheet-{k + 1:02d}.dxf", dxf_string(page))]
-        return out
-
-    # the guide and the sheets share nothing: made side by side on two cores (the bunny's 0.45 + 0.3 s,
-    # a 1,280-face sphere's 2.4 + 1.3 s), the guide here (`processes.beside`): the modules and kernels
-    # it loads stay loaded for the next model a process makes (in-process, the bunny's make 1.0-1.1 -> 0.84 s)
-    if usable_cores() >= 2:
-        (assembly_json, html, guide_pdf, guide_report), sheet_out = beside(guide_files, sheet_files)
+    if writer is not None:
+        # the writer's libraries were loaded while the model was laid out: the bunny's export
+        # 0.47 -> 0.39 s (its sheets' files 0.05 s there, 0.18 s in a process forked now)
+        sheets_ticket = writer.submit(sheet_files, pages, svgs, model)
+        guide = build()
+        pdf_ticket = None if guide is None else writer.submit(guide_pdf_bytes, *pdf_args(guide))
+        html = html_file(guide)
+        guide_pdf, guide_pages = (None, 0) if pdf_ticket is None else writer.result(pdf_ticket)
+        sheet_out = writer.result(sheets_ticket)
     else:
-        (assembly_json, html, guide_pdf, guide_report), sheet_out = guide_files(), sheet_files()
+        def guide_files() -> tuple[Guide | None, str, bytes | None, int]:
+            """The guide, instructions.html, guide.pdf and its pages (no guide: None, html, None, 0)."""
+            guide = build()
+            if guide is None:
+                return None, html_file(None), None, 0
+            if usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
+                # side by side: guide.pdf in a forked process (the sheets' process is done by then),
+                # instructions.html here meanwhile
+                html, (pdf, n) = beside(lambda: html_file(guide), lambda: guide_pdf_bytes(*pdf_args(guide)))
+                return guide, html, pdf, n
+            return guide, html_file(guide), *guide_pdf_bytes(*pdf_args(guide))
+
+        # the guide and the sheets share nothing: made side by side on two cores (the bunny's 0.45 + 0.3 s,
+        # a 1,280-face sphere's 2.4 + 1.3 s), the guide here (`processes.beside`): the modules and kernels
+        # it loads stay loaded for the next model a process makes (in-process, the bunny's make 1.0-1.1 -> 0.84 s)
+        if usable_cores() >= 2:
+            (guide, html, guide_pdf, guide_pages), sheet_out = beside(guide_files,
+                                                                      lambda: sheet_files(pages, svgs, model))
+        else:
+            (guide, html, guide_pdf, guide_pages), sheet_out = guide_files(), sheet_files(pages, svgs, model)
+    guide_report = None
+    if guide is not None:
+        closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
+        guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=guide.pictures,
+                                   pdf_pages=guide_pages, closing_seams=closing)
+    assembly_json = assembly(model, opts, parts, sheets, rows, guide).to_json()
     with StagedFolder(out_dir, "make", inputs=inputs) as stage:
         for name, data in sheet_out:
             stage.write(name, data)

@@ -14,7 +14,7 @@ import os
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from ..deadline import CompileTally, Deadline
 from ..errors import OutOfTime, PolyfoldError
@@ -25,13 +25,16 @@ from ..formats.files import check_folder
 from ..mesh.appearance import Appearance
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh
-from .export import OUTPUTS, PrintedLook, write_make_folder
+from .export import OUTPUTS, PrintedLook, load_writers, write_make_folder
 from .folding import fold_pieces
 from .options import MakeOptions, check_options
 from .parts import component_faces, make_parts
 from .report import (ChecksReport, ColorReport, ExportReport, GuideReport, InflateReport, InputReport, LayoutReport,
                      LoadReport, MakeReport, PieceReport, SimplifyReport, StageReports, StageSeconds)
 from .sheets import PageSplit, Sheets, fit_parts, lay_out, pack_box, split_for_pages
+
+if TYPE_CHECKING:
+    from ..processes import Standby
 
 Progress = Callable[[str, str], None]  # (stage, message)
 
@@ -195,22 +198,37 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
     check_folder(out_dir, OUTPUTS, inputs)
     hard = Deadline.after(opts.time_limit)  # the whole run's
     t0 = time.perf_counter()
-    mesh, look, input_report, load_report, name = _load(source, name, say)
+    writer = _writer_process()
     try:
-        return _make(mesh, look, name, out_dir, opts, (width, height), say, hard, t0, input_report, load_report,
-                     inputs, compiling)
-    except OutOfTime as exc:
-        raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
-                        f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh first "
-                        f"(--faces auto, or --faces N for about N faces) or raise --time-limit",
-                        exc.doing) from None
+        mesh, look, input_report, load_report, name = _load(source, name, say)
+        try:
+            return _make(mesh, look, name, out_dir, opts, (width, height), say, hard, t0, input_report,
+                         load_report, inputs, compiling, writer)
+        except OutOfTime as exc:
+            raise OutOfTime(f"{name}: stopped at --time-limit {opts.time_limit:g} s while {exc.doing}: its "
+                            f"{mesh.n_faces:,} faces need longer (and print small); simplify the mesh first "
+                            f"(--faces auto, or --faces N for about N faces) or raise --time-limit",
+                            exc.doing) from None
+    finally:
+        if writer is not None:
+            writer.close()
+
+
+def _writer_process() -> Standby | None:
+    """The process that makes the sheets' files and guide.pdf at the end (`export.load_writers`:
+    it loads their libraries meanwhile, on the core the load, unfold and much of the layout leave
+    idle): where there are two cores and processes may be forked, else None."""
+    from ..processes import Standby, can_fork, usable_cores
+
+    return Standby(load_writers) if usable_cores() >= 2 and can_fork() else None
 
 
 def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.PathLike, opts: MakeOptions,
           page: tuple[float, float], say: Progress, hard: Deadline, t0: float, input_report: InputReport,
-          load_report: LoadReport, inputs: tuple[Path, ...], compiling: CompileTally) -> MakeResult:
+          load_report: LoadReport, inputs: tuple[Path, ...], compiling: CompileTally,
+          writer: Standby | None = None) -> MakeResult:
     """`make` after loading (page: width, height in mm): OutOfTime when `hard` passes in work that
-    cannot be skipped."""
+    cannot be skipped. writer: the export's (`_writer_process`)."""
     width, height = page
     mesh, look, simplify_report = _simplify(mesh, look, name, opts, say)
     layout_s, tail_s = time_shares(mesh.n_faces, opts.time_limit)
@@ -270,5 +288,5 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     if look is not None and opts.color != "none":
         say("export", f"printing the model's {'texture' if look.textured.any() and opts.color == 'texture' else 'colours'}")
     files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs,
-                                      look=look, original=original, contacts=contacts)
+                                      look=look, original=original, contacts=contacts, writer=writer)
     return MakeResult(out_dir=Path(out_dir), files=files, report=report)
