@@ -132,15 +132,18 @@ def assembly(model: str, opts: MakeOptions, parts: list[Part], sheets: Sheets,
         steps=steps)
 
 
+# what the sheets' and the guide's writers import when first used (`load_writers`)
+WRITER_MODULES = ("ezdxf", "PIL.JpegImagePlugin", "reportlab.lib.styles", "reportlab.pdfgen.canvas", "reportlab.platypus")
+
+
 def load_writers() -> None:
     """Import the libraries the file writers load when first used (ezdxf 0.13 s, reportlab's
     platypus 0.09 s here): the prepare() of make's writer process (`processes.Standby`), which
     loads them while the model is laid out."""
-    import ezdxf  # noqa: F401
-    import PIL.JpegImagePlugin  # noqa: F401
-    import reportlab.lib.styles  # noqa: F401
-    import reportlab.pdfgen.canvas  # noqa: F401
-    import reportlab.platypus  # noqa: F401
+    import importlib
+
+    for name in WRITER_MODULES:
+        importlib.import_module(name)
 
 
 def sheet_files(pages: list[Page], svgs: list[str], model: str) -> list[tuple[str, str | bytes]]:
