@@ -266,6 +266,31 @@ def test_standby_prepares_then_runs_the_calls_sent_in_order_with_large_data_both
         standby.close()
 
 
+def _sleep(seconds: float) -> float:
+    import time
+
+    time.sleep(seconds)
+    return seconds
+
+
+def test_standby_says_whether_a_call_is_answered_without_waiting() -> None:
+    import time
+
+    standby = Standby(_prepare)
+    try:
+        slow = standby.submit(_sleep, 1.0)
+        t0 = time.monotonic()
+        assert not standby.answered(slow) and time.monotonic() - t0 < 0.5
+        assert standby.result(slow) == 1.0
+        quick = standby.submit(_sleep, 0.0)
+        t0 = time.monotonic()
+        while not standby.answered(quick) and time.monotonic() - t0 < 20:
+            time.sleep(0.01)
+        assert standby.result(quick) == 0.0
+    finally:
+        standby.close()
+
+
 def test_standby_raises_here_what_a_call_raised_there_and_goes_on() -> None:
     standby = Standby(_prepare)
     try:

@@ -325,6 +325,17 @@ class Standby:
         except Exception:  # the process is gone, or the call does not pickle: `result` runs it here
             self.close()
 
+    def answered(self, ticket: int) -> bool:
+        """Whether the call with this ticket has been answered (or will be run here), without
+        waiting: the process is free for the next call when every call sent so far is."""
+        try:
+            while ticket not in self._answers and not self._gone and self._conn.poll(0):
+                self._answers[self._received] = self._conn.recv()
+                self._received += 1
+        except (EOFError, OSError):
+            self._gone = True
+        return ticket in self._answers or self._gone
+
     def result(self, ticket: int) -> Any:
         """fn(*args) of the call with this ticket (waits for it and for the calls before it; reads
         while a sender may still be writing: the process may be sending an answer as large)."""

@@ -132,18 +132,24 @@ def test_mesh_in_memory_makes_the_same_folder(models_dir, tmp_path):
 
 def test_the_writer_process_writes_what_this_one_would(models_dir, tmp_path, monkeypatch):
     """The sheets' files and guide.pdf made in make's writer process (`processes.Standby`, where
-    it can fork) are byte for byte those made without it (forked at the export, or here)."""
+    it can fork), or the sheets' there and guide.pdf in a process forked when the guide is ready
+    (the writer still busy), are byte for byte those made without it (forked at the export, or
+    here)."""
     import polyfold.pipeline.make as make_module
-    from polyfold.processes import can_fork, usable_cores
+    from polyfold.processes import Standby, can_fork, usable_cores
 
     opts = MakeOptions(time_limit=30)
     with_writer = make(models_dir / "bunny-128.obj", tmp_path / "writer", opts)
+    with monkeypatch.context() as busy:
+        busy.setattr(Standby, "answered", lambda self, ticket: False)
+        writer_busy = make(models_dir / "bunny-128.obj", tmp_path / "busy", opts)
     monkeypatch.setattr(make_module, "_writer_process", lambda: None)
     without = make(models_dir / "bunny-128.obj", tmp_path / "plain", opts)
-    assert with_writer.files == without.files and "guide.pdf" in without.files
+    assert with_writer.files == writer_busy.files == without.files and "guide.pdf" in without.files
     for name in without.files:
         if name != "report.json":  # (timings)
-            assert (tmp_path / "writer" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes(), name
+            plain = (tmp_path / "plain" / name).read_bytes()
+            assert (tmp_path / "writer" / name).read_bytes() == plain == (tmp_path / "busy" / name).read_bytes(), name
     if usable_cores() >= 2 and can_fork():
         assert make_module._writer_process() is None  # (patched) and the real one forks:
         monkeypatch.undo()

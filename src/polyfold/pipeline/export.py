@@ -193,14 +193,30 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                             any(g.printed != g.label for g in sheets.glue), contacts)
         return guide, f"Building {model}", (sheets.width, sheets.height), intro
 
+    def html_and_pdf(guide: Guide) -> tuple[str, bytes, int]:
+        """instructions.html and guide.pdf (its bytes and pages)."""
+        if usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
+            # side by side: guide.pdf in a forked process (the sheets' process is done by then, or
+            # nearly), instructions.html here meanwhile
+            html, (pdf, n) = beside(lambda: html_file(guide), lambda: guide_pdf_bytes(*pdf_args(guide)))
+            return html, pdf, n
+        return html_file(guide), *guide_pdf_bytes(*pdf_args(guide))
+
     if writer is not None:
         # the writer's libraries were loaded while the model was laid out: the bunny's export
-        # 0.47 -> 0.39 s (its sheets' files 0.05 s there, 0.18 s in a process forked now)
+        # 0.47 -> 0.39 s (its sheets' files 0.05 s there, 0.18 s in a process forked now). guide.pdf
+        # goes there too when the sheets are done by the time the guide is (a 1,500-face model's
+        # take 0.9 s there, as long as its guide here: then a process forked now is sooner)
         sheets_ticket = writer.submit(sheet_files, pages, svgs, model)
         guide = build()
-        pdf_ticket = None if guide is None else writer.submit(guide_pdf_bytes, *pdf_args(guide))
-        html = html_file(guide)
-        guide_pdf, guide_pages = (None, 0) if pdf_ticket is None else writer.result(pdf_ticket)
+        if guide is None:
+            html, guide_pdf, guide_pages = html_file(None), None, 0
+        elif writer.answered(sheets_ticket):
+            pdf_ticket = writer.submit(guide_pdf_bytes, *pdf_args(guide))
+            html = html_file(guide)
+            guide_pdf, guide_pages = writer.result(pdf_ticket)
+        else:
+            html, guide_pdf, guide_pages = html_and_pdf(guide)
         sheet_out = writer.result(sheets_ticket)
     else:
         def guide_files() -> tuple[Guide | None, str, bytes | None, int]:
@@ -208,12 +224,7 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
             guide = build()
             if guide is None:
                 return None, html_file(None), None, 0
-            if usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
-                # side by side: guide.pdf in a forked process (the sheets' process is done by then),
-                # instructions.html here meanwhile
-                html, (pdf, n) = beside(lambda: html_file(guide), lambda: guide_pdf_bytes(*pdf_args(guide)))
-                return guide, html, pdf, n
-            return guide, html_file(guide), *guide_pdf_bytes(*pdf_args(guide))
+            return guide, *html_and_pdf(guide)
 
         # the guide and the sheets share nothing: made side by side on two cores (the bunny's 0.45 + 0.3 s,
         # a 1,280-face sphere's 2.4 + 1.3 s), the guide here (`processes.beside`): the modules and kernels
