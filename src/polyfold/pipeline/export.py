@@ -193,14 +193,39 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                             any(g.printed != g.label for g in sheets.glue), contacts)
         return guide, f"Building {model}", (sheets.width, sheets.height), intro
 
-    def html_and_pdf(guide: Guide) -> tuple[str, bytes, int]:
-        """instructions.html and guide.pdf (its bytes and pages)."""
+    def model_files() -> list[tuple[str, str | bytes]]:
+        """part-K.obj, original.obj, model.glb and piece-X.fold: (name, contents)."""
+        out: list[tuple[str, str | bytes]] = []
+        for k, part in enumerate(parts):
+            sub = mesh.submesh(part.faces)
+            out.append((f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)")))
+        if original is not None:
+            out.append(("original.obj", obj_text(original.vertices, original.faces,
+                                                 f"{model} as approximated by the parts (polyfold make)")))
+        if look is not None and opts.color != "none":  # the model as made, in the look printed (the viewer shows it)
+            shown = look if opts.color == "texture" else flat_look(look)
+            out.append(("model.glb", look_glb(mesh.vertices, mesh.faces, shown)))
+        for fp, piece, row, placement in zip(folded, sheets.pieces, rows, sheets.packing.placements):
+            out.append((row.fold_file, dumps(piece_fold(
+                fp.pattern, title=f"part {fp.part} piece", file_title=f"{model} piece {piece.name} (part {fp.part})",
+                whole_mesh_faces=fp.mesh_faces, path=fp.path, resolution_deg=opts.resolution_deg,
+                contact_tol=opts.contact_tol, thickness=opts.thickness / sheets.scale, verified=fp.info.path,
+                mm_per_unit=sheets.scale, page=row.page,
+                to_page=pattern_to_page(fp.pattern, fp.net, sheets.scale, placement)))))
+        return out
+
+    def here_files(guide: Guide | None) -> tuple[str, list[tuple[str, str | bytes]]]:
+        """instructions.html and `model_files`: made here while guide.pdf is made elsewhere."""
+        return html_file(guide), model_files()
+
+    def html_and_pdf(guide: Guide) -> tuple[str, list[tuple[str, str | bytes]], bytes, int]:
+        """`here_files` and guide.pdf (its bytes and pages)."""
         if usable_cores() >= 2 and guide.pictures >= PARALLEL_GUIDE_PICTURES:
             # side by side: guide.pdf in a forked process (the sheets' process is done by then, or
-            # nearly), instructions.html here meanwhile
-            html, (pdf, n) = beside(lambda: html_file(guide), lambda: guide_pdf_bytes(*pdf_args(guide)))
-            return html, pdf, n
-        return html_file(guide), *guide_pdf_bytes(*pdf_args(guide))
+            # nearly), the rest here meanwhile
+            (html, files), (pdf, n) = beside(lambda: here_files(guide), lambda: guide_pdf_bytes(*pdf_args(guide)))
+            return html, files, pdf, n
+        return *here_files(guide), *guide_pdf_bytes(*pdf_args(guide))
 
     if writer is not None:
         # the writer's libraries were loaded while the model was laid out: the bunny's export
@@ -210,30 +235,31 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         sheets_ticket = writer.submit(sheet_files, pages, svgs, model)
         guide = build()
         if guide is None:
-            html, guide_pdf, guide_pages = html_file(None), None, 0
+            (html, files), guide_pdf, guide_pages = here_files(None), None, 0
         elif writer.answered(sheets_ticket):
             pdf_ticket = writer.submit(guide_pdf_bytes, *pdf_args(guide))
-            html = html_file(guide)
+            html, files = here_files(guide)
             guide_pdf, guide_pages = writer.result(pdf_ticket)
         else:
-            html, guide_pdf, guide_pages = html_and_pdf(guide)
+            html, files, guide_pdf, guide_pages = html_and_pdf(guide)
         sheet_out = writer.result(sheets_ticket)
     else:
-        def guide_files() -> tuple[Guide | None, str, bytes | None, int]:
-            """The guide, instructions.html, guide.pdf and its pages (no guide: None, html, None, 0)."""
+        def guide_files() -> tuple[Guide | None, str, list[tuple[str, str | bytes]], bytes | None, int]:
+            """The guide, instructions.html, `model_files`, guide.pdf and its pages (no guide: None,
+            html, the files, None, 0)."""
             guide = build()
             if guide is None:
-                return None, html_file(None), None, 0
+                return None, *here_files(None), None, 0
             return guide, *html_and_pdf(guide)
 
         # the guide and the sheets share nothing: made side by side on two cores (the bunny's 0.45 + 0.3 s,
         # a 1,280-face sphere's 2.4 + 1.3 s), the guide here (`processes.beside`): the modules and kernels
         # it loads stay loaded for the next model a process makes (in-process, the bunny's make 1.0-1.1 -> 0.84 s)
         if usable_cores() >= 2:
-            (guide, html, guide_pdf, guide_pages), sheet_out = beside(guide_files,
-                                                                      lambda: sheet_files(pages, svgs, model))
+            (guide, html, files, guide_pdf, guide_pages), sheet_out = beside(
+                guide_files, lambda: sheet_files(pages, svgs, model))
         else:
-            (guide, html, guide_pdf, guide_pages), sheet_out = guide_files(), sheet_files(pages, svgs, model)
+            (guide, html, files, guide_pdf, guide_pages), sheet_out = guide_files(), sheet_files(pages, svgs, model)
     guide_report = None
     if guide is not None:
         closing = tuple(sheets.glue[k].label for st in guide.plan.steps for k in st.hard)
@@ -244,22 +270,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         for name, data in sheet_out:
             stage.write(name, data)
         pdf = sheet_out[0][1]
-        for k, part in enumerate(parts):
-            sub = mesh.submesh(part.faces)
-            stage.write(f"part-{k}.obj", obj_text(sub.vertices, sub.faces, f"part {k} of {model} (polyfold make)"))
-        if original is not None:
-            stage.write("original.obj", obj_text(original.vertices, original.faces,
-                                                 f"{model} as approximated by the parts (polyfold make)"))
-        if look is not None and opts.color != "none":  # the model as made, in the look printed (the viewer shows it)
-            shown = look if opts.color == "texture" else flat_look(look)
-            stage.write("model.glb", look_glb(mesh.vertices, mesh.faces, shown))
-        for fp, piece, row, placement in zip(folded, sheets.pieces, rows, sheets.packing.placements):
-            stage.write(row.fold_file, dumps(piece_fold(
-                fp.pattern, title=f"part {fp.part} piece", file_title=f"{model} piece {piece.name} (part {fp.part})",
-                whole_mesh_faces=fp.mesh_faces, path=fp.path, resolution_deg=opts.resolution_deg,
-                contact_tol=opts.contact_tol, thickness=opts.thickness / sheets.scale, verified=fp.info.path,
-                mm_per_unit=sheets.scale, page=row.page,
-                to_page=pattern_to_page(fp.pattern, fp.net, sheets.scale, placement))))
+        for name, data in files:
+            stage.write(name, data)
         stage.write("assembly.json", assembly_json)
         stage.write("instructions.html", html)
         if guide_pdf is not None:
