@@ -15,14 +15,15 @@ from conftest import check_sheet, read_sheet
 from sheet_reader import read_svg
 from polyfold.deadline import Deadline
 from polyfold.fabricate.fit import model_scale
-from polyfold.fabricate.paper import FOOTER_MM
+from polyfold.fabricate.pack import pack_outlines
+from polyfold.fabricate.paper import FOOTER_MM, GAP_MM
 from polyfold.fabricate.pieces import build_sheet_pieces
 from polyfold.formats.meshes import load_mesh
 from polyfold.pipeline.folding import fold_pieces
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions, paper_size
 from polyfold.pipeline.parts import make_parts
-from polyfold.pipeline.sheets import fit_parts, lay_out, pack_box, piece_inputs, split_for_pages
+from polyfold.pipeline.sheets import _packer_page, fit_parts, lay_out, pack_box, piece_inputs, split_for_pages
 
 # A4 pages of Blender's paper-model export at 150 mm (issue 18)
 BLENDER_PAGES = {"bunny-128": 3, "horse-302": 3, "fish-472": 2, "bunny-348": 5, "bumpy-528": 5}
@@ -89,6 +90,13 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     folded, _ = fold_pieces(split.parts, opts, deadline, lambda *a: None, scale)
     sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
     assert len(sheets.pieces) == split.pieces and sheets.packing.n_pages == split.pages
+    # the packing found before folding is kept: packing the same pieces again in its order, from the
+    # same seed, gives the very same placements
+    assert sheets.packing is split.packing and not split.packing.ran_out
+    page, margin = _packer_page(pack_box(w, h, opts))
+    again = pack_outlines([p.footprint for p in split.drawn[0]], page, margin=margin, gap=GAP_MM, seed=opts.seed,
+                          time_limit=60, hint=list(split.order), tries=1)
+    assert again.placements == split.packing.placements
     # the pieces drawn before folding, laid out again, are what drawing the folded pieces gives
     fresh, _, _ = build_sheet_pieces(piece_inputs(mesh, folded), scale, min_label_mm=opts.min_label_mm)
     assert [p.footprint.equals_exact(q.footprint, 0.0) for p, q in zip(split.drawn[0], fresh)] == [True] * len(fresh)
