@@ -130,6 +130,28 @@ def test_mesh_in_memory_makes_the_same_folder(models_dir, tmp_path):
         ".polyfold-manifest.json", ".polyfold.lock"]
 
 
+@pytest.mark.parametrize("with_writer", [True, False])
+def test_a_failed_sheet_check_writes_nothing(models_dir, tmp_path, monkeypatch, with_writer):
+    """The sheet check runs in the writer process beside the export's start (or here, before it);
+    either way a failed check stops make before any file is written, the folder not even made."""
+    import polyfold.pipeline.make as make_module
+    from polyfold.errors import PolyfoldError
+
+    real = make_module.check_pages
+
+    def failing(*args):
+        counts = real(*args)
+        return {**counts, "page_overlaps": 1, "problems": ["page 1: pieces A and B overlap or touch"]}
+
+    monkeypatch.setattr(make_module, "check_pages", failing)
+    if not with_writer:
+        monkeypatch.setattr(make_module, "_writer_process", lambda: None)
+    out = tmp_path / "out"
+    with pytest.raises(PolyfoldError, match="sheet check failed, nothing written: page 1: pieces A and B overlap"):
+        make(models_dir / "bunny-128.obj", out, MakeOptions(fold=False, time_limit=30))
+    assert not out.exists()
+
+
 def test_the_writer_process_writes_what_this_one_would(models_dir, tmp_path, monkeypatch):
     """The sheets' files and guide.pdf made in make's writer process (`processes.Standby`, where
     it can fork), or the sheets' there and guide.pdf in a process forked when the guide is ready

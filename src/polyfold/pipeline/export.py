@@ -160,8 +160,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
                       finish: Callable[[tuple[PieceReport, ...], list[str], PrintedLook, int, GuideReport | None],
                                        MakeReport],
                       inputs: tuple[Path, ...] = (), look: Appearance | None = None, original: Mesh | None = None,
-                      contacts: tuple[tuple[int, int], ...] = (), writer: Standby | None = None
-                      ) -> tuple[tuple[str, ...], MakeReport]:
+                      contacts: tuple[tuple[int, int], ...] = (), writer: Standby | None = None,
+                      before_writing: Callable[[], object] | None = None) -> tuple[tuple[str, ...], MakeReport]:
     """Write the make folder (see the module docstring); return the file names, in the order
     written, and the report. finish(piece rows, outputs so far, what the sheets print of the
     model's `look`, sheets.pdf's size in bytes, the guide's report or None) gives the report,
@@ -170,7 +170,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
     it beside the parts); contacts: the pairs of parts glued face to face (the guide says which).
     writer: a process that has the writers' libraries loaded (`load_writers`): the sheets' files
     and guide.pdf are made there while the guide and instructions.html are made here; without
-    one, the sheets' files are made in a process forked now."""
+    one, the sheets' files are made in a process forked now. before_writing(): called when the
+    files are made, before any is written (make's sheet check, which may raise: nothing written)."""
     from ..processes import beside, usable_cores
 
     pages, printed = sheet_pages(sheets, model, opts, look)
@@ -266,6 +267,8 @@ def write_make_folder(out_dir: str | Path, model: str, mesh: Mesh, opts: MakeOpt
         guide_report = GuideReport(seconds=guide.seconds, steps=len(guide.steps), pictures=guide.pictures,
                                    pdf_pages=guide_pages, closing_seams=closing)
     assembly_json = assembly(model, opts, parts, sheets, rows, guide).to_json()
+    if before_writing is not None:
+        before_writing()
     with StagedFolder(out_dir, "make", inputs=inputs) as stage:
         for name, data in sheet_out:
             stage.write(name, data)

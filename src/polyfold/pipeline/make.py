@@ -106,19 +106,39 @@ def _inflate(mesh: Mesh, opts: MakeOptions, say: Progress) -> tuple[Mesh, Inflat
                                    notes=tuple(res.notes))
 
 
-def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Progress) -> ChecksReport:
-    """The independent page checks; PolyfoldError (nothing written) when one fails."""
+def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Progress,
+           writer: Standby | None = None) -> Callable[[], ChecksReport]:
+    """The independent page checks, started: a call that gives their report, or raises
+    PolyfoldError when one failed (asked before anything is written). In the writer process
+    when there is one (a 1,500-face model's take 0.2 s, there beside the export's start), else
+    here, at once (a failed check raises here)."""
     say("check", "checking every page")
-    tc = time.perf_counter()
-    checks = check_pages(list(sheets.pieces), sheets.page_of_piece(), sheets.packing.n_pages,
-                         pack_box(sheets.width, sheets.height, opts), GAP_MM)
-    problems = checks.pop("problems")
-    report = ChecksReport(seconds=time.perf_counter() - tc, **checks, problems=tuple(problems), paths_verified=verified,
-                          pieces=len(sheets.pieces), untabbed_edges=tuple(sheets.stats.untabbed))
-    if problems:
-        raise PolyfoldError(f"{name}: sheet check failed, nothing written: {problems[0]}"
-                            + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""))
+    args = (list(sheets.pieces), sheets.page_of_piece(), sheets.packing.n_pages,
+            pack_box(sheets.width, sheets.height, opts), GAP_MM)
+    ticket = writer.submit(timed_check, *args) if writer is not None else None
+    done = [timed_check(*args)] if writer is None else []
+
+    def report() -> ChecksReport:
+        if not done:
+            done.append(writer.result(ticket))
+        counts, seconds = done[0]
+        problems = counts["problems"]
+        if problems:
+            raise PolyfoldError(f"{name}: sheet check failed, nothing written: {problems[0]}"
+                                + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""))
+        return ChecksReport(seconds=seconds, **{k: v for k, v in counts.items() if k != "problems"},
+                            problems=tuple(problems), paths_verified=verified, pieces=len(sheets.pieces),
+                            untabbed_edges=tuple(sheets.stats.untabbed))
+
+    if ticket is None:
+        report()  # (raises now: the export is not started)
     return report
+
+
+def timed_check(*args) -> tuple[dict, float]:
+    """`fabricate.check.check_pages`(*args) and the seconds it took (where it ran)."""
+    tc = time.perf_counter()
+    return check_pages(*args), time.perf_counter() - tc
 
 
 # The time limit holds for the whole run. The searches (unfold, fold) end early enough to leave the
@@ -265,7 +285,7 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     fit_seconds = time.perf_counter() - ts
     folded, fold_report = fold_pieces(fitted, opts, searches, say, scale, hard=hard)
     sheets = lay_out(mesh, folded, scale, opts, width, height, hard, say, planned=split, glued_to=glued_to)
-    checks = _check(sheets, opts, name, fold_report.verified, say)
+    checked = _check(sheets, opts, name, fold_report.verified, say, writer)
     if approximate_report is not None:
         approximate_report = replace(approximate_report, unmarked_sides=sheets.unnoted_sides)
     layout_report = _layout_report(mesh, sheets, opts, scale, page_splits, split, sheets.seconds + fit_seconds)
@@ -280,7 +300,7 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
                                                   pdf_bytes=pdf_size),
                               simplify=simplify_report, color=_color_report(look, opts, printed), guide=guide,
                               approximate=approximate_report)
-        return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checks,
+        return MakeReport(input=input_report, options=opts, stages=stages, pieces=rows, checks=checked(),
                           outputs=(*outputs, "report.json"), seconds=time.perf_counter() - t0,
                           compile_seconds=tuple(StageSeconds(stage, round(s, 2))
                                                 for stage, s in compiling.by_stage().items()))
@@ -288,5 +308,6 @@ def _make(mesh: Mesh, look: Appearance | None, name: str, out_dir: str | os.Path
     if look is not None and opts.color != "none":
         say("export", f"printing the model's {'texture' if look.textured.any() and opts.color == 'texture' else 'colours'}")
     files, report = write_make_folder(out_dir, name, mesh, opts, fitted, folded, sheets, finish, inputs,
-                                      look=look, original=original, contacts=contacts, writer=writer)
+                                      look=look, original=original, contacts=contacts, writer=writer,
+                                      before_writing=checked)
     return MakeResult(out_dir=Path(out_dir), files=files, report=report)
