@@ -280,8 +280,6 @@ class Standby:
                     call = theirs.recv()
                 except (EOFError, OSError):  # the parent is gone
                     return
-                if call is None:
-                    return
                 fn, args = call
                 try:
                     answer = (True, fn(*args))
@@ -294,10 +292,10 @@ class Standby:
 
         gc.freeze()  # (see fork_map)
         try:
-            self._proc = ctx.Process(target=serve, daemon=True)
+            self._proc: Any = ctx.Process(target=serve, daemon=True)
             self._proc.start()
         except OSError:
-            self._gone = True
+            self._proc, self._gone = None, True
         finally:
             gc.unfreeze()
         theirs.close()
@@ -355,10 +353,11 @@ class Standby:
 
     def close(self) -> None:
         """End the process (at once: calls not yet answered are run here if asked for)."""
-        if not self._gone:
-            self._gone = True
+        self._gone = True
+        proc, self._proc = self._proc, None
+        if proc is not None:
             try:
-                self._proc.kill()
-                self._proc.join()
-            except (OSError, ValueError, AttributeError):
+                proc.kill()  # (one that ended already: no error)
+                proc.join()
+            except (OSError, ValueError, AssertionError):
                 pass
