@@ -2,7 +2,8 @@
 
 load -> simplify (--faces) -> inflate -> segment + unfold (`parts`) -> fit to pages (`sheets.fit_parts`, then
 `sheets.split_for_pages`) -> fold
-(`folding`) -> tabs, labels, packing (`sheets.lay_out`) -> check (`fabricate.check`) -> export
+(`folding`) -> tabs, labels, packing (`sheets.lay_out`) -> check (`fabricate.check`; in the writer
+process beside the export's start where there is one, awaited before anything is written) -> export
 (`export`). In: a mesh (a file, or a `Mesh` in memory) and `MakeOptions`. Out: the files of
 `export.py`, moved into place only after every check passed, and a `MakeResult` whose `report` is
 report.json (`report.MakeReport`).
@@ -135,7 +136,7 @@ def _check(sheets: Sheets, opts: MakeOptions, name: str, verified: int, say: Pro
     return report
 
 
-def timed_check(*args) -> tuple[dict, float]:
+def timed_check(*args: object) -> tuple[dict, float]:
     """`fabricate.check.check_pages`(*args) and the seconds it took (where it ran)."""
     tc = time.perf_counter()
     return check_pages(*args), time.perf_counter() - tc
@@ -235,9 +236,10 @@ def make(source: str | os.PathLike | Mesh | LoadedMesh, out_dir: str | os.PathLi
 
 
 def _writer_process() -> Standby | None:
-    """The process that makes the sheets' files and guide.pdf at the end (`export.load_writers`:
-    it loads their libraries meanwhile, on the core the load, unfold and much of the layout leave
-    idle): where there are two cores and processes may be forked, else None."""
+    """The process that checks the pages and makes the sheets' files and guide.pdf at the end
+    (`export.load_writers`: it loads their libraries meanwhile, on the core the load, unfold and
+    much of the layout leave idle): where there are two cores and processes may be forked, else
+    None."""
     from ..processes import Standby, can_fork, usable_cores
 
     return Standby(load_writers) if usable_cores() >= 2 and can_fork() else None
