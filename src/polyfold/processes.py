@@ -263,7 +263,7 @@ class Standby:
         self._sent: list[tuple[Callable[..., Any], tuple]] = []  # every call submitted, by ticket
         self._answers: dict[int, tuple[bool, Any]] = {}
         self._received = 0  # answers read from the pipe (they come in the order sent)
-        self._senders: list[Any] = []
+        self._sender: Any = None  # the thread sending the last call (the next one waits for it)
         self._gone = False
 
         def serve() -> None:
@@ -307,10 +307,9 @@ class Standby:
 
         self._sent.append((fn, args))
         if not self._gone:
-            before = self._senders[-1] if self._senders else None  # (sent after it: one stream)
-            sender = threading.Thread(target=self._send, args=((fn, args), before), daemon=True)
+            sender = threading.Thread(target=self._send, args=((fn, args), self._sender), daemon=True)
             sender.start()
-            self._senders.append(sender)
+            self._sender = sender
         return len(self._sent) - 1
 
     def _send(self, call: tuple, before: Any) -> None:

@@ -111,24 +111,31 @@ def part_piece_inputs(mesh: Mesh, parts: list[Part]) -> list[PieceInput]:
 
 @dataclass(frozen=True, eq=False)
 class PageSplit:
-    """`split_for_pages`' result: the parts with the creases it cut (`cuts` of them); the pages and
-    pieces (net pieces and glue strips) of the packing found and its piece order; every mesh face's
-    place in that order (`lay_out` follows it when folding splits a piece); whether the time budget
-    stopped the search."""
+    """`split_for_pages`' result: the parts with the creases it cut (`cuts` of them); the pieces
+    (net pieces and glue strips) and the packing found for them (its pages and piece order:
+    `pages`, `order`); every mesh face's place in that order (`lay_out` follows it when folding
+    splits a piece); whether the time budget stopped the search."""
 
     parts: list[Part]
     cuts: int
-    pages: int
     pieces: int
     net_pieces: int
-    order: tuple[int, ...]
     rank: np.ndarray
     ran_out: bool
     drawn: tuple[list[SheetPiece], list[GlueEdge], LayoutStats]  # build_sheet_pieces of `parts`' pieces
     inputs: list[PieceInput]  # what was drawn
+    packing: Packing  # of `drawn`'s pieces
     label_cuts: int = 0  # creases cut before that where labels found no readable place (in `parts`)
     labels_ran_out: bool = False  # the time limit stopped those cuts with labels still crowded
-    packing: Packing | None = None  # the packing of `drawn`'s pieces found (its order: `order`)
+
+    @property
+    def pages(self) -> int:
+        return self.packing.n_pages
+
+    @property
+    def order(self) -> tuple[int, ...]:
+        """The piece order whose fill gave the packing."""
+        return tuple(self.packing.order)
 
     def same_pieces(self, folded: list[FoldedPiece]) -> bool:
         """Whether the folded pieces are the very pieces planned (folding split none)."""
@@ -248,7 +255,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
     # (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1 planned or not by chance)
     budget = deadline.within(pack_budget(deadline) + draw_seconds)
-    best = (packing.n_pages, len(pieces), parts, inputs, packing.order, 0, drawn, packing)
+    best = (packing.n_pages, len(pieces), parts, inputs, 0, drawn, packing)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     grown = float(shapely.area(shapely.buffer([p.footprint for p in pieces], GAP_MM / 2)).sum()) / box_area
     fewest = max(1, math.ceil(grown / MAX_FILL - 1e-9))
@@ -285,8 +292,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             cut_packing = pack(cur_drawn[0], hint, max(0.5, budget.left()))
             ran_out |= cut_packing.ran_out
             if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
-                best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cut_packing.order, cuts,
-                        cur_drawn, cut_packing)
+                best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cuts, cur_drawn, cut_packing)
 
     for n_pages in range(fewest, packing.n_pages):
         say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
@@ -308,13 +314,13 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
         if best[0] > n_pages:
             break
         n_pages = best[0] - 1
-    n_pages, n_pieces, parts, inputs, order, cuts, drawn, packing = best
-    rank = np.full(mesh.n_faces, len(order), dtype=np.int64)
-    for pos, i in enumerate(order):
+    _, n_pieces, parts, inputs, cuts, drawn, packing = best
+    rank = np.full(mesh.n_faces, len(packing.order), dtype=np.int64)
+    for pos, i in enumerate(packing.order):
         if i < len(inputs):  # glue strips come after the net pieces and have no faces
             rank[inputs[i].face_ids] = pos
-    return PageSplit(parts, cuts, n_pages, n_pieces, len(inputs), tuple(order), rank, ran_out, drawn, inputs,
-                     label_cuts, labels_ran_out, packing)
+    return PageSplit(parts, cuts, n_pieces, len(inputs), rank, ran_out, drawn, inputs, packing, label_cuts,
+                     labels_ran_out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -365,13 +371,13 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
     if glued_to is not None:
         pieces, unnoted = with_side_notes(list(pieces), glued_to, opts.min_label_mm)
     say("layout", f"packing {len(pieces)} pieces onto {opts.paper} pages")
-    page, margin = _packer_page(pack_box(width, height, opts))
-    hint = None if planned is None else planned.hint(folded, len(pieces))
-    if same and planned.packing is not None and not planned.packing.ran_out:
+    if same and not planned.packing.ran_out:
         # the very pieces packed before folding: filling them in the order that packing found, from
         # the same seed, gives the same placements again (checked on 11 models); 0.3 s at 1,500 faces
         packing = planned.packing
     else:
+        page, margin = _packer_page(pack_box(width, height, opts))
+        hint = None if planned is None else planned.hint(folded, len(pieces))
         packing = pack_outlines([p.footprint for p in pieces], page, margin=margin, gap=GAP_MM, seed=opts.seed,
                                 time_limit=pack_budget(deadline), hint=hint, tries=1 if same else ORDER_TRIES)
     placed = tuple(place(p, packing.placements[i]) for i, p in enumerate(pieces))
