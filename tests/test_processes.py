@@ -319,3 +319,13 @@ def test_standby_runs_here_what_it_cannot_send_or_answer() -> None:
         assert standby.result(died) == os.getpid()
     finally:
         standby.close()
+
+
+def test_large_results_come_back_whole_and_in_order() -> None:
+    """Results larger than a pipe holds (each worker writes them to a file of its own) and more
+    items than workers: every result whole, in the items' order, from several processes."""
+    got = fork_map(lambda i: (os.getpid(), np.full(300_000, i, dtype=np.int64)), list(range(9)), 2)
+    assert [int(a[0]) for _pid, a in got] == list(range(9))
+    assert all(len(a) == 300_000 and (a == i).all() for i, (_pid, a) in enumerate(got))
+    if os.uname().sysname == "Linux":
+        assert os.getpid() not in {pid for pid, _a in got}

@@ -19,7 +19,6 @@ from typing import Any, Callable, Sequence, TypeVar
 
 T = TypeVar("T")
 
-_TASK: Callable[[Any], Any] | None = None  # fork_map's function, inherited by the forked workers
 
 
 def usable_cores() -> int:
@@ -103,45 +102,105 @@ def can_fork() -> bool:
     return sys.platform.startswith("linux") and not mp.current_process().daemon
 
 
-def _call(item: Any) -> Any:
-    assert _TASK is not None
-    return _TASK(item)
+def _results_file():
+    """An anonymous file for a forked worker's results: in memory (memfd) where the OS has it."""
+    import tempfile
+
+    if hasattr(os, "memfd_create"):
+        try:
+            return os.fdopen(os.memfd_create("polyfold-results"), "w+b")
+        except OSError:
+            pass
+    return tempfile.TemporaryFile()
 
 
 def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list[Any]:
     """[fn(x) for x in items], in that order, run by up to `workers` processes forked from this
-    one, which take the items one at a time (put the longest first). fn and whatever it reads are
-    inherited by the fork, not pickled; each item and result is pickled. fn must not depend on
-    side effects of other calls (each child changes only its own copy of memory). An exception
-    raised by fn is raised here. Runs here, in order, when workers or items are fewer than two, on
-    other systems than Linux, in a daemonic process (which may not have children), or when no
-    pool can be made (no /dev/shm for its locks); when a worker dies (killed, out of memory) the
-    items are done here instead of waiting for it forever."""
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
-    from concurrent.futures.process import BrokenProcessPool
+    one, which take the items one at a time (put the longest first). fn, the items and whatever
+    they read are inherited by the fork, not pickled; each result is pickled. fn must not depend on
+    side effects of other calls (each child changes only its own copy of memory; this process's
+    stays as it was). An exception raised by fn is raised here (the first item's that raised).
+    Runs here, in order, when workers or items are fewer than two, on other systems than Linux,
+    or in a daemonic process (which may not have children); when a worker dies (killed, out of
+    memory) its items are done here instead of waiting for it forever.
 
-    global _TASK
+    Plain forks (3-4 ms each for a make's process), not a pool (concurrent.futures' took 11-17 ms,
+    its queues, threads and pickled items): the items' numbers are handed out through a pipe
+    written before the fork (a read of one number from it is atomic), and each worker writes
+    its results to a file of its own in memory, read here when it has ended."""
+    import pickle
+    import signal
+
     workers = min(workers, len(items))
     if workers < 2 or not can_fork():
         return [fn(x) for x in items]
-    try:
-        pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"))
-    except OSError:  # its queues' locks need /dev/shm (an error raised by fn is not caught here)
-        return [fn(x) for x in items]
-    _TASK = fn  # (set before the workers fork: they start when the items are handed out)
+    # the numbers: one per item, or per run of items where they are more than the pipe holds
+    per = -(-len(items) // 8192)
+    starts = list(range(0, len(items), per))
+    numbers, rest = os.pipe()
+    with os.fdopen(rest, "wb") as pipe:
+        pipe.write(b"".join(k.to_bytes(4, sys.byteorder, signed=True) for k in starts))  # (closed before the fork)
+    files, pids = [], []
     # what this process holds is no garbage the workers need look at: frozen, their collections
     # skip it (a full collection over make's objects costs each worker tens of ms, and touches
-    # pages it shares with this process); thawed here when they are done
+    # pages it shares with this process); thawed here when they are forked
     gc.freeze()
     try:
-        with pool:
-            return list(pool.map(_call, items))
-    except BrokenProcessPool:
-        return [fn(x) for x in items]
+        for _ in range(workers):
+            out = _results_file()
+            try:
+                pid = os.fork()
+            except OSError:  # no more processes to be had: those forked do the work
+                out.close()
+                break
+            if pid == 0:  # a worker: never returns into the caller's code
+                try:
+                    signal.signal(signal.SIGINT, signal.SIG_IGN)  # (this process reports Ctrl-C and ends it)
+                    while len(got := os.read(numbers, 4)) == 4:
+                        first = int.from_bytes(got, sys.byteorder, signed=True)
+                        for i in range(first, min(first + per, len(items))):
+                            try:
+                                pickle.dump((i, True, fn(items[i])), out, protocol=pickle.HIGHEST_PROTOCOL)
+                            except BaseException as exc:  # (raised here instead; the worker stops)
+                                pickle.dump((i, False, exc), out, protocol=pickle.HIGHEST_PROTOCOL)
+                                raise
+                finally:
+                    try:
+                        out.flush()
+                    finally:
+                        os._exit(0)
+            files.append(out)
+            pids.append(pid)
     finally:
-        _TASK = None
         gc.unfreeze()
+        os.close(numbers)
+    done: dict[int, tuple[bool, Any]] = {}
+    try:
+        for pid, out in zip(pids, files):
+            os.waitpid(pid, 0)
+            out.seek(0)
+            while True:
+                try:
+                    i, ok, value = pickle.load(out)
+                except Exception:  # the end (or a worker killed mid-write: its items are done here)
+                    break
+                done[i] = (ok, value)
+    finally:
+        for pid in pids:  # (left running only when this process was interrupted)
+            try:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+            except OSError:
+                pass
+        for out in files:
+            out.close()
+    results = []
+    for i, x in enumerate(items):
+        ok, value = done[i] if i in done else (True, fn(x))
+        if not ok:
+            raise value
+        results.append(value)
+    return results
 
 
 class Forked:

@@ -247,3 +247,25 @@ def test_pictures_drawn_side_by_side_are_the_pictures_drawn_one_by_one(models_di
         assert got[1][2][key] == got[2][2][key]
     # with two cores the pictures (the model's and 3 parts' sides, then the steps) were spread
     assert spread.value >= 1
+
+
+def test_a_picture_pickled_once_encoded_carries_its_files_not_its_pixels() -> None:
+    """A guide's pictures drawn in forked processes come back encoded (`Picture.encoded`): the
+    pickle holds the PNG and JPEG (what instructions.html and guide.pdf embed) and the shape, the
+    same bytes as the picture made them here, and no pixels; one not yet encoded keeps them."""
+    import pickle
+
+    from polyfold.guide.guide import Picture
+
+    rng = np.random.default_rng(3)
+    image = np.zeros((150, 200, 3), dtype=np.uint8)
+    image[40:110, 50:150] = rng.integers(0, 255, size=(70, 100, 3), dtype=np.uint8)
+    raw = Picture(image, "a piece")
+    assert pickle.loads(pickle.dumps(raw)).image is not None
+    encoded = Picture(image.copy(), "a piece").encoded()
+    data = pickle.dumps(encoded)
+    assert len(data) < image.nbytes
+    back = pickle.loads(data)
+    assert back.image is None and back.caption == "a piece" and back.shape == (150, 200)
+    assert back.png == raw.png and back.jpeg == raw.jpeg
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(back.png)).convert("RGB")), image)

@@ -14,7 +14,7 @@ def _image(pic, width_pt: float):
     """A reportlab Image flowable of a guide Picture, width_pt wide."""
     from reportlab.platypus import Image
 
-    h, w = pic.image.shape[:2]
+    h, w = pic.shape
     return Image(io.BytesIO(pic.jpeg), width=width_pt, height=width_pt * h / w)
 
 

@@ -35,10 +35,18 @@ LINEAR_FRACTIONS = (0.0, 1 / 3, 2 / 3, 1.0)
 
 @dataclass(frozen=True, eq=False)
 class Picture:
-    """An image (H, W, 3) uint8 and what it shows (alt text)."""
+    """An image (H, W, 3) uint8 and what it shows (alt text); `shape`: (H, W). Its PNG
+    (instructions.html) and JPEG (guide.pdf) are made when first asked for, or at once by
+    `encoded` (where the picture is drawn: a guide's pictures drawn in forked processes come back
+    encoded). Pickled once both are made, a Picture carries them instead of its pixels (the
+    bunny's guide: 11 MB of pixels, 1 MB of files): `image` is None where it arrives."""
 
-    image: np.ndarray
+    image: np.ndarray | None
     caption: str
+
+    @cached_property
+    def shape(self) -> tuple[int, int]:
+        return tuple(self.image.shape[:2])  # type: ignore[union-attr]
 
     @cached_property
     def png(self) -> bytes:
@@ -54,6 +62,17 @@ class Picture:
         buf = io.BytesIO()
         Image.fromarray(self.image).save(buf, "JPEG", quality=92)
         return buf.getvalue()
+
+    def encoded(self) -> Picture:
+        """This picture, its shape, PNG and JPEG made."""
+        self.shape, self.png, self.jpeg  # noqa: B018  (cached: made here)
+        return self
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        if "png" in state and "jpeg" in state:
+            state["image"] = None  # (every reader takes the files and the shape)
+        return state
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,9 +174,9 @@ def _glue_line(g_rows: list, pieces, pages: list[int]) -> str:
 
 
 # face x steps from which the guide's pictures are drawn in processes forked from this one
-# (`processes.fork_map`): the bunny's 128 x 14 draw in 0.2 s, a 1,280-face sphere's 1,280 x 76
-# in 1.1 s, half of it on each of two cores
-PARALLEL_PICTURES = 20_000
+# (`processes.fork_map`): the bunny's 128 x 14 draw and encode in 0.27 s on one core, 0.15 s on
+# two; a 1,280-face sphere's 1,280 x 76 in 1.1 s, half of it on each of two cores
+PARALLEL_PICTURES = 1_000
 
 
 def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float) -> Guide:
@@ -194,19 +213,21 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
 
     def draw(item: tuple[str, int]):
         """One job of pictures: ("sides", -1) the model's, ("sides", k) part k's, ("step", n) step n's
-        picture and its instructions (with the folding pictures of its piece)."""
+        picture and its instructions (with the folding pictures of its piece); every picture
+        encoded (`Picture.encoded`), on the core that drew it."""
         kind, k = item
         if kind == "sides" and k < 0:
-            return _sides(mesh, tris, np.arange(mesh.n_faces), face_piece, palette, pieces, pages, OVERVIEW_PX,
-                          "the model")
+            return tuple(p.encoded() for p in _sides(mesh, tris, np.arange(mesh.n_faces), face_piece, palette, pieces,
+                                                     pages, OVERVIEW_PX, "the model"))
         if kind == "sides":
             inside = [i for i in range(n_net) if pieces[i].part == k]
-            return _sides(mesh, tris, np.flatnonzero(np.isin(face_piece, inside)), face_piece, palette, pieces,
-                          pages, PART_PX, f"part {k + 1}")
+            return tuple(p.encoded() for p in _sides(mesh, tris, np.flatnonzero(np.isin(face_piece, inside)),
+                                                     face_piece, palette, pieces, pages, PART_PX, f"part {k + 1}"))
         st = plan.steps[k]
         picture = _step_picture(mesh, tris, placed_faces[k], face_piece, palette, st, seams, glue, rotations[views[k]],
                                 k + 1)
-        return picture, _instructions(st, seams, pieces, pages, folded, paths, palette)
+        lines, notes, folding = _instructions(st, seams, pieces, pages, folded, paths, palette)
+        return picture.encoded(), (lines, notes, tuple(p.encoded() for p in folding))
 
     jobs = ([("sides", -1)] + ([("sides", k) for k in part_ids] if len(part_ids) > 1 else [])
             + [("step", n) for n in range(len(plan.steps))])

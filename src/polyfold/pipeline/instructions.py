@@ -84,7 +84,7 @@ def _approximation_intro(n_parts: int, pieces, contacts: tuple[tuple[int, int], 
 def _img(pic, css: str = "") -> str:
     """An embedded picture (data URI: the page works offline, alone)."""
     b64 = base64.b64encode(pic.png).decode("ascii")
-    h, w = pic.image.shape[:2]
+    h, w = pic.shape
     return (f"<figure{css}><img src='data:image/png;base64,{b64}' width='{w}' height='{h}' alt='{escape(pic.caption)}'>"
             f"<figcaption>{escape(pic.caption)}</figcaption></figure>")
 
