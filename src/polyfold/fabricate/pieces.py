@@ -302,8 +302,9 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
 
 
 # glue labels to place from which `_labels` places pieces in parallel (forked processes, one piece
-# at a time each): a pool costs 15-20 ms (the bunny, 136 labels: 0.128 s in one process, 0.141 s
-# in two), and horse-302 (308) gains 0.69 -> 0.58 s, fish-472 (478) 1.78 -> 1.15 s here
+# at a time each): horse-302 (308) gains 0.69 -> 0.58 s, fish-472 (478) 1.78 -> 1.15 s here; the
+# bunny (136) loses, with a pool (15-20 ms: 0.128 s in one process, 0.141 s in two) and with
+# `fork_map`'s plain forks since (6-8 ms: its make's two drawings 25 ms slower)
 PARALLEL_LABELS = 250
 
 
