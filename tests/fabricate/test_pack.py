@@ -385,24 +385,52 @@ def test_points_hull_is_shapelys_hull_of_the_points():
                 assert len(hull_corners(xy)) <= len(shapely.get_coordinates(want)) - 1 + 2
 
 
-def test_runs_of_a_mask_widest_first_ties_in_row_order():
-    from polyfold.fabricate.pack import _runs
+def test_shape_runs_are_the_rasters_runs_widest_first_ties_in_row_order():
+    """`_shape_runs` finds a rotation's runs from its edges' crossings, without the raster: the
+    runs of set cells of `_raster` of the same edges (scanned row by row here), sorted widest
+    first with rows in order among equals, and their centroid summed in the same order, to the
+    last bit; on rotated buffered triangles, rings with holes, outlines cut by the grid's sides
+    (crossings clamped to its first column or past its last), edges along a row's centre line and
+    ones that meet at a cell centre, and random grids of cells."""
+    import shapely
+    from shapely import affinity
+
+    from polyfold.fabricate.pack import _raster, _runs_mask, _shape_runs
 
     rng = np.random.default_rng(2)
-    for _ in range(300):
-        h, w = (int(v) for v in rng.integers(1, 25, 2))
-        mask = rng.random((h, w)) < rng.random()
-        runs, row, col = _runs(mask)
-        expect = []
+    cases = []
+    for _ in range(120):
+        g = affinity.rotate(shapely.Polygon(rng.uniform(0, 30, (3, 2))).buffer(rng.uniform(0.3, 4), quad_segs=3),
+                            rng.uniform(0, 360))
+        if rng.random() < 0.3:
+            g = g.difference(shapely.Point(*rng.uniform(5, 25, 2)).buffer(rng.uniform(1, 6)))
+        rings = shapely.get_rings(shapely.get_parts(g))
+        xy, idx = shapely.get_coordinates(rings, return_index=True)
+        same = idx[1:] == idx[:-1]
+        lo = xy.min(axis=0) - rng.uniform(-3, 2, 2)  # (some outlines reach past the grid's sides)
+        h, w = (np.ceil(xy.max(axis=0) - lo) + rng.integers(-3, 3, 2)).astype(int)[::-1]
+        cases.append((xy[:-1][same] - lo, xy[1:][same] - lo, max(int(h), 1), max(int(w), 1)))
+    # on cell centre lines and corners: a square, a diamond, a zigzag of cells
+    cases.append((np.array([[1.5, 1.5], [6.5, 1.5], [6.5, 5.5], [1.5, 5.5]]),
+                  np.array([[6.5, 1.5], [6.5, 5.5], [1.5, 5.5], [1.5, 1.5]]), 8, 9))
+    cases.append((np.array([[4.5, 0.5], [8.5, 4.5], [4.5, 8.5], [0.5, 4.5]]),
+                  np.array([[8.5, 4.5], [4.5, 8.5], [0.5, 4.5], [4.5, 0.5]]), 10, 10))
+    for p0, p1, h, w in cases:
+        runs, row, col = _shape_runs(np.ascontiguousarray(p0), np.ascontiguousarray(p1), h, w)
+        mask = _raster(np.ascontiguousarray(p0), np.ascontiguousarray(p1), h, w)
+        expect, n, sr, sc = [], 0, 0.0, 0.0
         for r in range(h):
             edges = np.flatnonzero(np.diff(np.concatenate([[0], mask[r].astype(int), [0]])))
-            expect += [(r, a, b - 1) for a, b in zip(edges[::2], edges[1::2])]
+            for a, c in zip(edges[::2].tolist(), edges[1::2].tolist()):
+                expect.append((r, a, c - 1))
+                n, sr, sc = n + (c - a), sr + (c - a) * r, sc + (c - a) * (a + c - 1) / 2.0
         expect = np.array(expect, dtype=np.int64).reshape(-1, 3)
         expect = expect[np.argsort(expect[:, 1] - expect[:, 2], kind="stable")]
         assert np.array_equal(runs, expect)
-        if mask.any():
-            rr, cc = np.nonzero(mask)
-            assert np.isclose(row, rr.mean()) and np.isclose(col, cc.mean())
+        assert (row, col) == (sr / max(n, 1), sc / max(n, 1))
+        assert np.array_equal(_runs_mask(runs, h, w), mask)
+    assert sum(len(_shape_runs(np.ascontiguousarray(p0), np.ascontiguousarray(p1), h, w)[0])
+               for p0, p1, h, w in cases) > 1000
 
 
 def test_mark_rings_sets_the_cells_inside_each_geometry_in_its_window():
