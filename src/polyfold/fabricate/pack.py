@@ -138,11 +138,12 @@ def _angles(outline: Polygon | MultiPolygon, angles: int, phase: float) -> np.nd
             a = -math.degrees(math.atan2(d[1], d[0]))
             out += [a, a + 90.0]
     out = np.mod(np.asarray(out), 360.0)
-    keep = []
-    for a in out:  # a handful of values: drop near-duplicates, keep the order
-        if all(min(abs(a - b), 360.0 - abs(a - b)) > 1e-6 for b in keep):
-            keep.append(float(a))
-    return np.asarray(keep)
+    d = np.abs(out[:, None] - out[None, :])
+    near = np.minimum(d, 360.0 - d) <= 1e-6  # (a handful of values: drop near-duplicates of those kept before)
+    keep = np.ones(len(out), dtype=bool)
+    for i in range(1, len(out)):
+        keep[i] = not (near[i, :i] & keep[:i]).any()
+    return out[keep]
 
 
 def hull_corners(xy: np.ndarray) -> np.ndarray:
