@@ -359,12 +359,16 @@ def _shape_runs(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> tuple[np.ndar
             cols[j + 1] = v
         start = -1  # the column where the current run began (-1: outside)
         i = lo
-        while i < hi:
-            v = cols[i]
-            k = i
-            while k < hi and cols[k] == v:
-                k += 1
-            if (k - i) % 2 == 1 and v < w:  # toggled an odd number of times, at a cell of the row
+        while i <= hi:
+            if i < hi:
+                v = cols[i]
+                k = i
+                while k < hi and cols[k] == v:
+                    k += 1
+                odd = (k - i) % 2 == 1 and v < w  # toggled an odd number of times, at a cell of the row
+            else:  # the row's end closes a run still open
+                v, k, odd = w, hi + 1, start >= 0
+            if odd:
                 if start < 0:
                     start = v
                 else:
@@ -376,13 +380,6 @@ def _shape_runs(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> tuple[np.ndar
                     sc += m * (start + v - 1) / 2.0
                     start = -1
             i = k
-        if start >= 0:  # still inside at the row's end
-            runs[n, 0], runs[n, 1], runs[n, 2] = r, start, w - 1
-            n += 1
-            m = w - start
-            cnt += m
-            sr += m * r
-            sc += m * (start + w - 1) / 2.0
     per_width = np.zeros(w + 2, dtype=np.int64)
     for i in range(n):
         per_width[w - (runs[i, 2] - runs[i, 1])] += 1  # (widest: bucket 1)
