@@ -329,3 +329,40 @@ def test_large_results_come_back_whole_and_in_order() -> None:
     assert all(len(a) == 300_000 and (a == i).all() for i, (_pid, a) in enumerate(got))
     if os.uname().sysname == "Linux":
         assert os.getpid() not in {pid for pid, _a in got}
+
+
+def test_workers_stop_taking_items_when_this_process_is_killed() -> None:
+    """A make killed mid-work (SIGKILL, or SIGTERM from a served client's end) leaves no worker
+    working on: each takes no more items once its parent is gone."""
+    import signal
+    import subprocess
+    import sys
+    import textwrap
+    import time
+
+    code = textwrap.dedent("""
+        import os, sys, time
+        from polyfold.processes import fork_map
+        def slow(i):
+            os.write(1, f"{os.getpid()}\\n".encode())
+            time.sleep(0.3)
+            return i
+        fork_map(slow, list(range(40)), 2)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    workers: set[int] = set()
+    while len(workers) < 2:  # (each worker says its pid at each item it takes)
+        workers.add(int(proc.stdout.readline()))
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    def running(pid: int) -> bool:  # (an ended worker nobody has reaped yet is a zombie: gone)
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+        except OSError:
+            return False
+
+    deadline = time.monotonic() + 5.0  # (40 items of 0.3 s on two workers would take 6 s)
+    while time.monotonic() < deadline and any(running(pid) for pid in workers):
+        time.sleep(0.05)
+    assert not any(running(pid) for pid in workers)  # each stopped after its item

@@ -127,7 +127,9 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     Plain forks (3-4 ms each for a make's process), not a pool (concurrent.futures' took 11-17 ms,
     its queues, threads and pickled items): the items' numbers are handed out through a pipe
     written before the fork (a read of one number from it is atomic), and each worker writes
-    its results to a file of its own in memory, read here when it has ended."""
+    its results to a file of its own in memory, read here when it has ended. Workers ignore
+    Ctrl-C (this process reports it and kills them) and take no more items once this process has
+    gone (killed: nobody would read them)."""
     import pickle
     import signal
 
@@ -140,7 +142,7 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
     numbers, rest = os.pipe()
     with os.fdopen(rest, "wb") as pipe:
         pipe.write(b"".join(k.to_bytes(4, sys.byteorder, signed=True) for k in starts))  # (closed before the fork)
-    files, pids = [], []
+    files, pids, parent = [], [], os.getpid()
     # what this process holds is no garbage the workers need look at: frozen, their collections
     # skip it (a full collection over make's objects costs each worker tens of ms, and touches
     # pages it shares with this process); thawed here when they are forked
@@ -156,7 +158,8 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
             if pid == 0:  # a worker: never returns into the caller's code
                 try:
                     signal.signal(signal.SIGINT, signal.SIG_IGN)  # (this process reports Ctrl-C and ends it)
-                    while len(got := os.read(numbers, 4)) == 4:
+                    # (a worker whose parent has gone, killed, takes no more items: nobody reads them)
+                    while os.getppid() == parent and len(got := os.read(numbers, 4)) == 4:
                         first = int.from_bytes(got, sys.byteorder, signed=True)
                         for i in range(first, min(first + per, len(items))):
                             try:
