@@ -2,11 +2,12 @@
 use; `fork_map`, which runs independent pieces of work in processes forked from this one,
 `beside`, which runs one piece of work in a forked process while this one does another,
 `Forked`, a forked process to poll, wait for or kill, as `subprocess.Popen` would a spawned one,
-and the command line's process settings (`collect_less`, `in_roomy_stack`, `exit_status`, `leave`).
+`Standby`, a process forked early that loads libraries and then runs the calls it is sent, and
+the command line's process settings (`collect_less`, `in_roomy_stack`, `exit_status`, `leave`).
 
 Forked, not spawned: a child starts as a copy of this process (its modules, kernels and data), so
-nothing but the items and the results is pickled and a pool costs milliseconds to start, not the
-second of a fresh interpreter. Linux only (fork is unsafe on macOS); elsewhere the work runs here.
+little but the results is pickled and a fork costs milliseconds, not the second of a fresh
+interpreter. Linux only (fork is unsafe on macOS); elsewhere the work runs here.
 """
 
 from __future__ import annotations
@@ -18,7 +19,6 @@ import types
 from typing import Any, Callable, Sequence, TypeVar
 
 T = TypeVar("T")
-
 
 
 def usable_cores() -> int:

@@ -241,6 +241,21 @@ def ring_edges(geoms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 @njit(cache=True)
+def _rows_crossed(a: np.ndarray, b: np.ndarray, h: int) -> tuple[int, int]:
+    """(r0, r1): the rows r0 <= r < r1 of a raster h rows high whose centre line r + 0.5 the edge
+    a -> b (points (2,) in cell units) crosses, lo <= r + 0.5 < hi (none for a level edge)."""
+    return (min(max(math.ceil(min(a[1], b[1]) - 0.5), 0), h), min(max(math.ceil(max(a[1], b[1]) - 0.5), 0), h))
+
+
+@njit(cache=True)
+def _toggled_column(a: np.ndarray, b: np.ndarray, r: int, w: int) -> int:
+    """The first cell of row r (of w) whose centre lies right of where the edge a -> b crosses the
+    row's centre line (one of `_rows_crossed`); w when none does."""
+    u = a[0] + (r + 0.5 - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+    return min(max(math.ceil(u - 0.5), 0), w)
+
+
+@njit(cache=True)
 def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     """(h, w) bool: cells whose centre (c + 0.5, r + 0.5) is inside the rings p0 -> p1 (e, 2) given
     in cell units (even-odd rule, so holes work). Scanline: each edge toggles, in every row whose
@@ -249,12 +264,9 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     are rasterised as their runs, `_shape_runs`, which reads the same crossings.)"""
     toggles = np.zeros((h, w + 1), dtype=np.uint8)
     for e in range(p0.shape[0]):
-        a0, a1, b0, b1 = p0[e, 0], p0[e, 1], p1[e, 0], p1[e, 1]
-        r0 = min(max(math.ceil(min(a1, b1) - 0.5), 0), h)  # rows with lo <= r + 0.5 < hi
-        r1 = min(max(math.ceil(max(a1, b1) - 0.5), 0), h)
+        r0, r1 = _rows_crossed(p0[e], p1[e], h)
         for r in range(r0, r1):
-            u = a0 + (r + 0.5 - a1) * (b0 - a0) / (b1 - a1)
-            toggles[r, min(max(math.ceil(u - 0.5), 0), w)] ^= 1  # column w: right of every cell
+            toggles[r, _toggled_column(p0[e], p1[e], r, w)] ^= 1
     inside = np.empty((h, w), dtype=np.bool_)
     for r in range(h):
         parity = 0
@@ -317,8 +329,8 @@ def _runs_mask(runs: np.ndarray, h: int, w: int) -> np.ndarray:
 def _shape_runs(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> tuple[np.ndarray, float, float]:
     """The runs of set cells of `_raster`(p0, p1, h, w), (k, 3) int64 rows of (row, first column,
     last column), and their centroid (row, column), without the raster: per row, the columns
-    where `_raster`'s edges toggle (computed as there), sorted, a column toggled twice dropped;
-    a run from each odd toggle to the cell before the next (or to the row's end). Runs widest
+    where `_raster`'s edges toggle (`_rows_crossed`, `_toggled_column`), sorted, a column toggled
+    twice dropped; a run from each odd toggle to the cell before the next (or to the row's end). Runs widest
     first, rows in order among equals: a stable counting sort by width (numba's
     argsort(kind="mergesort") compiled for 1.5 s). The same runs and centroid, to the last bit, as
     scanning the raster's rows; work by edges and rows, not cells (a piece's rotation is 50,000
@@ -326,9 +338,7 @@ def _shape_runs(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> tuple[np.ndar
     # the toggled columns, by row (counted, then filled)
     count = np.zeros(h + 1, dtype=np.int64)
     for e in range(p0.shape[0]):
-        a1, b1 = p0[e, 1], p1[e, 1]
-        r0 = min(max(math.ceil(min(a1, b1) - 0.5), 0), h)  # rows with lo <= r + 0.5 < hi
-        r1 = min(max(math.ceil(max(a1, b1) - 0.5), 0), h)
+        r0, r1 = _rows_crossed(p0[e], p1[e], h)
         for r in range(r0, r1):
             count[r + 1] += 1
     for r in range(h):
@@ -336,12 +346,9 @@ def _shape_runs(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> tuple[np.ndar
     cols = np.empty(count[h], dtype=np.int64)
     fill = count[:h].copy()
     for e in range(p0.shape[0]):
-        a0, a1, b0, b1 = p0[e, 0], p0[e, 1], p1[e, 0], p1[e, 1]
-        r0 = min(max(math.ceil(min(a1, b1) - 0.5), 0), h)
-        r1 = min(max(math.ceil(max(a1, b1) - 0.5), 0), h)
+        r0, r1 = _rows_crossed(p0[e], p1[e], h)
         for r in range(r0, r1):
-            u = a0 + (r + 0.5 - a1) * (b0 - a0) / (b1 - a1)
-            cols[fill[r]] = min(max(math.ceil(u - 0.5), 0), w)  # column w: right of every cell
+            cols[fill[r]] = _toggled_column(p0[e], p1[e], r, w)
             fill[r] += 1
     runs = np.empty((count[h] // 2 + h, 3), dtype=np.int64)
     n = 0
