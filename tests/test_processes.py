@@ -1,6 +1,7 @@
 """processes.py: `fork_map` runs a function over items in forked processes, in order, and raises
 what it raises; `beside` runs one function in a forked process while another runs here;
-`Forked` waits for, polls and kills a forked process as Popen does a spawned one; `Standby`
+`Forked` waits for, polls and kills a forked process as Popen does a spawned one; `ForkedStream`
+reads a generator's values made in a forked process as they come; `Standby`
 prepares in a forked process and then runs the calls it is sent there; `usable_cores` counts
 this process's cores."""
 
@@ -366,3 +367,51 @@ def test_workers_stop_taking_items_when_this_process_is_killed() -> None:
     while time.monotonic() < deadline and any(running(pid) for pid in workers):
         time.sleep(0.05)
     assert not any(running(pid) for pid in workers)  # each stopped after its item
+
+
+def test_a_forked_stream_gives_the_generators_values_in_order_as_they_come() -> None:
+    """Values made in a forked process (larger in all than a pipe holds), read one at a time:
+    (True, value) in the generator's order, then (False, None) for good."""
+    from polyfold.processes import ForkedStream
+
+    here = os.getpid()
+
+    def values():
+        for i in range(12):
+            yield i, os.getpid(), np.full(200_000, i, dtype=np.int64)  # (19 MB in all)
+
+    with ForkedStream(values) as stream:
+        got = [stream.next() for _ in range(12)]
+        assert stream.next() == (False, None) and stream.next() == (False, None)
+    assert all(ok for ok, _v in got)
+    assert [v[0] for _ok, v in got] == list(range(12))
+    assert all(len(v[2]) == 200_000 and (v[2] == v[0]).all() for _ok, v in got)
+    if os.uname().sysname == "Linux":
+        assert {v[1] for _ok, v in got} != {here}
+
+
+def test_a_forked_stream_ends_where_its_generator_raises_and_close_ends_its_process() -> None:
+    import time
+
+    from polyfold.processes import ForkedStream
+
+    def two_then_raise():
+        yield 1
+        yield 2
+        raise ValueError("no more")
+
+    with ForkedStream(two_then_raise) as stream:
+        assert [stream.next() for _ in range(3)] == [(True, 1), (True, 2), (False, None)]
+
+    def forever():
+        while True:
+            time.sleep(0.01)
+            yield 0
+
+    stream = ForkedStream(forever)
+    pid = stream.pid
+    assert stream.next() == (True, 0)
+    stream.close()
+    with pytest.raises(ChildProcessError):  # (killed and reaped)
+        os.waitpid(pid, 0)
+    assert stream.next() == (False, None)

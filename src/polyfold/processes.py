@@ -2,6 +2,7 @@
 use; `fork_map`, which runs independent pieces of work in processes forked from this one,
 `beside`, which runs one piece of work in a forked process while this one does another,
 `Forked`, a forked process to poll, wait for or kill, as `subprocess.Popen` would a spawned one,
+`ForkedStream`, the values of a generator made in a forked process and read as they come,
 `Standby`, a process forked early that loads libraries and then runs the calls it is sent, and
 the command line's process settings (`collect_less`, `in_roomy_stack`, `exit_status`, `leave`).
 
@@ -255,6 +256,88 @@ class Forked:
             self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
             os.close(self._ended)
         return self.returncode
+
+
+class ForkedStream:
+    """The values a generator yields, made in a process forked from this one (check `can_fork`
+    first) and read here one at a time as they come: for work done ahead of its need, while this
+    process does other work. `next()` waits for the next value and returns (True, value), or
+    (False, None) once there are no more: the generator ended or raised, or its process died (a
+    caller that needs the rest makes it itself). Each value is pickled through a pipe (made 1 MB
+    where the OS allows, so the process rarely waits for this one to read). The process ignores
+    Ctrl-C (this one reports it), stops once this one has gone, and `close` (or leaving a `with`
+    block) kills it."""
+
+    PIPE_BYTES = 1 << 20
+
+    def __init__(self, gen: Callable[[], Any]) -> None:
+        import signal
+
+        readable, writable = os.pipe()
+        try:
+            import fcntl
+
+            fcntl.fcntl(writable, fcntl.F_SETPIPE_SZ, self.PIPE_BYTES)
+        except (ImportError, AttributeError, OSError):  # (the OS's own size: the process waits more)
+            pass
+        parent = os.getpid()
+        gc.freeze()  # (see fork_map)
+        try:
+            pid = os.fork()
+        except OSError:
+            pid = -1
+        finally:
+            gc.unfreeze()
+        if pid == 0:  # the child: never returns into the caller's code
+            try:
+                import pickle
+
+                signal.signal(signal.SIGINT, signal.SIG_IGN)  # (this process reports Ctrl-C and ends it)
+                os.close(readable)
+                with os.fdopen(writable, "wb") as out:
+                    for value in gen():
+                        if os.getppid() != parent:  # (killed: nobody reads them)
+                            break
+                        pickle.dump(value, out, protocol=pickle.HIGHEST_PROTOCOL)
+                        out.flush()
+            finally:
+                os._exit(0)
+        os.close(writable)
+        self.pid = pid
+        self._in: Any = os.fdopen(readable, "rb")
+        if pid < 0:  # no process to be had: no values
+            self.close()
+
+    def next(self) -> tuple[bool, Any]:
+        import pickle
+
+        if self._in is None:
+            return False, None
+        try:
+            return True, pickle.load(self._in)
+        except Exception:  # the end (or the process killed mid-write)
+            self.close()
+            return False, None
+
+    def close(self) -> None:
+        import signal
+
+        if self._in is not None:
+            self._in.close()
+            self._in = None
+        if self.pid > 0:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+                os.waitpid(self.pid, 0)
+            except OSError:
+                pass
+            self.pid = 0
+
+    def __enter__(self) -> ForkedStream:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
 
 
 def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]:

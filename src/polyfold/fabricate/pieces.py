@@ -22,7 +22,7 @@ from ..unfold.net import Net
 from .labels import LABEL_PAD_MM, LabelStats, PieceLabels, label_font, piece_name, text_box, text_width
 from .page import TextItem, upright
 from .paper import MIN_LABEL_MM
-from .tabs import CutSide, Room, Tab, choose_tab, full_depth
+from .tabs import CutSide, Room, Tab, choose_tab, full_depth, tab_key
 
 OUTLINE_TOL_MM = 1e-3  # outline corners closer than this are one corner
 RUN_MAX_EDGES = 8  # a seam run printed with one label spans at most this many edges
@@ -261,44 +261,106 @@ class _Glued:
     reduced: list = field(default_factory=list)  # (label, reason) of every tab smaller than full
     n_tabs: int = 0
     moved: int = 0
+    new_tabs: int = 0  # tabs not found in `_glue`'s memo
+    ahead_tabs: int = 0  # of those, tabs its forked process chose
 
     def __post_init__(self) -> None:
         self.tabs, self.tab_folds, self.tab_mountain, self.slits = ([[] for _ in range(self.n)] for _ in range(4))
 
 
 def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
-          rho: dict[tuple[int, int], float], deadline: Deadline, memo: dict | None = None
-          ) -> tuple[_Glued, list[Tab | None]]:
+          rho: dict[tuple[int, int], float], deadline: Deadline, memo: dict | None = None,
+          expected_new: int | None = None) -> tuple[_Glued, list[Tab | None]]:
     """Note slits (two sides of one piece that touch in the plane) and give each glued pair (label
-    = its 1-based rank) its tab (`choose_tab`, with its `memo`); every tab joins its piece's `Room`."""
-    from shapely.geometry import Polygon
+    = its 1-based rank) its tab (`choose_tab`, with its `memo`); every tab joins its piece's `Room`.
+
+    Where AHEAD_PAIRS tabs or more are to be chosen anew (`expected_new`, not found in the memo;
+    None: every pair's) and there is a second core, the tabs of the later pairs (from AHEAD_SHARE
+    of them on) are chosen ahead in a process forked from this one (`_tabs_ahead`), as if the
+    pairs before them were not there, while this one chooses the earlier ones; each comes back
+    with its memo key, and is taken where the pair's key here is the same: a tab depends on
+    nothing but the pair's sides and what lies near them (`choose_tab`), and most tabs of the
+    earlier pairs lie far from the later pairs. The same tabs whatever the process. The tabs
+    chosen anew this time are counted in `_Glued.new_tabs`."""
+    from ..processes import ForkedStream, can_fork, usable_cores
 
     out = _Glued(len(drawn))
     chosen: list[Tab | None] = []
-    for idx, (key, (o1, o2)) in enumerate(pairs):
-        deadline.check(f"placing the tabs of {len(pairs):,} glued edges")
-        label = str(idx + 1)
-        if o1.piece == o2.piece and np.allclose(o1.p0, o2.p1, atol=1e-6) and np.allclose(o1.p1, o2.p0, atol=1e-6):
-            out.slits[o1.piece].append(np.array([o1.p0, o1.p1]))  # the two sides touch in the plane
-        tab = choose_tab((o1, o2), rooms, memo) if tabs else None
-        chosen.append(tab)
-        if tab is None:
-            if tabs:
-                out.untabbed.append(label)
-            out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), None, 0.0, rho[key]))
-            continue
-        piece = (o1, o2)[tab.side].piece
-        for poly, fold in zip(tab.polygons, tab.folds):
-            out.tabs[piece].append(poly)
-            out.tab_folds[piece].append(fold)
-            out.tab_mountain[piece].append(rho[key] > 0)
-            rooms[piece].add([Polygon(poly)])
-        out.n_tabs += 1
-        out.moved += tab.side == 1
-        if tab.reason != "full":
-            out.reduced.append((label, tab.reason))
-        out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.depth, rho[key]))
+    start, ahead = len(pairs), None
+    if (tabs and (len(pairs) if expected_new is None else expected_new) >= AHEAD_PAIRS and usable_cores() > 1
+            and can_fork()):
+        memo = {} if memo is None else memo  # (the same tabs with or without one: `choose_tab`)
+        start = int(AHEAD_SHARE * len(pairs))
+        ahead = ForkedStream(lambda: _tabs_ahead(pairs, rooms, memo, start))
+    try:
+        for idx, (key, (o1, o2)) in enumerate(pairs):
+            deadline.check(f"placing the tabs of {len(pairs):,} glued edges")
+            label = str(idx + 1)
+            if o1.piece == o2.piece and np.allclose(o1.p0, o2.p1, atol=1e-6) and np.allclose(o1.p1, o2.p0, atol=1e-6):
+                out.slits[o1.piece].append(np.array([o1.p0, o1.p1]))  # the two sides touch in the plane
+            tab = None
+            if tabs and memo is None:
+                tab = choose_tab((o1, o2), rooms)
+            elif tabs:
+                sides = (o1, o2)
+                tab_id = tab_key(sides, rooms)
+                out.new_tabs += tab_id not in memo
+                if ahead is not None and idx >= start:  # (the values come in the pairs' order, one each)
+                    got, value = ahead.next()
+                    if got and value[0] not in memo:
+                        memo[value[0]] = value[1]
+                        out.ahead_tabs += value[0] == tab_id
+                tab = choose_tab(sides, rooms, memo, tab_id)
+            chosen.append(tab)
+            if tab is None:
+                if tabs:
+                    out.untabbed.append(label)
+                out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), None, 0.0, rho[key]))
+                continue
+            piece = _join_room(tab, (o1, o2), rooms)
+            for poly, fold in zip(tab.polygons, tab.folds):
+                out.tabs[piece].append(poly)
+                out.tab_folds[piece].append(fold)
+                out.tab_mountain[piece].append(rho[key] > 0)
+            out.n_tabs += 1
+            out.moved += tab.side == 1
+            if tab.reason != "full":
+                out.reduced.append((label, tab.reason))
+            out.glue.append(GlueEdge(label, key, (o1.piece, o2.piece), piece, tab.depth, rho[key]))
+    finally:
+        if ahead is not None:
+            ahead.close()
     return out, chosen
+
+
+# `_glue` has the later pairs' tabs chosen ahead in a second process from this many pairs (a
+# 1,500-face model has about 750, the bunny 190): the first drawing of torus-50 decimated to 1,500
+# faces, 756 pairs, took 0.91 s in one process; from half of them on, ahead, 0.43 s there, and 58
+# of those 378 tabs had to be chosen here again (the pairs before them had put a tab near them)
+AHEAD_PAIRS = 300
+AHEAD_SHARE = 0.5
+
+
+def _join_room(tab: Tab, sides: tuple[CutSide, CutSide], rooms: list[Room]) -> int:
+    """Add the tab's polygons to the room of the piece it goes on (one at a time: a room's key
+    depends on how they are added); returns that piece."""
+    from shapely.geometry import Polygon
+
+    piece = sides[tab.side].piece
+    for poly in tab.polygons:
+        rooms[piece].add([Polygon(poly)])
+    return piece
+
+
+def _tabs_ahead(pairs, rooms: list[Room], memo: dict, start: int):
+    """(`choose_tab`'s memo key, tab) of each of pairs[start:] in turn, chosen as `_glue` chooses
+    them but in these rooms as they are (each tab joins them): for `_glue`'s forked process."""
+    for _key, sides in pairs[start:]:
+        key = tab_key(sides, rooms)
+        tab = choose_tab(sides, rooms, memo, key)
+        if tab is not None:
+            _join_room(tab, sides, rooms)
+        yield key, tab
 
 
 # glue labels to place from which `_labels` places pieces in parallel (forked processes, one piece
@@ -560,7 +622,10 @@ def build_sheet_pieces(inputs: list[PieceInput], scale: float, tabs: bool = True
     pairs = [(key, sides) for key, sides in pairs if not (key in flat and sides[0].piece == sides[1].piece)]
     tab_memo = None if memo is None else memo.setdefault("tabs", {})
     label_memo = None if memo is None else memo.setdefault("labels", {})
-    g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline, tab_memo)
+    g, chosen = _glue(pairs, drawn, rooms, tabs, rho, deadline, tab_memo,
+                      None if memo is None else memo.get("new_tabs"))
+    if memo is not None:
+        memo["new_tabs"] = g.new_tabs  # (as many are likely new in the next drawing: `_glue` goes by it)
     shapes = None if memo is None else memo.setdefault("outlines", {})
 
     def shape(i: int, outside: list) -> tuple:

@@ -427,7 +427,8 @@ def _clipped(s: int, side: CutSide, room: Room) -> Tab | None:
     return Tab(s, tuple(parts), np.array(folds), depth, "tapered" if len(parts) == 1 else "split")
 
 
-def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | None = None) -> Tab | None:
+def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | None = None,
+               key: tuple | None = None) -> Tab | None:
     """The tab of a glued pair: the first of TAB_VARIANTS that fits on either side (the first side
     first), else the larger clipped tab of the two sides; None when nothing fits (see the module
     docstring). A tab may touch the faces beside its fold line at the corners, nothing else.
@@ -438,13 +439,19 @@ def choose_tab(sides: tuple[CutSide, CutSide], rooms: list[Room], memo: dict | N
     dict kept across drawings of one model's pieces: make draws them again after cutting some)
     keeps it by the sides' coordinates and what lies within NEAR_MM more than that of each side
     (`Room.near_key`): a pair drawn again beside the same faces and tabs gets the tab found
-    before, untested, though its piece was cut elsewhere and its faces renumbered."""
+    before, untested, though its piece was cut elsewhere and its faces renumbered. `key`: the
+    pair's `tab_key`, when the caller has made it already."""
     if memo is None:
         return _choose_tab(sides, rooms)
-    key = tuple(_side_key(side, rooms[side.piece]) for side in sides)
+    key = tab_key(sides, rooms) if key is None else key
     if key not in memo:
         memo[key] = _choose_tab(sides, rooms)
     return memo[key]
+
+
+def tab_key(sides: tuple[CutSide, CutSide], rooms: list[Room]) -> tuple:
+    """`choose_tab`'s memo key of a glued pair: its sides and what lies near each on its piece."""
+    return tuple(_side_key(side, rooms[side.piece]) for side in sides)
 
 
 NEAR_MM = 0.01  # margin of `choose_tab`'s memo key around the region its tests can reach
