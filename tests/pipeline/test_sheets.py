@@ -105,6 +105,45 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     assert lay_out(mesh, unsplit, scale, opts, w, h, deadline, lambda *a: None).packing.n_pages > split.pages
 
 
+def test_a_drawing_after_folding_split_a_piece_takes_what_it_can_from_the_planned_drawings(models_dir):
+    """When folding splits a piece, lay_out draws the pieces again with split_for_pages' memo: the
+    pieces not split keep their tabs and labels found before, and the drawing is the one made
+    afresh."""
+    from polyfold.fabricate.split import PagePlan
+    from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
+
+    mesh = load_mesh(models_dir / "bunny-348.obj").mesh
+    opts = MakeOptions(fold=False, guide=False)
+    deadline = Deadline.after(60)
+    parts, _, _ = make_parts(mesh, opts, deadline, lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    w, h = paper_size(opts.paper)
+    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "bunny-348")
+    split = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), deadline, lambda *a: None)
+    # as folding splits a piece it cannot fold: one crease of the last one cut
+    inputs = part_piece_inputs(mesh, split.parts)
+    net = inputs[-1].net
+    creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
+    cuts = tuple(np.array([creases[len(creases) // 2]] if i == len(inputs) - 1 else [], dtype=np.int64)
+                 for i in range(len(inputs)))
+    cut_parts = _cut_plan(split.parts, inputs, PagePlan(cuts, (), 0))[0]
+    folded, _ = fold_pieces(cut_parts, opts, deadline, lambda *a: None, scale)
+    assert not split.same_pieces(folded)
+    tabs_before = len(split.memo["tabs"])
+    sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
+    fresh, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, min_label_mm=opts.min_label_mm,
+                                            by_run=split.drawn[2].labels_by_run)
+    assert len(split.memo["tabs"]) - tabs_before < stats.glue_edges  # (tabs found before were taken)
+    assert list(sheets.glue) == glue and sheets.stats == stats
+    from polyfold.fabricate.page import place
+
+    for i, (p, q) in enumerate(zip(sheets.pieces, fresh, strict=True)):
+        q = place(q, sheets.packing.placements[i])  # (laid out: moved onto its page as p was)
+        assert p.texts == q.texts and len(p.tabs) == len(q.tabs)
+        assert all(np.array_equal(a, b) for a, b in zip(p.tabs, q.tabs))
+        assert p.footprint.equals_exact(q.footprint, 0.0)
+
+
 def test_same_seed_same_pages(models_dir, tmp_path):
     a = make(models_dir / "bunny-128.obj", tmp_path / "a", MakeOptions(fold=False, guide=False))
     b = make(models_dir / "bunny-128.obj", tmp_path / "b", MakeOptions(fold=False, guide=False))

@@ -333,12 +333,14 @@ def _glue(pairs, drawn: list[_Drawn], rooms: list[Room], tabs: bool,
     return out, chosen
 
 
-# `_glue` has the later pairs' tabs chosen ahead in a second process from this many pairs (a
-# 1,500-face model has about 750, the bunny 190): the first drawing of torus-50 decimated to 1,500
-# faces, 756 pairs, took 0.91 s in one process; from half of them on, ahead, 0.43 s there, and 58
-# of those 378 tabs had to be chosen here again (the pairs before them had put a tab near them)
+# `_glue` has the later pairs' tabs chosen ahead in a second process where this many are new (a
+# 1,500-face model has about 750 pairs, the bunny 190): the first drawing of torus-50 decimated to
+# 1,500 faces, 756 pairs, took 0.91 s in one process; with the tabs from half of the pairs on
+# chosen ahead (0.43 s there; 58 of those 378 had to be chosen here again: a pair before them had
+# put a tab near them), 0.58 s. From 0.4 of them on: 0.48 s (horse-302 decimated 0.61 -> 0.56 s,
+# periscope2-44 0.60 -> 0.53 s; from 0.3, 0.35, 0.45, 0.55 or 0.6 on, slower on one of the three)
 AHEAD_PAIRS = 300
-AHEAD_SHARE = 0.5
+AHEAD_SHARE = 0.4
 
 
 def _join_room(tab: Tab, sides: tuple[CutSide, CutSide], rooms: list[Room]) -> int:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -127,6 +127,9 @@ class PageSplit:
     packing: Packing  # of `drawn`'s pieces
     label_cuts: int = 0  # creases cut before that where labels found no readable place (in `parts`)
     labels_ran_out: bool = False  # the time limit stopped those cuts with labels still crowded
+    # its drawings' memo (`build_sheet_pieces`): a drawing of pieces that folding split takes from
+    # it what it can (the tabs and labels of the pieces not split, the same as drawn afresh)
+    memo: dict = field(default_factory=dict)
 
     @property
     def pages(self) -> int:
@@ -320,7 +323,7 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
         if i < len(inputs):  # glue strips come after the net pieces and have no faces
             rank[inputs[i].face_ids] = pos
     return PageSplit(parts, cuts, n_pieces, len(inputs), rank, ran_out, drawn, inputs, packing, label_cuts,
-                     labels_ran_out)
+                     labels_ran_out, memo)
 
 
 @dataclass(frozen=True, eq=False)
@@ -366,7 +369,8 @@ def lay_out(mesh: Mesh, folded: list[FoldedPiece], scale: float, opts: MakeOptio
         say("layout", f"tabs and labels for {len(folded)} pieces")
         pieces, glue, stats = build_sheet_pieces(piece_inputs(mesh, folded), scale, tabs=opts.tabs,
                                                  min_label_mm=opts.min_label_mm, deadline=deadline,
-                                                 by_run=planned is not None and planned.drawn[2].labels_by_run)
+                                                 by_run=planned is not None and planned.drawn[2].labels_by_run,
+                                                 memo=None if planned is None else planned.memo)
     unnoted = 0
     if glued_to is not None:
         pieces, unnoted = with_side_notes(list(pieces), glued_to, opts.min_label_mm)
