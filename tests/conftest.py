@@ -154,6 +154,24 @@ def single_component(models_dir, name):
     return mesh
 
 
+def fitted_parts(models_dir, name: str) -> tuple:
+    """(mesh, options, scale, page width, page height, parts): a shared model unfolded as make does
+    (fold and guide off) and its parts cut to fit A4 at 150 mm (`sheets.fit_parts`)."""
+    from polyfold.deadline import Deadline
+    from polyfold.fabricate.fit import model_scale
+    from polyfold.pipeline.options import paper_size
+    from polyfold.pipeline.parts import make_parts
+    from polyfold.pipeline.sheets import fit_parts, pack_box
+
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    opts = MakeOptions(fold=False, guide=False)
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    w, h = paper_size(opts.paper)
+    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), name)
+    return mesh, opts, scale, w, h, fitted
+
+
 def sorted_side_lengths(tri):
     """Side lengths of each triangle (..., 3, d), sorted."""
     return np.sort(np.linalg.norm(tri - np.roll(tri, -1, axis=-2), axis=-1), axis=-1)

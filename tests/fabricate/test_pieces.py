@@ -7,13 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 import polyfold.fabricate.pieces as pieces_module
-from polyfold.deadline import Deadline
-from polyfold.fabricate.fit import model_scale
+from conftest import fitted_parts
 from polyfold.fabricate.pieces import build_sheet_pieces
-from polyfold.formats.meshes import load_mesh
-from polyfold.pipeline.options import MakeOptions, paper_size
-from polyfold.pipeline.parts import make_parts
-from polyfold.pipeline.sheets import fit_parts, pack_box, part_piece_inputs
+from polyfold.pipeline.sheets import part_piece_inputs
 from polyfold.processes import can_fork, usable_cores
 
 
@@ -34,12 +30,7 @@ def _drawn(inputs, scale, monkeypatch, ahead_pairs: int, memo: dict | None):
 
 
 def test_tabs_chosen_ahead_in_a_forked_process_are_the_tabs_chosen_here(models_dir, monkeypatch):
-    mesh = load_mesh(models_dir / "fish-472.obj").mesh
-    opts = MakeOptions(fold=False, guide=False)
-    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
-    scale = model_scale([mesh], opts.size)
-    w, h = paper_size(opts.paper)
-    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "fish-472")
+    mesh, _opts, scale, _w, _h, fitted = fitted_parts(models_dir, "fish-472")
     inputs = part_piece_inputs(mesh, fitted)
     (here, glue_here, stats_here), alone = _drawn(inputs, scale, monkeypatch, 10**9, None)
     memo: dict = {}

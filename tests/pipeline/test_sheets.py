@@ -11,19 +11,16 @@ import numpy as np
 
 import pytest
 
-from conftest import check_sheet, read_sheet
+from conftest import check_sheet, fitted_parts, read_sheet
 from sheet_reader import read_svg
 from polyfold.deadline import Deadline
-from polyfold.fabricate.fit import model_scale
 from polyfold.fabricate.pack import pack_outlines
 from polyfold.fabricate.paper import FOOTER_MM, GAP_MM
 from polyfold.fabricate.pieces import build_sheet_pieces
-from polyfold.formats.meshes import load_mesh
 from polyfold.pipeline.folding import fold_pieces
 from polyfold.pipeline.make import make
 from polyfold.pipeline.options import MakeOptions, paper_size
-from polyfold.pipeline.parts import make_parts
-from polyfold.pipeline.sheets import _packer_page, fit_parts, lay_out, pack_box, piece_inputs, split_for_pages
+from polyfold.pipeline.sheets import _packer_page, lay_out, pack_box, piece_inputs, split_for_pages
 
 # A4 pages of Blender's paper-model export at 150 mm (issue 18)
 BLENDER_PAGES = {"bunny-128": 3, "horse-302": 3, "fish-472": 2, "bunny-348": 5, "bumpy-528": 5}
@@ -77,13 +74,8 @@ def test_pieces_that_fit_one_page_are_not_cut(models_dir, tmp_path):
 
 
 def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
-    mesh = load_mesh(models_dir / "bunny-348.obj").mesh
-    opts = MakeOptions(fold=False, guide=False)
+    mesh, opts, scale, w, h, fitted = fitted_parts(models_dir, "bunny-348")
     deadline = Deadline.after(60)
-    parts, _, _ = make_parts(mesh, opts, deadline, lambda *a: None)
-    scale = model_scale([mesh], opts.size)
-    w, h = paper_size(opts.paper)
-    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "bunny-348")
     split = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), deadline, lambda *a: None)
     n_fitted = sum(p.net.n_pieces for p in fitted)
     assert split.cuts > 0 and split.net_pieces == n_fitted + split.cuts
@@ -109,25 +101,11 @@ def test_a_drawing_after_folding_split_a_piece_takes_what_it_can_from_the_planne
     """When folding splits a piece, lay_out draws the pieces again with split_for_pages' memo: the
     pieces not split keep their tabs and labels found before, and the drawing is the one made
     afresh."""
-    from polyfold.fabricate.split import PagePlan
-    from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
-
-    mesh = load_mesh(models_dir / "bunny-348.obj").mesh
-    opts = MakeOptions(fold=False, guide=False)
+    mesh, opts, scale, w, h, fitted = fitted_parts(models_dir, "bunny-348")
     deadline = Deadline.after(60)
-    parts, _, _ = make_parts(mesh, opts, deadline, lambda *a: None)
-    scale = model_scale([mesh], opts.size)
-    w, h = paper_size(opts.paper)
-    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "bunny-348")
     split = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), deadline, lambda *a: None)
     # as folding splits a piece it cannot fold: one crease of the last one cut
-    inputs = part_piece_inputs(mesh, split.parts)
-    net = inputs[-1].net
-    creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
-    cuts = tuple(np.array([creases[len(creases) // 2]] if i == len(inputs) - 1 else [], dtype=np.int64)
-                 for i in range(len(inputs)))
-    cut_parts = _cut_plan(split.parts, inputs, PagePlan(cuts, (), 0))[0]
-    folded, _ = fold_pieces(cut_parts, opts, deadline, lambda *a: None, scale)
+    folded, _ = fold_pieces(_last_piece_cut(mesh, split.parts), opts, deadline, lambda *a: None, scale)
     assert not split.same_pieces(folded)
     tabs_before = len(split.memo["tabs"])
     sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
@@ -153,29 +131,32 @@ def test_same_seed_same_pages(models_dir, tmp_path):
     assert a.report.stages.layout.pages == b.report.stages.layout.pages
 
 
+def _last_piece_cut(mesh, parts):
+    """The parts with their last piece cut along one crease near the middle of its tree."""
+    from polyfold.fabricate.split import PagePlan
+    from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
+
+    inputs = part_piece_inputs(mesh, parts)
+    net = inputs[-1].net
+    creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
+    cuts = tuple(np.array([creases[len(creases) // 2]] if i == len(inputs) - 1 else [], dtype=np.int64)
+                 for i in range(len(inputs)))
+    return _cut_plan(parts, inputs, PagePlan(cuts, (), 0))[0]
+
+
 def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_afresh(models_dir):
     """split_for_pages draws a model's pieces again after cutting some, with one memo: what it
     takes from the memo (a pair's tab, a piece's labels, outline and footprint) is what drawing
     afresh gives."""
-    from polyfold.fabricate.split import PagePlan
-    from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
+    from polyfold.pipeline.sheets import part_piece_inputs
 
-    mesh = load_mesh(models_dir / "bunny-348.obj").mesh
-    opts = MakeOptions(fold=False, guide=False)
-    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
-    scale = model_scale([mesh], opts.size)
-    w, h = paper_size(opts.paper)
-    fitted, _ = fit_parts(parts, scale, opts, pack_box(w, h, opts), "bunny-348")
+    mesh, opts, scale, w, h, fitted = fitted_parts(models_dir, "bunny-348")
     before = part_piece_inputs(mesh, fitted)
     memo: dict = {}
     first, _, _ = build_sheet_pieces(before, scale, memo=memo)
-    # cut the last piece along one crease near the middle of its tree (the pieces before it keep
-    # their names and glue numbers: their labels can be taken again)
-    big = len(before) - 1
-    net = before[big].net
-    creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
-    cuts = tuple(np.array([creases[len(creases) // 2]] if i == big else [], dtype=np.int64) for i in range(len(before)))
-    after = part_piece_inputs(mesh, _cut_plan(fitted, before, PagePlan(cuts, (), 0))[0])
+    # cut the last piece (the pieces before it keep their names and glue numbers: their labels can
+    # be taken again)
+    after = part_piece_inputs(mesh, _last_piece_cut(mesh, fitted))
     assert len(after) == len(before) + 1
     tabs_before, labels_before, outlines_before = len(memo["tabs"]), len(memo["labels"]), len(memo["outlines"])
     taken, glue_taken, stats_taken = build_sheet_pieces(after, scale, memo=memo)
