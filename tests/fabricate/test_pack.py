@@ -385,6 +385,32 @@ def test_points_hull_is_shapelys_hull_of_the_points():
                 assert len(hull_corners(xy)) <= len(shapely.get_coordinates(want)) - 1 + 2
 
 
+def test_hull_corners_of_part_of_a_cloud_from_the_whole_clouds_order():
+    """A part's corners from the whole cloud's `sorted_points` with the other points left out
+    (`order_among`, the fitting's parts): the corners, point for point, that sorting the part's
+    points gives, in any order the part's points come in (equal points stand in for each other);
+    on clouds with many equal points (the corners faces share) and collinear ones."""
+    from polyfold.fabricate.pack import hull_corners, order_among, sorted_points
+
+    rng = np.random.default_rng(3)
+    for n in (3, 12, 300, 3000):
+        for t in range(20):
+            xy = rng.random((n, 2)) * 100
+            if t % 2 == 0:
+                xy = np.round(xy / 10) * 10  # (many equal points)
+            if t % 5 == 0:
+                xy[: n // 2, 1] = 0.5 * xy[: n // 2, 0]
+            order = sorted_points(xy)
+            ids = np.flatnonzero(rng.random(n) < 0.6)
+            if len(ids) < 3:
+                continue
+            part = xy[ids]
+            want = part[hull_corners(part)]
+            assert np.array_equal(part[hull_corners(part, order_among(order, ids))], want), (n, t)
+            shuffled = xy[rng.permutation(ids)]  # (the same points in another order)
+            assert np.array_equal(shuffled[hull_corners(shuffled)], want), (n, t)
+
+
 def test_shape_runs_are_the_rasters_runs_widest_first_ties_in_row_order():
     """`_shape_runs` finds a rotation's runs from its edges' crossings, without the raster: the
     runs of set cells of `_raster` of the same edges (scanned row by row here), sorted widest

@@ -146,15 +146,30 @@ def _angles(outline: Polygon | MultiPolygon, angles: int, phase: float) -> np.nd
     return out[keep]
 
 
-def hull_corners(xy: np.ndarray) -> np.ndarray:
+def hull_corners(xy: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
     """Indices of the corners of the convex hull of the points xy (n, 2), counter-clockwise from
     the lowest-x (then lowest-y) point; points on a hull side are left out (Andrew's monotone
     chain). Collinear points: the two ends; fewer than three points: all of them. The points are
-    ordered by numpy (a stable sort compiled by numba took 2.5 s of a first run)."""
+    ordered by numpy (a stable sort compiled by numba took 2.5 s of a first run), or by `order`
+    when the caller has it (`sorted_points`)."""
     xy = np.ascontiguousarray(xy, dtype=np.float64)
     if len(xy) < 3:
         return np.arange(len(xy))
-    return _monotone_chain(xy, np.lexsort((xy[:, 1], xy[:, 0])))  # by x, then y, then index
+    return _monotone_chain(xy, sorted_points(xy) if order is None else order)
+
+
+def sorted_points(xy: np.ndarray) -> np.ndarray:
+    """The points xy (n, 2) in `hull_corners`' order: by x, then y, then index. The order of some
+    of them (ids, increasing) is this order with the others left out (`order_among`)."""
+    return np.lexsort((xy[:, 1], xy[:, 0]))
+
+
+def order_among(order: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """`sorted_points` of xy[ids] from that of xy (`order`), for increasing `ids`: positions in ids."""
+    rank = np.full(len(order), -1, dtype=np.int64)
+    rank[ids] = np.arange(len(ids))
+    ranked = rank[order]
+    return ranked[ranked >= 0]
 
 
 @njit(cache=True)
