@@ -115,6 +115,17 @@ def _results_file():
     return tempfile.TemporaryFile()
 
 
+def _kill_and_reap(pid: int) -> None:
+    """End a forked child now (SIGKILL) and reap it; nothing when it is gone already."""
+    import signal
+
+    try:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+    except OSError:
+        pass
+
+
 def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list[Any]:
     """[fn(x) for x in items], in that order, run by up to `workers` processes forked from this
     one, which take the items one at a time (put the longest first). fn, the items and whatever
@@ -191,11 +202,7 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
                 done[i] = (ok, value)
     finally:
         for pid in pids:  # (left running only when this process was interrupted)
-            try:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-            except OSError:
-                pass
+            _kill_and_reap(pid)
         for out in files:
             out.close()
     results = []
@@ -320,17 +327,11 @@ class ForkedStream:
             return False, None
 
     def close(self) -> None:
-        import signal
-
         if self._in is not None:
             self._in.close()
             self._in = None
         if self.pid > 0:
-            try:
-                os.kill(self.pid, signal.SIGKILL)
-                os.waitpid(self.pid, 0)
-            except OSError:
-                pass
+            _kill_and_reap(self.pid)
             self.pid = 0
 
     def __enter__(self) -> ForkedStream:
