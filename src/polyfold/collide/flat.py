@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import copy_flat
 from ..jit import njit
 
 
@@ -100,9 +101,7 @@ def overlapping_pairs(tris: np.ndarray, parent: np.ndarray, tol: float, max_pair
             if triangles_overlap(tris[i], tris[j], tol):
                 if every and count == pairs.shape[0]:
                     grown = np.empty((2 * count, 2), dtype=np.int64)
-                    for k in range(count):  # (by element: a slice assignment compiles numba's
-                        grown[k, 0] = pairs[k, 0]  # shape-mismatch message, 2 s of a first run)
-                        grown[k, 1] = pairs[k, 1]
+                    copy_flat(grown, pairs, 2 * count)
                     pairs = grown
                 if every or count < max_pairs:
                     pairs[count, 0] = min(i, j)

@@ -368,7 +368,9 @@ def _refresh_free(free, taken, windows, hw, hh):
         t0, t1, u0, u1 = max(0, r0 - hh), min(ny - 1, r1 + hh), max(0, c0 - hw), min(nx - 1, c1 + hw)
         s0, s1, v0, v1 = max(0, t0 - hh), min(ny - 1, t1 + hh), max(0, u0 - hw), min(nx - 1, u1 + hw)
         part = _box_free(np.ascontiguousarray(taken[s0:s1 + 1, v0:v1 + 1]), hw, hh)
-        free[t0:t1 + 1, u0:u1 + 1] = part[t0 - s0:t1 - s0 + 1, u0 - v0:u1 - v0 + 1]
+        for r in range(t0, t1 + 1):  # (a loop, not a slice assignment: see polyfold.arrays)
+            for c in range(u0, u1 + 1):
+                free[r, c] = part[r - s0, c - v0]
 
 
 @njit(cache=True)

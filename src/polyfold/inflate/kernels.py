@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from ..arrays import copy_flat
 from ..jit import njit
 
 from ..mesh.geometry import HYPERBOLIC_EPS
@@ -212,12 +213,12 @@ def run_steps(X, P, F, L0, fedge, edges, efaces, counted, pv, boost, pcap, p, E,
                 break
         if status != RUNNING:
             break
-        X[:] = Xn
-        normals[:] = normals_n
-        area2[:] = area2_n
-        phi[:] = phi_n
-        S[:] = S_n
-        rho[:] = rho_n
+        copy_flat(X, Xn, Xn.size)
+        copy_flat(normals, normals_n, normals_n.size)
+        copy_flat(area2, area2_n, area2_n.size)
+        copy_flat(phi, phi_n, phi_n.size)
+        copy_flat(S, S_n, S_n.size)
+        copy_flat(rho, rho_n, rho_n.size)
         hv = hv_n
         done += 1
         if boost > 0.0:

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import copy_flat
 from ..jit import njit
+from ..sorting import sorted_unique
 from .hull_kernels import HULL_FLAT_EPS, NOISE, convex_hull, copy_row, denoise, depth_chain, max_depth
 
 
@@ -69,7 +71,7 @@ def new_memo(n_faces):
 def _rows(a, n, keep):
     """A new array of n rows (n >= keep) holding a copy of a's first `keep` rows."""
     out = np.empty((n,) + a.shape[1:], a.dtype)
-    out[:keep] = a[:keep]
+    copy_flat(out, a, keep * (a.size // a.shape[0]) if a.shape[0] > 0 else 0)
     return out
 
 
@@ -111,7 +113,7 @@ def _pool_add(pool, used, src, rows):
 def make_cluster(faces, mesh_faces, vertices, samples, diag):
     """(points, hull points, absolute concavity) of the faces (sorted ids): the points are the
     faces' vertices (sorted ids) then their surface samples; the hull is of the vertices."""
-    verts = np.unique(mesh_faces[faces].ravel())
+    verts = sorted_unique(mesh_faces[faces].ravel())
     n_v = verts.shape[0]
     pts = np.empty((n_v + 3 * faces.shape[0], 3))
     for k in range(n_v):

@@ -26,6 +26,7 @@ import math
 import numpy as np
 
 from ..jit import njit
+from ..sorting import stable_argsort
 from .memo_kernels import bucket, memo_grown, memo_lookup, pow2, union_eval
 
 
@@ -382,7 +383,7 @@ def _merge_pass(limit, scale, target, w_compact, w_seam, min_faces, diag, units,
     while changed and n_alive > stop and ok:
         changed = False
         ids = np.flatnonzero(alive[:nid])
-        order = np.argsort(n_faces[ids], kind="mergesort")  # stable: ties in id order
+        order = stable_argsort(n_faces[ids])  # ties in id order
         t = np.int64(0)
         while t < order.shape[0] and not changed and ok:
             i = ids[order[t]]

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..graphs import union_labels
 from ..jit import njit
+from ..sorting import sort_in_place, stable_argsort
 from .hull_kernels import HULL_FLAT_EPS, convex_hull, copy_row, denoise, max_depth
 
 
@@ -113,7 +114,7 @@ def unit_groups(seeds, polygon):
     polygons inside it (in label order), faces ascending within each. (seed_unit, sub_lo, sub_hi
     (per seed: its unit and the range of its polygons' units), faces (2F,), start (U + 1,))."""
     n = seeds.shape[0]
-    order = np.argsort(seeds, kind="mergesort")
+    order = stable_argsort(seeds)
     n_seeds = 0
     for t in range(n):
         if t == 0 or seeds[order[t]] != seeds[order[t - 1]]:
@@ -135,7 +136,7 @@ def unit_groups(seeds, polygon):
             faces[w] = order[q]
             w += 1
         block = order[t:e]
-        sub = block[np.argsort(polygon[block], kind="mergesort")]
+        sub = block[stable_argsort(polygon[block])]
         sub_lo[s] = n_units
         for q in range(e - t):
             if q == 0 or polygon[sub[q]] != polygon[sub[q - 1]]:
@@ -211,7 +212,7 @@ def part_tables(label, n_parts, mesh_faces, n_vertices):
                     pos[v] = p
                     verts[n] = v
                     n += 1
-        verts[lo:n].sort()
+        sort_in_place(verts[lo:n])
         vstart[p + 1] = n
         for q in range(lo, n):
             pos[verts[q]] = q - lo

@@ -9,8 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..collide.flat import all_overlapping_pairs, face_bounds, overlapping_pairs, overlapping_pairs_between
+from ..arrays import copy_flat
 from ..jit import njit
-from ..sorting import stable_argsort
+from ..sorting import sort_in_place
 
 
 # Prim's heap: parallel arrays (weight, push counter, face, parent, edge) ordered by (weight,
@@ -377,11 +378,7 @@ def local_search(crease, merged, base, adj_ptr, adj_face, adj_edge, edge_faces, 
                     if f0 >= 0 and f1 >= 0 and in_sub[f0] != in_sub[f1]:
                         candidates[n_cand] = e
                         n_cand += 1
-            # (not .sort(): numba's quicksort of integers is 0.6 s of a first run's compiling, and
-            # equal edge ids are equal, so every sort gives this order)
-            ranked = candidates[stable_argsort(candidates[:n_cand])]
-            for ci in range(n_cand):
-                candidates[ci] = ranked[ci]
+            sort_in_place(candidates[:n_cand])
         pick = np.int64(-1)  # (not a literal: see prim_tree's size)
         seen = 0
         near_pick = np.int64(-1)
@@ -491,8 +488,7 @@ def _rehang(pick, in_sub, order, new_order, parent, parent_edge, crease, edge_fa
     first). first: no face of the subtree comes before order[first] (its top's place). Returns the
     number of other faces."""
     hang = edge_faces[pick, 0] if in_sub[edge_faces[pick, 0]] else edge_faces[pick, 1]
-    for idx in range(first):  # (not a slice assignment: see collide.flat.overlapping_pairs)
-        new_order[idx] = order[idx]
+    copy_flat(new_order, order, first)
     n_rest = np.int64(first)  # (not a literal: see prim_tree's size)
     for idx in range(first, order.shape[0]):
         if not in_sub[order[idx]]:
