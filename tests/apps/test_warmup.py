@@ -150,6 +150,41 @@ def test_the_sections_beside_compile_every_kernel_of_makes_fold_stage():
     assert got["new"] == {}, f"make's fold stage compiles beyond the first run's sections: {got['new']}"
 
 
+_UNFOLD_STAGE_SIGNATURES = r"""
+import json, sys
+from pathlib import Path
+from polyfold.apps.benchpaper import kernel_signatures
+from polyfold.apps.warmup import SECTIONS
+from polyfold.deadline import Deadline
+from polyfold.formats.meshes import load_mesh
+from polyfold.pipeline.options import MakeOptions
+from polyfold.pipeline.parts import make_parts
+
+SECTIONS["unfold"][1](None)
+before = kernel_signatures()
+mesh = load_mesh(Path(sys.argv[1])).mesh
+parts, _, report = make_parts(mesh, MakeOptions(parts=4), Deadline.after(60.0), lambda stage, message: None)
+after = kernel_signatures()
+new = {k: sorted(v - before.get(k, set())) for k, v in after.items()
+       if k.startswith("unfold.") and v - before.get(k, set())}
+print(json.dumps({"new": new, "parts": len(parts), "local": [n.method for n in report.nets]}))
+"""
+
+
+def test_the_unfold_section_compiles_the_unfold_stage_of_a_segmented_make(models_dir):
+    """What a first run's `make --parts` (or `--inflate`) has the second process compile while it
+    segments: after the section `unfold` (a closed bumpy sphere), unfolding the horse's four parts
+    (open patches) as make does calls no unfolder kernel signature the section did not."""
+    import json
+
+    proc = subprocess.run([sys.executable, "-c", _UNFOLD_STAGE_SIGNATURES, str(models_dir / "horse-302.obj")], capture_output=True,
+                          text=True, timeout=600, env=JUST_IN_TIME)
+    assert proc.returncode == 0, proc.stderr
+    got = json.loads(proc.stdout.splitlines()[-1])
+    assert got["parts"] == 4
+    assert got["new"] == {}, f"make's unfold stage compiles beyond the section: {got['new']}"
+
+
 _AFTER_THE_WAIT = r"""
 import json, sys, tempfile
 from pathlib import Path

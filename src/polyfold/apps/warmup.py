@@ -223,6 +223,23 @@ def _warm_tabs(mesh) -> None:
     PieceLabels(room, 2.0, np.stack([tri, np.roll(tri, -1, axis=0)], axis=1)).edge(side, "1")
 
 
+def _warm_unfold(mesh) -> None:
+    """make's unfold stage (`pipeline.parts.make_parts`: the net search, its local search, the
+    moves that make room for tabs) on a bumpier sphere whose heuristic nets overlap, so that the
+    local search runs: a first run's `Beside` compiles it while a make that inflates or segments
+    compiles those stages first."""
+    from ..deadline import Deadline
+    from ..mesh.mesh import Mesh
+    from ..pipeline.options import MakeOptions
+    from ..pipeline.parts import make_parts
+
+    bumpy = Mesh(*bumpy_sphere(subdivisions=2, sigma=0.15, seed=1))
+    for seed in range(1, 6):
+        _, _, report = make_parts(bumpy, MakeOptions(seed=seed), Deadline.after(10.0), lambda stage, message: None)
+        if any("local-search" in net.method for net in report.nets):
+            break
+
+
 def _warm_fold_plan(mesh) -> None:
     """make's fold stage without the check of the paths: the tree, the collision test, a plan."""
     from ..fold.plan import plan_fold
@@ -292,7 +309,9 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "inflate": ("inflation", _warm_inflate),
     # (make's own: a `polyfold server` makes its sphere through the command line instead)
     "labels": ("make's label kernels for crowded pieces", lambda mesh: _warm_crowded_labels()),
-    # a first run's `Beside` (make has them both)
+    # a first run's `Beside` (make has them all; `unfold` only where inflation or segmentation
+    # comes first)
+    "unfold": ("make's unfold stage: the net search", _warm_unfold),
     "tabs": ("make's layout: the overlap tests of tabs and labels", _warm_tabs),
     "fold-plan": ("make's fold stage: the planners", _warm_fold_plan),
     "fold-check": ("make's fold stage: the path check", _warm_fold_check),
@@ -365,9 +384,12 @@ def _quiet_sections(names: tuple[str, ...]) -> None:
     run_sections(list(names))
 
 
-def compile_beside() -> "Beside | None":
+def compile_beside(stages_first: bool = False) -> "Beside | None":
     """With two or more cores, a `Beside` for make's fold stage (for a first run:
-    `kernels_cached()` False); else None."""
+    `kernels_cached()` False); else None. stages_first: the make inflates or segments before it
+    unfolds, and the second process compiles the unfold stage first, while this one compiles
+    those (horse-302 with --parts 4 --inflate constrained: this one compiled 33 s, mostly before
+    its unfold stage, the other 20 s, idle from then on)."""
     if usable_cores() >= 2:  # (on one core the two processes would only take turns)
         if can_fork():  # (numba's set-up once, here: the forked process inherits it)
             from ..jit import start_compiler
@@ -378,7 +400,8 @@ def compile_beside() -> "Beside | None":
         # thirteenth session), and with the guide there too this process waited for it (cold make
         # of the bunny, alternating: 18.6-19.2 s with the guide there, 17.6-18.3 s here; the
         # eleventh session had put it there when `tabs` took 3 s)
-        return Beside(("tabs", "fold-plan"), ("fold-check", "guide"), "fold")
+        first = ("unfold",) if stages_first else ()
+        return Beside(first + ("tabs", "fold-plan"), ("fold-check", "guide"), "fold")
     return None
 
 
@@ -399,7 +422,7 @@ def run_sections(names: list[str], progress: Callable[[str], None] | None = None
 
     say = progress or (lambda line: None)
     # (make's fold-stage sections bring their own net: no trimesh sphere to build for them)
-    mesh = Mesh(*bumpy_sphere()) if set(names) - {"tabs", "fold-plan", "fold-check", "guide", "labels"} else None
+    mesh = Mesh(*bumpy_sphere()) if set(names) - {"unfold", "tabs", "fold-plan", "fold-check", "guide", "labels"} else None
     seconds: dict[str, float] = {}
     for name in names:
         what, run = SECTIONS[name]

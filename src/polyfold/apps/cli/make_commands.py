@@ -53,7 +53,8 @@ def make(
     from ..warmup import compile_beside, kernels_cached
 
     first_run = kernels_cached() is False
-    beside = compile_beside() if first_run and fold else None
+    beside = compile_beside(opts.inflate != "none" or opts.tau is not None or opts.parts is not None) \
+        if first_run and fold else None
     if not quiet and first_run:
         say("first run: compiling polyfold's kernels (once: about 20 s with two cores, 40 s with one; "
             "`polyfold warm-up` does it ahead)"
