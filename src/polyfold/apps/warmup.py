@@ -34,6 +34,8 @@ from ..processes import Forked, can_fork, usable_cores
 if TYPE_CHECKING:
     import subprocess
 
+    from ..mesh.mesh import Mesh
+
 
 def compile_bytecode() -> bool:
     """Write the bytecode (`__pycache__/*.pyc`) of every module of the installed polyfold package,
@@ -138,11 +140,9 @@ def _warm_fold(mesh) -> None:
     from ..collide.tolerance import THICKNESS_REL
     from ..fold.plan import PLANNERS, plan_fold
     from ..fold.tree import FoldTree
-    from ..mesh.mesh import Mesh
     from ..unfold.search import unfold
 
-    # a bumpier sphere, whose heuristic nets overlap: the memetic search's local search runs
-    bumpy = Mesh(*bumpy_sphere(subdivisions=2, sigma=0.15, seed=1))
+    bumpy = _bumpier_sphere()
     for seed in range(1, 6):
         _, stats = unfold(bumpy, seed=seed, time_limit=10.0)
         if "local-search" in stats.method:
@@ -223,17 +223,24 @@ def _warm_tabs(mesh) -> None:
     PieceLabels(room, 2.0, np.stack([tri, np.roll(tri, -1, axis=0)], axis=1)).edge(side, "1")
 
 
+def _bumpier_sphere() -> "Mesh":
+    """A bumpier sphere of 320 faces, whose heuristic nets overlap: the memetic search's local
+    search runs on it (within seeds 1-5)."""
+    from ..mesh.mesh import Mesh
+
+    return Mesh(*bumpy_sphere(subdivisions=2, sigma=0.15, seed=1))
+
+
 def _warm_unfold(mesh) -> None:
     """make's unfold stage (`pipeline.parts.make_parts`: the net search, its local search, the
     moves that make room for tabs) on a bumpier sphere whose heuristic nets overlap, so that the
     local search runs: a first run's `Beside` compiles it while a make that inflates or segments
     compiles those stages first."""
     from ..deadline import Deadline
-    from ..mesh.mesh import Mesh
     from ..pipeline.options import MakeOptions
     from ..pipeline.parts import make_parts
 
-    bumpy = Mesh(*bumpy_sphere(subdivisions=2, sigma=0.15, seed=1))
+    bumpy = _bumpier_sphere()
     for seed in range(1, 6):
         _, _, report = make_parts(bumpy, MakeOptions(seed=seed), Deadline.after(10.0), lambda stage, message: None)
         if any("local-search" in net.method for net in report.nets):
