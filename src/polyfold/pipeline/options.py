@@ -44,6 +44,17 @@ class MakeOptions:
     dpi: float = DPI  # raster resolution of printed textures
     guide: bool = True  # write the assembly guide (guide.pdf, the steps in instructions.html)
 
+    @property
+    def segments(self) -> bool:
+        """Whether the parts are the segmenter's (--tau or --parts), not the mesh's components."""
+        return self.tau is not None or self.parts is not None
+
+    @property
+    def before_unfold(self) -> bool:
+        """Whether make inflates or segments before it unfolds (--inflate, --tau, --parts,
+        --approximate hulls, whose parts are segmented first)."""
+        return self.inflate != "none" or self.segments or self.approximate != "none"
+
 
 def paper_size(spec: str) -> tuple[float, float]:
     """'a4' | 'letter' | 'a3' | '12x12in' | 'WxHmm' (e.g. '200x300mm') -> (width, height) in mm."""

@@ -83,14 +83,13 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
     `deadline`: the searches'; past `hard` OutOfTime (every part needs a net, however short its
     search: past `deadline` each still gets MIN_UNFOLD_S)."""
     comp, components = component_faces(mesh)
-    explicit = opts.tau is not None or opts.parts is not None
     mode = "tau" if opts.tau is not None else "parts" if opts.parts is not None else opts.segment
     segmenter = _Segmenter(mesh, deadline)
     segmented: list[int] = []
     nets: list[NetReport] = []
     unfold_s = 0.0
     budget = max(1.0, 0.5 * opts.time_limit)  # unfolding gets at most half the time limit
-    if explicit:
+    if opts.segments:
         say("segment", f"segmenting ({mode})")
         todo = segmenter(np.arange(mesh.n_faces), opts.tau, opts.parts)
     else:
@@ -137,7 +136,7 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
         nets.append(NetReport(faces=int(len(faces)), pieces=int(net.n_pieces), seconds=st.seconds, method=st.method,
                               timed_out=bool(st.timed_out)))
         out.append(Part(faces, net))
-    tau = segmenter.tau if explicit else (DEFAULT_TAU if segmented else None)
+    tau = segmenter.tau if opts.segments else (DEFAULT_TAU if segmented else None)
     seg_report = SegmentReport(mode=mode, tau=tau, parts=len(out), concavity=tuple(segmenter.concavity),
                                seconds=segmenter.seconds, segmented_components=tuple(segmented))
     return out, seg_report, UnfoldReport(seconds=unfold_s, nets=tuple(nets))

@@ -71,7 +71,7 @@ def new_memo(n_faces):
 def _rows(a, n, keep):
     """A new array of n rows (n >= keep) holding a copy of a's first `keep` rows."""
     out = np.empty((n,) + a.shape[1:], a.dtype)
-    copy_flat(out, a, keep * (a.size // a.shape[0]) if a.shape[0] > 0 else 0)
+    copy_flat(out, a, keep * (a.size // max(a.shape[0], 1)))  # (keep rows of a.size / a.shape[0] each)
     return out
 
 

@@ -53,11 +53,10 @@ def make(
     from ..warmup import compile_beside, kernels_cached
 
     first_run = kernels_cached() is False
-    stages_first = opts.inflate != "none" or opts.tau is not None or opts.parts is not None
-    beside = compile_beside(stages_first) if first_run and fold else None
+    beside = compile_beside(opts.before_unfold) if first_run and fold else None
     if not quiet and first_run:
         say("first run: compiling polyfold's kernels (once: about 20 s with two cores, 40 s with one"
-            + (", twice that with inflation or segmentation" if stages_first else "")
+            + (", twice that with inflation or segmentation" if opts.before_unfold else "")
             + "; `polyfold warm-up` does it ahead)"
             + ("; the folding stage's in a second process" if beside is not None else ""))
     t0 = time.perf_counter()
