@@ -16,7 +16,7 @@ import pytest
 from polyfold.fabricate.page import Page
 from polyfold.formats.dxf import write_dxf_page
 from polyfold.errors import PolyfoldError
-from polyfold.formats.files import JOURNAL, MANIFEST, StagedFolder, atomic_write, check_folder, check_outputs
+from polyfold.formats.files import JOURNAL, LOCK, MANIFEST, StagedFolder, atomic_write, check_folder, check_outputs
 from polyfold.formats.pdf import write_pdf
 from polyfold.formats.svg import write_svg_page
 
@@ -108,6 +108,56 @@ def test_an_error_before_commit_leaves_the_folder_as_it_was(tmp_path):
             raise RuntimeError("boom")
     assert _visible(tmp_path) == ["part-0.obj"] and (tmp_path / "part-0.obj").read_text() == "old"
     assert not [p for p in tmp_path.iterdir() if p.is_dir()]  # no temporary folder left
+
+
+def test_a_run_stopped_before_its_commit_takes_away_the_folders_it_made(tmp_path):
+    """An error or Ctrl-C (KeyboardInterrupt) between making a new output folder (and the folders
+    above it) and the commit removes them again: they held nothing but the lock. A folder that
+    was there stays, and so does one that holds anything else."""
+    for exc in (RuntimeError, KeyboardInterrupt):
+        with pytest.raises(exc):
+            with StagedFolder(tmp_path / "new" / exc.__name__ / "out", "test") as stage:
+                stage.write("report.json", "{}")
+                raise exc()
+        assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(RuntimeError):
+        with StagedFolder(tmp_path / "kept", "test"):
+            raise RuntimeError()
+    assert (tmp_path / "kept").is_dir() and list((tmp_path / "kept").iterdir()) == [tmp_path / "kept" / LOCK]
+    with pytest.raises(RuntimeError):
+        with StagedFolder(tmp_path / "other", "test"):
+            (tmp_path / "other" / "notes.txt").write_text("mine")  # (not polyfold's: the folder stays)
+            raise RuntimeError()
+    assert (tmp_path / "other" / "notes.txt").read_text() == "mine"
+
+
+def test_a_run_waiting_for_one_that_takes_its_folder_away_makes_it_again(tmp_path):
+    """A second run into a new folder, waiting for the lock of the run that made it: that run
+    stops before its commit and removes the folder; the second finds its lock file gone, makes
+    the folder again and commits into it."""
+    import threading
+    import time
+
+    folder = tmp_path / "out"
+    entered, go_on, done = threading.Event(), threading.Event(), []
+
+    def first() -> None:
+        with pytest.raises(RuntimeError):
+            with StagedFolder(folder, "test"):
+                entered.set()
+                go_on.wait(10)
+                raise RuntimeError("given up")
+
+    runs = [threading.Thread(target=first), threading.Thread(target=lambda: done.append(_run(folder, {"a.txt": "b"})))]
+    runs[0].start()
+    assert entered.wait(10)
+    runs[1].start()
+    time.sleep(0.3)  # (the second run waits for the lock)
+    go_on.set()
+    for run in runs:
+        run.join(10)
+    assert done == [("a.txt",)] and _visible(folder) == ["a.txt"] and (folder / "a.txt").read_text() == "b"
 
 
 def test_a_commit_cut_short_is_finished_by_the_next_run(tmp_path, monkeypatch):

@@ -11,6 +11,8 @@ A folder polyfold writes into keeps three hidden files beside the outputs:
   run's set or the other's, never a mix, once anyone writes there again.
 - `.polyfold.lock`: held (flock) while a run stages and commits, so two runs into one folder take
   turns. Temporary `.polyfold-*` folders found under the lock are a killed run's and are removed.
+  A run that made the folder (and the folders above it) and stops before its commit (an error,
+  Ctrl-C) removes them again while they hold nothing but the lock.
 """
 
 from __future__ import annotations
@@ -73,6 +75,26 @@ MANIFEST = ".polyfold-manifest.json"
 JOURNAL = ".polyfold-commit.json"
 LOCK = ".polyfold.lock"
 TEMP_PREFIX = ".polyfold-"
+
+
+def _first_missing(folder: Path) -> Path | None:
+    """The topmost of `folder` and its parents that does not exist (None: folder exists)."""
+    missing = None
+    while not folder.exists():
+        missing, folder = folder, folder.parent
+        if folder == missing:  # (the root)
+            break
+    return missing
+
+
+def _same_inode(fd: int, path: Path) -> bool:
+    """Whether the open file `fd` is the file at `path` (which may be gone)."""
+    try:
+        here = os.stat(path)
+    except FileNotFoundError:
+        return False
+    there = os.fstat(fd)
+    return (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -140,16 +162,25 @@ class StagedFolder:
         self.names: list[str] = []
         self._lock_fd: int | None = None
         self.tmp: Path | None = None
+        self._made: Path | None = None  # the topmost folder this run made (`__enter__`)
+        self._committed = False
 
     def __enter__(self) -> StagedFolder:
         import fcntl
 
-        try:
-            self.out.mkdir(parents=True, exist_ok=True)
-            self._lock_fd = os.open(self.out / LOCK, os.O_RDWR | os.O_CREAT, _FILE_MODE)
-        except OSError as exc:
-            raise PolyfoldError(f"{self.out}: cannot write into this folder ({exc.strerror or exc})") from None
-        fcntl.flock(self._lock_fd, fcntl.LOCK_EX)  # another run into this folder: wait for it
+        while True:
+            try:
+                self._made = _first_missing(self.out)  # (removed again if this run writes nothing)
+                self.out.mkdir(parents=True, exist_ok=True)
+                self._lock_fd = os.open(self.out / LOCK, os.O_RDWR | os.O_CREAT, _FILE_MODE)
+            except OSError as exc:
+                raise PolyfoldError(f"{self.out}: cannot write into this folder ({exc.strerror or exc})") from None
+            fcntl.flock(self._lock_fd, fcntl.LOCK_EX)  # another run into this folder: wait for it
+            if _same_inode(self._lock_fd, self.out / LOCK):
+                break
+            # the run waited for made the folder, wrote nothing and took the folder away: again
+            os.close(self._lock_fd)
+            self._lock_fd = None
         try:
             self._recover()
             self.previous = set(self._manifest())
@@ -164,8 +195,28 @@ class StagedFolder:
             shutil.rmtree(self.tmp, ignore_errors=True)
             self.tmp = None
         if self._lock_fd is not None:
+            if self._made is not None and not self._committed:
+                self._remove_empty()
             os.close(self._lock_fd)  # releases the flock
             self._lock_fd = None
+
+    def _remove_empty(self) -> None:
+        """Remove the folder this run made, and those it made above it, while it holds nothing
+        but the lock (a run stopped before its commit: an error, or Ctrl-C mid-export), under the
+        lock: a run waiting for it finds its lock file gone and makes the folder again
+        (`__enter__`)."""
+        try:
+            if [p.name for p in self.out.iterdir()] != [LOCK]:
+                return
+            (self.out / LOCK).unlink()
+            folder = self.out
+            while True:
+                folder.rmdir()
+                if folder == self._made:
+                    break
+                folder = folder.parent
+        except OSError:
+            pass
 
     def path(self, name: str) -> Path:
         """Where to write file `name` (for writers that take a path); it is committed with the rest."""
@@ -202,6 +253,7 @@ class StagedFolder:
                     raise PolyfoldError(f"{self.out / name}: is this run's input and an earlier run's output "
                                         "that this run would remove: choose another output folder")
         journal = {"staged": self.tmp.name, "files": self.names, "remove": remove}
+        self._committed = True  # (from the journal on, the folder holds a run's files, or will)
         atomic_write(self.out / JOURNAL, json.dumps(journal) + "\n")
         self._apply(journal)
         return tuple(self.names)
