@@ -27,6 +27,7 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
                    "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs",
                    "fabricate.overlap_kernels.blocked_by", "fabricate.overlap_kernels.grown_box_meets",
                    "fabricate.overlap_kernels.first_clear_box", "fabricate.overlap_kernels.first_box_in_triangle",
+                   "fabricate.overlap_kernels.first_leader_spot",
                    "fabricate.overlap_kernels.first_unblocked", "fabricate.overlap_kernels.overlap_area",
                    "fabricate.labels._path_back", "fabricate.labels._path_turns", "fabricate.labels._refresh_free",
                    "fabricate.pack.mark_rings", "fabricate.overlap_kernels.grown_box_apart",

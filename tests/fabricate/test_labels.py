@@ -130,6 +130,72 @@ def test_pieces_placed_in_parallel_get_the_same_labels(models_dir, monkeypatch, 
         assert sheet(1, by_run=True) == one
 
 
+def test_the_screen_of_far_spots_skips_only_what_the_exact_test_turns_down(models_dir, monkeypatch) -> None:
+    """`PieceLabels._leader_spots` (the compiled screen of the spots `_elsewhere` finds for a label
+    that fits nowhere near its edge) skips spots off the faces that the room blocks and spots whose
+    leader would cross a label: each one it skips, `_leader_spot` turns down, and the crowded fish
+    (60 mm, 80 mm pages, labelled by seam run) gets the same sheets with the screen as with every
+    spot asked of `_leader_spot`, which is asked far less often."""
+    import shapely
+
+    from polyfold.deadline import Deadline
+    from polyfold.fabricate import labels as L
+    from polyfold.fabricate import pieces as P
+    from polyfold.fabricate.fit import model_scale
+    from polyfold.formats.meshes import load_mesh
+    from polyfold.pipeline.options import MakeOptions, paper_size
+    from polyfold.pipeline.parts import make_parts
+    from polyfold.pipeline.sheets import fit_parts, pack_box, part_piece_inputs
+
+    mesh = load_mesh(models_dir / "fish-472.obj").mesh
+    opts = MakeOptions(size=60.0, paper="80x80mm")
+    parts, _, _ = make_parts(mesh, opts, Deadline.after(60), lambda *a: None)
+    scale = model_scale([mesh], opts.size)
+    fitted, _ = fit_parts(parts, scale, opts, pack_box(*paper_size(opts.paper), opts), "fish-472")
+    inputs = part_piece_inputs(mesh, fitted)
+    monkeypatch.setattr("polyfold.processes.usable_cores", lambda: 1)
+    screened, exact, elsewhere = L.PieceLabels._leader_spots, L.PieceLabels._leader_spot, L.PieceLabels._elsewhere
+    counts = {"asked": 0, "skipped": 0, "skipped but taken": 0}
+
+    def with_text(self, text, sides):
+        self._text = text  # (for `checked`)
+        return elsewhere(self, text, sides)
+
+    def checked(self, boxes, p):
+        """The screen's spots, after every spot it skips is asked of the exact test (which turns
+        it down, placing nothing: it may not take it)."""
+        kept = list(screened(self, boxes, p))
+        for i in sorted(set(range(len(boxes))) - set(kept)):
+            center = boxes[i].mean(axis=0)
+            u = (boxes[i][1] - boxes[i][0]) / np.linalg.norm(boxes[i][1] - boxes[i][0])
+            counts["skipped"] += 1
+            counts["skipped but taken"] += exact(self, self._text, u, center, np.array([p, center]), bent=False)
+        yield from kept
+
+    def counted(self, *args, **kwargs):
+        counts["asked"] += 1
+        return exact(self, *args, **kwargs)
+
+    def sheet():
+        counts["asked"] = 0
+        pieces, glue, stats = P.build_sheet_pieces(inputs, scale)
+        return ([(p.texts, p.leaders.tobytes(), shapely.to_wkb(p.outline), shapely.to_wkb(p.footprint)) for p in pieces],
+                [(g.label, g.printed) for g in glue], stats)
+
+    monkeypatch.setattr(L.PieceLabels, "_elsewhere", with_text)
+    monkeypatch.setattr(L.PieceLabels, "_leader_spots", checked)
+    checked_sheet = sheet()
+    assert checked_sheet[2].labels_by_run and checked_sheet[2].labels_outside > 0
+    assert counts["skipped"] > 200 and counts["skipped but taken"] == 0, counts
+    monkeypatch.setattr(L.PieceLabels, "_leader_spots", screened)
+    monkeypatch.setattr(L.PieceLabels, "_leader_spot", counted)
+    assert sheet() == checked_sheet
+    with_screen = counts["asked"]
+    monkeypatch.setattr(L.PieceLabels, "_leader_spots", lambda self, boxes, p: iter(range(len(boxes))))
+    assert sheet() == checked_sheet
+    assert with_screen < 0.7 * counts["asked"], (with_screen, counts["asked"])
+
+
 def _distances_by_numpy(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """(k,) distances from p (2,) to the segments (k, 2, 2) as numpy writes them."""
     a, ab = segments[:, 0], segments[:, 1] - segments[:, 0]

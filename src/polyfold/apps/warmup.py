@@ -120,10 +120,10 @@ def _warm_crowded_labels() -> None:
 def _warm_label_sides() -> None:
     """The tests of spots beside an edge (`labels.PieceLabels._nearest_to`: nearer it than the
     piece's other cut sides; `_outside`'s compiled test of its spots; `_hits`), on a triangle
-    too small for its labels."""
+    too small for its labels; the screen of spots farther off (`_leader_spots`)."""
     from shapely.geometry import Polygon
 
-    from ..fabricate.labels import PieceLabels, text_box
+    from ..fabricate.labels import PieceLabels, _Taken, text_box, text_boxes
     from ..fabricate.tabs import CutSide, Room
 
     tri = np.array([[0.0, 0.0], [10.0, 0.0], [5.0, 8.0]])
@@ -134,6 +134,9 @@ def _warm_label_sides() -> None:
     for text in ("12345", "12345"):  # beside the edge (there is no room in the face), then next to that
         labels.edge(side, text)
     labels._hits(text_box(np.array([5.0, -1.0]), np.array([1.0, 0.0]), "1", 2.0))
+    labels._taken = _Taken(labels)
+    spots = text_boxes(np.array([[5.0, -6.0], [5.0, 3.0]]), np.array([1.0, 0.0]), "1", 2.0)
+    list(labels._leader_spots(spots, tri[0] + [5.0, 0.0]))
 
 
 def _warm_fold(mesh) -> None:

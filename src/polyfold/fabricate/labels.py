@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..jit import njit
-from .overlap_kernels import first_box_in_triangle, first_clear_box, point_segment_distance
+from .overlap_kernels import first_box_in_triangle, first_clear_box, first_leader_spot, point_segment_distance
 from .page import TextItem, upright
 from .paper import CAP_HEIGHT
 from .tabs import OVERLAP_MM2, TAB_CLEAR_MM, TAB_ROOM_MM, CutSide, Room
@@ -59,6 +59,10 @@ TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
 # direction from the edge's outward normal (cos, sin of 0, 30, -30, 60, -60 degrees, as math has them)
 _ALONG = np.array([0.5, 0.35, 0.65, 0.2, 0.8])
 # where a leader of ELSEWHERE_MM at most is looked up in the raster (fractions of its length)
+SCREEN_MARGIN_MM = 1e-6  # what a compiled screen of spots leaves undecided on either side of a test's bound
+# a leader's strip (shapely's buffer of it, LEADER_HALF_MM, 8 segments a quarter circle) holds every
+# point this near its line: a label box this near is surely hit
+_LEADER_STRIP_MM = LEADER_HALF_MM * math.cos(math.pi / 32) - SCREEN_MARGIN_MM
 _LEADER_T = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
 _TURNS = np.array([(math.cos(math.radians(t)), math.sin(math.radians(t))) for t in (0.0, 30.0, -30.0, 60.0, -60.0)])
 
@@ -608,6 +612,7 @@ class _Taken:
         self._pending: list[tuple[object, float, bool]] = []  # (geometry, grow, into texts) to mark: `_flush`
         # face sides: points every half cell along them, then grown by a disc
         tri = shapely.get_coordinates(np.asarray(labels.room.faces, dtype=object)).reshape(-1, 4, 2)[:, :3]
+        self.tris = np.ascontiguousarray(tri)  # (the faces' triangles, for `PieceLabels._leader_spots`)
         a, b = tri.reshape(-1, 2), np.roll(tri, -1, axis=1).reshape(-1, 2)
         steps = np.maximum(np.ceil(np.linalg.norm(b - a, axis=1) / (0.5 * FREE_CELL_MM)).astype(int), 1)
         # np.linspace(0, 1, k + 1) of each side, at once: i (1 / k), the last 1
@@ -705,7 +710,7 @@ class _Taken:
         """Centres of level boxes of each of the two sizes (w, h mm) that touch no taken cell and whose
         leader from p crosses no label, within ELSEWHERE_MM of p: up to `want` per size and place,
         nearest first, centred in a face (each size in turn), then off the faces (the same), as
-        (index into sizes, centre), each list made when asked for. The raster's window is scanned
+        (index into sizes, centres (m, 2)), each list made when asked for. The raster's window is scanned
         once for all of them (`_free_cells_near`); nothing may be placed between two asks."""
         self._flush()
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
@@ -725,8 +730,9 @@ class _Taken:
             found = found[near[np.argsort(dist2[near], kind="stable")]]
             # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
             # most) are free; nearest first, until `want` are found
-            for c in found[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, found, _LEADER_T, want)]:
-                yield q % 2, c
+            clear = found[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, found, _LEADER_T, want)]
+            if len(clear):
+                yield q % 2, clear
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int
                     ) -> Iterator[tuple[int, np.ndarray, np.ndarray]]:
@@ -1020,8 +1026,10 @@ class PieceLabels:
                 for t in (0.5, 0.25, 0.75):
                     mid = side.p0 + t * (side.p1 - side.p0)
                     # in a face first (off them a label takes paper), level, then upright
-                    for k, c in self._taken.free_near(mid, [(w, h), (h, w)], ELSEWHERE_TRIES):
-                        yield mid, (level, upward)[k], c
+                    for k, centres in self._taken.free_near(mid, [(w, h), (h, w)], ELSEWHERE_TRIES):
+                        u = (level, upward)[k]
+                        for i in self._leader_spots(text_boxes(centres, u, text, self.size), mid):
+                            yield mid, u, centres[i]
 
         for mid, u, center in tries():
             if self._leader_spot(text, u, center, np.array([mid, center]), bent=False):
@@ -1033,6 +1041,23 @@ class PieceLabels:
                 return True
         self._no_spot += 1
         return False
+
+    def _leader_spots(self, boxes: np.ndarray, p: np.ndarray) -> Iterator[int]:
+        """The label boxes (k, 4, 2) that `_leader_spot` may take with a straight leader from p, in
+        order: the others, those it surely turns down (off the faces and blocked in the room, or
+        their leader over a label: `overlap_kernels.first_leader_spot`), are skipped. Nothing may
+        be placed while it is iterated."""
+        a = self.boxes.rings
+        pts, ring_ptr, ring_sign, obs_ptr, face_bounds, extra_bounds, n_extras = self.room.obstacle_table()
+        i = 0
+        while True:
+            i = first_leader_spot(boxes, i, p, self._taken.tris, face_bounds, LABEL_PAD_MM, SCREEN_MARGIN_MM,
+                                  _LEADER_STRIP_MM, a.pts, a.ring_ptr, a.n, TAB_CLEAR_MM, OVERLAP_MM2, pts, ring_ptr,
+                                  ring_sign, obs_ptr, extra_bounds, n_extras)
+            if i >= len(boxes):
+                return
+            yield i
+            i += 1
 
     def _leader_spot(self, text: str, u: np.ndarray, center: np.ndarray, path: np.ndarray, bent: bool) -> bool:
         """Stage 4's exact check and placement: the label at `center` (reading along u) with a

@@ -547,3 +547,91 @@ def first_unblocked(polys, side_of, skip_faces, discs, clear, least,
             return c, 0
         return c, 1
     return polys.shape[0], -1
+
+
+@njit(cache=True)
+def _surely_outside_triangle(box, tri, inset, margin):
+    """Whether the box (4, 2) is surely not inside triangle `tri` (3, 2) `inset` from its sides as
+    `labels.inside_triangle` computes it: a side of no length, or a corner short of `inset`
+    by more than `margin` (what numba's hypot may differ by from Python's is far less)."""
+    ax, ay, bx, by, cx, cy = tri[0, 0], tri[0, 1], tri[1, 0], tri[1, 1], tri[2, 0], tri[2, 1]
+    area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    sgn = 1.0 if area2 > 0 else -1.0
+    for s in range(3):
+        px, py = tri[s, 0], tri[s, 1]
+        ex, ey = tri[(s + 1) % 3, 0] - px, tri[(s + 1) % 3, 1] - py
+        ln = math.hypot(ex, ey)
+        if ln == 0:
+            return True
+        for c in range(box.shape[0]):
+            if sgn * (ex * (box[c, 1] - py) - ey * (box[c, 0] - px)) / ln < inset - margin:
+                return True
+    return False
+
+
+@njit(cache=True)
+def first_leader_spot(boxes, start, p, tris, face_bounds, inset, margin, strip, a_pts, a_ring_ptr, a_n, clear, least,
+                      pts, ring_ptr, ring_sign, obs_ptr, extra_bounds, n_extras):
+    """The first index i >= start of the label boxes (k, 4, 2 corners) that `labels.PieceLabels.
+    _leader_spot` may take with a straight leader from p (2,); k when none may. It surely turns a
+    box down
+    - when the box lies in no face (for each face triangle of tris (F, 3, 2) whose bounds
+      face_bounds (F, 4) meet the box's: `_surely_outside_triangle` of it, `inset` from its sides)
+      and the room blocks it (`_room_blocks`, `clear` and `least` as `tabs.Room.blocked`; the room's
+      table pts .. obs_ptr, its faces then its first n_extras extras, extra_bounds (E, 4)); or
+    - when its leader, p to the nearest point of the box's outline, comes within `strip` of a placed
+      label box (the rings a_pts[a_ring_ptr[t]:a_ring_ptr[t + 1]] of the first a_n): `strip` less
+      than the leader's half width by what shapely's buffer of it cuts off its round ends, and by
+      a margin for where that nearest point may differ in the last bits.
+    (The screen of `_elsewhere`'s candidates: most are turned down by one of these, each in a
+    tenth of a millisecond of shapely; the caller decides the others exactly.)"""
+    no_discs = np.zeros((0, 1, 2))
+    obstacles = np.empty(face_bounds.shape[0] + n_extras, dtype=np.int64)
+    for i in range(start, boxes.shape[0]):
+        box = np.ascontiguousarray(boxes[i])
+        x0, y0, x1, y1 = box[0, 0], box[0, 1], box[0, 0], box[0, 1]
+        for c in range(1, 4):
+            x0, y0 = min(x0, box[c, 0]), min(y0, box[c, 1])
+            x1, y1 = max(x1, box[c, 0]), max(y1, box[c, 1])
+        in_face = False
+        for f in range(tris.shape[0]):
+            if face_bounds[f, 0] <= x1 and x0 <= face_bounds[f, 2] and face_bounds[f, 1] <= y1 \
+                    and y0 <= face_bounds[f, 3] and not _surely_outside_triangle(box, tris[f], inset, margin):
+                in_face = True
+                break
+        if not in_face and _room_blocks(box, clear, no_discs, least, -1, pts, ring_ptr, ring_sign, obs_ptr,
+                                        face_bounds, extra_bounds, n_extras, obstacles) == 1:
+            continue
+        # the leader's end: the nearest point of the box's outline (its first side on a tie)
+        best, ex, ey = np.inf, 0.0, 0.0
+        for c in range(4):
+            a0, a1 = box[c, 0], box[c, 1]
+            b0, b1 = box[(c + 1) % 4, 0], box[(c + 1) % 4, 1]
+            ab0, ab1 = b0 - a0, b1 - a1
+            t = ((p[0] - a0) * ab0 + (p[1] - a1) * ab1) / max(ab0 * ab0 + ab1 * ab1, 1e-300)
+            t = min(max(t, 0.0), 1.0)
+            qx, qy = a0 + t * ab0, a1 + t * ab1
+            d = math.hypot(qx - p[0], qy - p[1])
+            if d < best:
+                best, ex, ey = d, qx, qy
+        lx0, lx1 = min(p[0], ex) - strip, max(p[0], ex) + strip
+        ly0, ly1 = min(p[1], ey) - strip, max(p[1], ey) + strip
+        hit = False
+        for t in range(a_n):
+            lo, hi = a_ring_ptr[t], a_ring_ptr[t + 1]
+            bx0, by0, bx1, by1 = np.inf, np.inf, -np.inf, -np.inf
+            for k in range(lo, hi):
+                bx0, by0 = min(bx0, a_pts[k, 0]), min(by0, a_pts[k, 1])
+                bx1, by1 = max(bx1, a_pts[k, 0]), max(by1, a_pts[k, 1])
+            if bx1 < lx0 or lx1 < bx0 or by1 < ly0 or ly1 < by0:
+                continue
+            for k in range(lo, hi):
+                m = k + 1 if k + 1 < hi else lo
+                if _segments_distance(p[0], p[1], ex, ey, a_pts[k, 0], a_pts[k, 1], a_pts[m, 0], a_pts[m, 1]) < strip:
+                    hit = True
+                    break
+            if hit:
+                break
+        if not hit:
+            return i
+    return boxes.shape[0]
