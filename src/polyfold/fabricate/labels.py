@@ -772,8 +772,10 @@ class PieceLabels:
         # (k, 2, 2) ends of every cut side of the piece: a label without a leader off the faces is
         # placed nearer its own side than any other, or a reader takes it for that one's
         self.cut_sides = np.zeros((0, 2, 2)) if cut_sides is None else np.ascontiguousarray(cut_sides, dtype=float)
-        # off-face labels stay in the room fitting a piece to the page leaves for its tabs
-        self.allowed = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
+        # off-face labels stay in the room fitting a piece to the page leaves for its tabs: around
+        # the hull of the faces' corners (the hull of their union, without the union: 3 ms a piece)
+        corners = shapely.multipoints(shapely.get_coordinates(room.faces))
+        self.allowed = shapely.convex_hull(corners).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
         shapely.prepare(self.allowed)  # asked whether it contains a label box for every spot tried
         self.size = size
         self.boxes = _Boxes()
