@@ -196,6 +196,27 @@ def test_the_screen_of_far_spots_skips_only_what_the_exact_test_turns_down(model
     assert with_screen < 0.7 * counts["asked"], (with_screen, counts["asked"])
 
 
+def test_the_room_for_off_face_labels_is_around_the_hull_of_the_faces_union() -> None:
+    """`PieceLabels.allowed` is taken from the hull of the faces' corners: the same polygon, to
+    the bit, as the hull of their union grown alike, on grids of triangles (straight outlines,
+    many corners on the hull's sides) and on jittered ones."""
+    import shapely
+
+    from polyfold.fabricate.labels import TAB_CLEAR_MM
+    from polyfold.fabricate.tabs import TAB_ROOM_MM
+
+    rng = np.random.default_rng(3)
+    for jitter in (0.0, 0.0, 0.2, 0.3):
+        nx, ny = (int(v) for v in rng.integers(2, 9, 2))
+        xy = np.stack(np.meshgrid(np.arange(nx + 1.0), np.arange(ny + 1.0)), axis=-1) * 3.0
+        xy += rng.uniform(-jitter, jitter, xy.shape)
+        tris = [t for i in range(nx) for j in range(ny)
+                for t in ((xy[j, i], xy[j, i + 1], xy[j + 1, i + 1]), (xy[j, i], xy[j + 1, i + 1], xy[j + 1, i]))]
+        room = Room(np.array([Polygon(t) for t in tris], dtype=object))
+        want = shapely.convex_hull(shapely.union_all(room.faces)).buffer(TAB_ROOM_MM - TAB_CLEAR_MM)
+        assert shapely.to_wkb(PieceLabels(room, 2.0).allowed) == shapely.to_wkb(want)
+
+
 def _distances_by_numpy(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """(k,) distances from p (2,) to the segments (k, 2, 2) as numpy writes them."""
     a, ab = segments[:, 0], segments[:, 1] - segments[:, 0]
