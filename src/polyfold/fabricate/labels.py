@@ -59,12 +59,12 @@ TICK_MM = 1.5  # a seam run's end mark, from the outline into the face
 # direction from the edge's outward normal (cos, sin of 0, 30, -30, 60, -60 degrees, as math has them)
 _ALONG = np.array([0.5, 0.35, 0.65, 0.2, 0.8])
 # where a leader of ELSEWHERE_MM at most is looked up in the raster (fractions of its length)
+_LEADER_T = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
+_TURNS = np.array([(math.cos(math.radians(t)), math.sin(math.radians(t))) for t in (0.0, 30.0, -30.0, 60.0, -60.0)])
 SCREEN_MARGIN_MM = 1e-6  # what a compiled screen of spots leaves undecided on either side of a test's bound
 # a leader's strip (shapely's buffer of it, LEADER_HALF_MM, 8 segments a quarter circle) holds every
 # point this near its line: a label box this near is surely hit
 _LEADER_STRIP_MM = LEADER_HALF_MM * math.cos(math.pi / 32) - SCREEN_MARGIN_MM
-_LEADER_T = np.linspace(0.0, 1.0, int(math.ceil(ELSEWHERE_MM / LEADER_STEP_MM)) + 1)
-_TURNS = np.array([(math.cos(math.radians(t)), math.sin(math.radians(t))) for t in (0.0, 30.0, -30.0, 60.0, -60.0)])
 
 
 def label_font(min_cap_mm: float) -> float:
