@@ -1054,8 +1054,8 @@ class PieceLabels:
         i = 0
         while True:
             i = first_leader_spot(boxes, i, p, self._taken.tris, face_bounds, LABEL_PAD_MM, SCREEN_MARGIN_MM,
-                                  _LEADER_STRIP_MM, a.pts, a.ring_ptr, a.n, TAB_CLEAR_MM, OVERLAP_MM2, pts, ring_ptr,
-                                  ring_sign, obs_ptr, extra_bounds, n_extras)
+                                  _LEADER_STRIP_MM, CELL_MM, a.pts, a.ring_ptr, a.cells, a.has_ring, a.n, TAB_CLEAR_MM,
+                                  OVERLAP_MM2, pts, ring_ptr, ring_sign, obs_ptr, extra_bounds, n_extras)
             if i >= len(boxes):
                 return
             yield i

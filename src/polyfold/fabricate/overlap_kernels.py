@@ -455,26 +455,10 @@ def first_box_in_triangle(boxes, tri, side_lengths, inset, box_cells, pad, a_pts
     (k, -1) when none."""
     near_a = np.empty(a_n, dtype=np.int64)
     near_b = np.empty(b_n, dtype=np.int64)
-    ax, ay, bx, by, cx, cy = tri[0, 0], tri[0, 1], tri[1, 0], tri[1, 1], tri[2, 0], tri[2, 1]
-    area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-    sgn = 1.0 if area2 > 0 else -1.0
     for i in range(boxes.shape[0]):
-        inside = True
-        for s in range(3):
-            px, py = tri[s, 0], tri[s, 1]
-            ex, ey = tri[(s + 1) % 3, 0] - px, tri[(s + 1) % 3, 1] - py
-            ln = side_lengths[s]
-            if ln == 0:
-                return boxes.shape[0], -1
-            for c in range(boxes.shape[1]):
-                if sgn * (ex * (boxes[i, c, 1] - py) - ey * (boxes[i, c, 0] - px)) / ln < inset:
-                    inside = False
-                    break
-            if not inside:
-                break
-        if not inside:
-            continue
         box = np.ascontiguousarray(boxes[i])
+        if not _triangle_clearance(box, tri, side_lengths) >= inset:
+            continue
         hit = _meets_labels(box, box_cells[i, 0], box_cells[i, 1], box_cells[i, 2], box_cells[i, 3], pad,
                             a_pts, a_ring_ptr, a_cells, a_has_ring, a_n, b_pts, b_ring_ptr, b_cells, b_has_ring, b_n,
                             near_a, near_b)
@@ -550,43 +534,49 @@ def first_unblocked(polys, side_of, skip_faces, discs, clear, least,
 
 
 @njit(cache=True)
-def _surely_outside_triangle(box, tri, inset, margin):
-    """Whether the box (4, 2) is surely not inside triangle `tri` (3, 2) `inset` from its sides as
-    `labels.inside_triangle` computes it: a side of no length, or a corner short of `inset`
-    by more than `margin` (what numba's hypot may differ by from Python's is far less)."""
+def _triangle_clearance(box, tri, side_lengths):
+    """How far inside triangle `tri` (3, 2), either orientation, the box's corners (k, 2) lie: the
+    least of their distances from its sides as `labels.inside_triangle` computes them
+    (side_lengths (3,): of sides ab, bc, ca), negative outside; -inf when a side has no length."""
     ax, ay, bx, by, cx, cy = tri[0, 0], tri[0, 1], tri[1, 0], tri[1, 1], tri[2, 0], tri[2, 1]
     area2 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
     sgn = 1.0 if area2 > 0 else -1.0
+    least = np.inf
     for s in range(3):
         px, py = tri[s, 0], tri[s, 1]
         ex, ey = tri[(s + 1) % 3, 0] - px, tri[(s + 1) % 3, 1] - py
-        ln = math.hypot(ex, ey)
+        ln = side_lengths[s]
         if ln == 0:
-            return True
+            return -np.inf
         for c in range(box.shape[0]):
-            if sgn * (ex * (box[c, 1] - py) - ey * (box[c, 0] - px)) / ln < inset - margin:
-                return True
-    return False
+            d = sgn * (ex * (box[c, 1] - py) - ey * (box[c, 0] - px)) / ln
+            if d < least:
+                least = d
+    return least
 
 
 @njit(cache=True)
-def first_leader_spot(boxes, start, p, tris, face_bounds, inset, margin, strip, a_pts, a_ring_ptr, a_n, clear, least,
-                      pts, ring_ptr, ring_sign, obs_ptr, extra_bounds, n_extras):
+def first_leader_spot(boxes, start, p, tris, face_bounds, inset, margin, strip, cell, a_pts, a_ring_ptr, a_cells,
+                      a_has_ring, a_n, clear, least, pts, ring_ptr, ring_sign, obs_ptr, extra_bounds, n_extras):
     """The first index i >= start of the label boxes (k, 4, 2 corners) that `labels.PieceLabels.
     _leader_spot` may take with a straight leader from p (2,); k when none may. It surely turns a
     box down
-    - when the box lies in no face (for each face triangle of tris (F, 3, 2) whose bounds
-      face_bounds (F, 4) meet the box's: `_surely_outside_triangle` of it, `inset` from its sides)
+    - when the box lies in no face (each face triangle of tris (F, 3, 2) whose bounds face_bounds
+      (F, 4) meet the box's holds it less than `inset` from its sides, by more than `margin`:
+      `_triangle_clearance`, numba's hypot, which may differ from Python's in the last bit)
       and the room blocks it (`_room_blocks`, `clear` and `least` as `tabs.Room.blocked`; the room's
       table pts .. obs_ptr, its faces then its first n_extras extras, extra_bounds (E, 4)); or
     - when its leader, p to the nearest point of the box's outline, comes within `strip` of a placed
-      label box (the rings a_pts[a_ring_ptr[t]:a_ring_ptr[t + 1]] of the first a_n): `strip` less
-      than the leader's half width by what shapely's buffer of it cuts off its round ends, and by
-      a margin for where that nearest point may differ in the last bits.
+      label box (the rings a_pts[a_ring_ptr[t]:a_ring_ptr[t + 1]] of the first a_n, each in the
+      `cell` mm hash cells a_cells[t], as `first_clear_box`'s): `strip` less than the leader's half
+      width by what shapely's buffer of it cuts off its round ends, and by a margin for where that
+      nearest point may differ in the last bits.
     (The screen of `_elsewhere`'s candidates: most are turned down by one of these, each in a
     tenth of a millisecond of shapely; the caller decides the others exactly.)"""
     no_discs = np.zeros((0, 1, 2))
     obstacles = np.empty(face_bounds.shape[0] + n_extras, dtype=np.int64)
+    near = np.empty(a_n, dtype=np.int64)
+    lengths = np.empty(3)
     for i in range(start, boxes.shape[0]):
         box = np.ascontiguousarray(boxes[i])
         x0, y0, x1, y1 = box[0, 0], box[0, 1], box[0, 0], box[0, 1]
@@ -596,9 +586,14 @@ def first_leader_spot(boxes, start, p, tris, face_bounds, inset, margin, strip, 
         in_face = False
         for f in range(tris.shape[0]):
             if face_bounds[f, 0] <= x1 and x0 <= face_bounds[f, 2] and face_bounds[f, 1] <= y1 \
-                    and y0 <= face_bounds[f, 3] and not _surely_outside_triangle(box, tris[f], inset, margin):
-                in_face = True
-                break
+                    and y0 <= face_bounds[f, 3]:
+                t0, t1, t2 = tris[f, 0], tris[f, 1], tris[f, 2]
+                lengths[0] = math.hypot(t1[0] - t0[0], t1[1] - t0[1])
+                lengths[1] = math.hypot(t2[0] - t1[0], t2[1] - t1[1])
+                lengths[2] = math.hypot(t0[0] - t2[0], t0[1] - t2[1])
+                if not _triangle_clearance(box, tris[f], lengths) < inset - margin:
+                    in_face = True
+                    break
         if not in_face and _room_blocks(box, clear, no_discs, least, -1, pts, ring_ptr, ring_sign, obs_ptr,
                                         face_bounds, extra_bounds, n_extras, obstacles) == 1:
             continue
@@ -614,20 +609,18 @@ def first_leader_spot(boxes, start, p, tris, face_bounds, inset, margin, strip, 
             d = math.hypot(qx - p[0], qy - p[1])
             if d < best:
                 best, ex, ey = d, qx, qy
-        lx0, lx1 = min(p[0], ex) - strip, max(p[0], ex) + strip
-        ly0, ly1 = min(p[1], ey) - strip, max(p[1], ey) + strip
+        # the labels sharing a hash cell with the leader's bounds (a cell wider: `_Boxes` hashes by
+        # Python's floor division), as `_Boxes.hits_geom` finds them
+        m = _near_cells(a_cells, a_has_ring, a_n, int(math.floor((min(p[0], ex) - strip) / cell)) - 1,
+                        int(math.floor((max(p[0], ex) + strip) / cell)) + 1,
+                        int(math.floor((min(p[1], ey) - strip) / cell)) - 1,
+                        int(math.floor((max(p[1], ey) + strip) / cell)) + 1, near)
         hit = False
-        for t in range(a_n):
-            lo, hi = a_ring_ptr[t], a_ring_ptr[t + 1]
-            bx0, by0, bx1, by1 = np.inf, np.inf, -np.inf, -np.inf
+        for q in range(max(m, 0)):
+            lo, hi = a_ring_ptr[near[q]], a_ring_ptr[near[q] + 1]
             for k in range(lo, hi):
-                bx0, by0 = min(bx0, a_pts[k, 0]), min(by0, a_pts[k, 1])
-                bx1, by1 = max(bx1, a_pts[k, 0]), max(by1, a_pts[k, 1])
-            if bx1 < lx0 or lx1 < bx0 or by1 < ly0 or ly1 < by0:
-                continue
-            for k in range(lo, hi):
-                m = k + 1 if k + 1 < hi else lo
-                if _segments_distance(p[0], p[1], ex, ey, a_pts[k, 0], a_pts[k, 1], a_pts[m, 0], a_pts[m, 1]) < strip:
+                e = k + 1 if k + 1 < hi else lo
+                if _segments_distance(p[0], p[1], ex, ey, a_pts[k, 0], a_pts[k, 1], a_pts[e, 0], a_pts[e, 1]) < strip:
                     hit = True
                     break
             if hit:
