@@ -105,7 +105,7 @@ def test_a_drawing_after_folding_split_a_piece_takes_what_it_can_from_the_planne
     deadline = Deadline.after(60)
     split = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), deadline, lambda *a: None)
     # as folding splits a piece it cannot fold: one crease of the last one cut
-    folded, _ = fold_pieces(_last_piece_cut(mesh, split.parts), opts, deadline, lambda *a: None, scale)
+    folded, _ = fold_pieces(_piece_cut(mesh, split.parts), opts, deadline, lambda *a: None, scale)
     assert not split.same_pieces(folded)
     tabs_before = len(split.memo["tabs"])
     sheets = lay_out(mesh, folded, scale, opts, w, h, deadline, lambda *a: None, planned=split)
@@ -131,17 +131,30 @@ def test_same_seed_same_pages(models_dir, tmp_path):
     assert a.report.stages.layout.pages == b.report.stages.layout.pages
 
 
-def _last_piece_cut(mesh, parts):
-    """The parts with their last piece cut along one crease near the middle of its tree."""
+def _piece_cut(mesh, parts, which: int = -1):
+    """The parts with one piece (index `which` among their pieces) cut along one crease near the
+    middle of its tree."""
     from polyfold.fabricate.split import PagePlan
     from polyfold.pipeline.sheets import _cut_plan, part_piece_inputs
 
     inputs = part_piece_inputs(mesh, parts)
-    net = inputs[-1].net
+    which %= len(inputs)
+    net = inputs[which].net
     creases = [f for f in range(len(net.parent)) if net.parent[f] >= 0 and net.cuttable[f]]
-    cuts = tuple(np.array([creases[len(creases) // 2]] if i == len(inputs) - 1 else [], dtype=np.int64)
+    cuts = tuple(np.array([creases[len(creases) // 2]] if i == which else [], dtype=np.int64)
                  for i in range(len(inputs)))
     return _cut_plan(parts, inputs, PagePlan(cuts, (), 0))[0]
+
+
+def _same_drawings(taken, fresh) -> None:
+    """Two `build_sheet_pieces` results are the same drawing."""
+    (pieces_a, glue_a, stats_a), (pieces_b, glue_b, stats_b) = taken, fresh
+    assert glue_a == glue_b and stats_a == stats_b
+    for p, q in zip(pieces_a, pieces_b, strict=True):
+        assert p.outline.equals_exact(q.outline, 0.0) and p.footprint.equals_exact(q.footprint, 0.0)
+        assert p.texts == q.texts
+        assert len(p.tabs) == len(q.tabs) and all(np.array_equal(a, b) for a, b in zip(p.tabs, q.tabs))
+        assert np.array_equal(p.leaders, q.leaders) and np.array_equal(p.tab_folds, q.tab_folds)
 
 
 def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_afresh(models_dir):
@@ -156,18 +169,39 @@ def test_drawings_that_take_tabs_and_labels_found_before_are_the_drawings_made_a
     first, _, _ = build_sheet_pieces(before, scale, memo=memo)
     # cut the last piece (the pieces before it keep their names and glue numbers: their labels can
     # be taken again)
-    after = part_piece_inputs(mesh, _last_piece_cut(mesh, fitted))
+    after = part_piece_inputs(mesh, _piece_cut(mesh, fitted))
     assert len(after) == len(before) + 1
     tabs_before, labels_before, outlines_before = len(memo["tabs"]), len(memo["labels"]), len(memo["outlines"])
-    taken, glue_taken, stats_taken = build_sheet_pieces(after, scale, memo=memo)
-    fresh, glue_fresh, stats_fresh = build_sheet_pieces(after, scale)
+    taken = build_sheet_pieces(after, scale, memo=memo)
+    fresh = build_sheet_pieces(after, scale)
     # the memo was used: fewer new entries than pairs and pieces drawn
-    assert len(memo["tabs"]) - tabs_before < stats_fresh.glue_edges
+    assert len(memo["tabs"]) - tabs_before < fresh[2].glue_edges
     assert len(memo["labels"]) - labels_before < len(after)
     assert len(memo["outlines"]) - outlines_before < len(after)
-    assert glue_taken == glue_fresh and stats_taken == stats_fresh
-    for p, q in zip(taken, fresh, strict=True):
-        assert p.outline.equals_exact(q.outline, 0.0) and p.footprint.equals_exact(q.footprint, 0.0)
-        assert p.texts == q.texts
-        assert len(p.tabs) == len(q.tabs) and all(np.array_equal(a, b) for a, b in zip(p.tabs, q.tabs))
-        assert np.array_equal(p.leaders, q.leaders) and np.array_equal(p.tab_folds, q.tab_folds)
+    _same_drawings(taken, fresh)
+
+
+def test_labels_found_before_are_taken_again_renamed_where_a_cut_renumbered_them(models_dir, monkeypatch):
+    """A cut in an early piece renames the pieces after it and renumbers the glue edges after its
+    new one: a piece whose labels were placed before with texts as wide (`labels.width_key`) takes
+    them again, renamed, and the drawing is the one made afresh."""
+    import polyfold.fabricate.pieces as pieces_module
+    from polyfold.pipeline.sheets import part_piece_inputs
+
+    mesh, opts, scale, w, h, fitted = fitted_parts(models_dir, "bunny-348")
+    memo: dict = {}
+    build_sheet_pieces(part_piece_inputs(mesh, fitted), scale, memo=memo)
+    after = part_piece_inputs(mesh, _piece_cut(mesh, fitted, 2))
+    renamed = []
+    original = pieces_module._renamed
+
+    def counted(texts_then, placed, texts):
+        got = original(texts_then, placed, texts)
+        if got is not None and texts != texts_then:
+            renamed.append((texts_then, texts))
+        return got
+
+    monkeypatch.setattr(pieces_module, "_renamed", counted)
+    taken = build_sheet_pieces(after, scale, memo=memo)
+    assert renamed  # (bunny-348's third piece cut: two pieces' labels are taken again under new texts)
+    _same_drawings(taken, build_sheet_pieces(after, scale))

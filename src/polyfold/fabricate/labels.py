@@ -97,6 +97,15 @@ def text_width(text: str, size: float) -> float:
     return float(stringWidth(text, "Helvetica", size))
 
 
+def width_key(text: str) -> int | str:
+    """All that a label's place depends on of its text, as a dict key: every test of a spot sees
+    the text only as a `text_width` box, so the sum of its glyphs' advance widths where
+    `text_width` sums them (ASCII; glue numbers are digits, all as wide in Helvetica), else the
+    text itself."""
+    widths = _ascii_widths()
+    return sum(map(widths.__getitem__, text)) if all(c in widths for c in text) else text
+
+
 @functools.lru_cache(maxsize=1)
 def _ascii_widths() -> dict[str, int]:
     """Helvetica's advance widths (1/1000 em) of the printable ASCII characters, from reportlab's

@@ -19,7 +19,7 @@ from ..deadline import Deadline
 from ..mesh.geometry import FLAT_EPS, merged_edges  # flat creases are not scored, as in the FOLD files
 from ..mesh.mesh import Mesh
 from ..unfold.net import Net
-from .labels import LABEL_PAD_MM, LabelStats, PieceLabels, label_font, piece_name, text_box, text_width
+from .labels import LABEL_PAD_MM, LabelStats, PieceLabels, label_font, piece_name, text_box, text_width, width_key
 from .page import TextItem, upright
 from .paper import MIN_LABEL_MM
 from .tabs import CutSide, Room, Tab, choose_tab, full_depth, tab_key
@@ -398,8 +398,10 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     placed on its own, in the order of the runs; with PARALLEL_LABELS or more labels, pieces are
     placed in processes forked from this one (`processes.fork_map`, the most labels first): the
     same labels in the same places whatever the number of processes. `memo` keeps every piece's
-    labels by all they depend on (its room's key, name, cut sides, font size, and its labels'
-    texts and sides with their tabs, in order): a piece met again is not placed again.
+    labels by all they depend on (its room's key, cut sides, font size, and its labels' sides
+    with their tabs, in order; of its name and labels' texts, only their widths, `width_key`): a
+    piece met again is not placed again, its texts renamed where they differ (a cut elsewhere
+    renumbers the glue edges after it and renames the pieces after it).
     shape(i, off-face geometries), when given, is asked of every piece placed, where it was placed
     (the piece's outline, which waits for its labels: made beside the other pieces' labels), and
     kept with them; it may depend on nothing but the piece's room and those geometries."""
@@ -430,18 +432,20 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
         return _Placed(labels.items, labels.outside, labels.leaders, labels.crowded, labels.stats,
                        None if shape is None else shape(i, labels.outside))
 
-    keys = [None if memo is None else _labels_key(drawn[i], i, rooms[i], size, all_or_none, jobs[i])
+    texts = [(piece_name(i), *(text for text, _copy in jobs[i])) for i in range(len(drawn))]
+    keys = [None if memo is None else _labels_key(drawn[i], rooms[i], size, all_or_none, texts[i], jobs[i])
             for i in range(len(drawn))]
-    order = sorted((i for i in range(len(drawn)) if memo is None or keys[i] not in memo), key=lambda i: -len(jobs[i]))
+    placed: list[_Placed | None] = [None if memo is None or k not in memo else _renamed(*memo[k], texts[i])
+                                    for i, k in enumerate(keys)]
+    order = sorted((i for i in range(len(drawn)) if placed[i] is None), key=lambda i: -len(jobs[i]))
     n_labels = sum(len(jobs[i]) for i in order)
     done = fork_map(place, order, usable_cores() if n_labels >= PARALLEL_LABELS else 1)
     if failed.value or any(p is None for p in done):
         return None
-    placed: list[_Placed] = [None if memo is None else memo.get(k) for k in keys]  # type: ignore[misc]
     for i, p in zip(order, done):
         placed[i] = p
         if memo is not None:
-            memo[keys[i]] = p
+            memo[keys[i]] = (texts[i], p)
     stats = LabelStats()
     for p in placed:
         stats.on_tabs += p.stats.on_tabs
@@ -451,13 +455,28 @@ def _labels(pairs, drawn: list[_Drawn], rooms: list[Room], chosen: list[Tab | No
     return placed, stats
 
 
-def _labels_key(d: _Drawn, i: int, room: Room, size: float, all_or_none: bool,
+def _labels_key(d: _Drawn, room: Room, size: float, all_or_none: bool, texts: tuple[str, ...],
                 jobs: list[tuple[str, list]]) -> tuple:
-    """All that `_labels` places piece i's labels from (see there), as a dict key."""
-    copies = tuple((text, tuple((side.key(), tuple(np.asarray(p).tobytes() for p in polys),
-                                 None if folds is None else np.asarray(folds).tobytes())
-                                for side, polys, folds in copy)) for text, copy in jobs)
-    return (room.key, piece_name(i), size, all_or_none, tuple(side.key() for _key, side in d.sides), copies)
+    """All that `_labels` places a piece's labels from (see there), as a dict key; texts: its
+    name, then its labels' texts (jobs' order)."""
+    copies = tuple(tuple((side.key(), tuple(np.asarray(p).tobytes() for p in polys),
+                          None if folds is None else np.asarray(folds).tobytes())
+                         for side, polys, folds in copy) for _text, copy in jobs)
+    return (room.key, size, all_or_none, tuple(side.key() for _key, side in d.sides), tuple(map(width_key, texts)),
+            copies)
+
+
+def _renamed(texts_then: tuple[str, ...], placed: _Placed, texts: tuple[str, ...]) -> _Placed | None:
+    """A piece's labels placed with texts_then (`_labels_key`'s texts), their texts now `texts`
+    (as wide: the same places); None where the two do not pair off one to one (to be placed
+    anew)."""
+    if texts == texts_then:
+        return placed
+    new = dict(zip(texts_then, texts))
+    if (len(new) != len(set(new.values())) or any(new[a] != b for a, b in zip(texts_then, texts))
+            or any(t.text not in new for t in placed.items)):
+        return None
+    return replace(placed, items=[replace(t, text=new[t.text]) for t in placed.items])
 
 
 def _run_copies(run: list[int], pairs, chosen: list[Tab | None]) -> list[list[tuple]]:
