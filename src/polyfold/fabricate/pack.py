@@ -47,6 +47,10 @@ _QUAD_SEGS = 4  # arcs of the grown outline: 4 segments per quarter circle
 _TOL = 1e-9  # mm: float noise allowed by check_packing
 ANGLES = 16  # rotations tried per piece (every 22.5 degrees), plus its minimum-rectangle ones
 ORDER_TRIES = 2  # piece orders pack_outlines fills: a caller's hint, then larger first
+# from this many outlines on, pack_outlines fills its second order in a forked process while this
+# one fills the first (a 1,500-face model's 190-270 outlines: 0.18-0.35 s a fill, on a core its
+# layout leaves idle here); a few dozen take milliseconds, less than the fork
+PARALLEL_PACK_OUTLINES = 100
 # outlines whose rasters a PageFiller keeps (least recently used dropped): page planning tries
 # hundreds of candidate parts, each up to ANGLES rasters (about 1 MB a part on a 1,280-face net,
 # where an unbounded cache reached 840 MB)
@@ -749,6 +753,18 @@ def _orders(areas: np.ndarray, rng: np.random.Generator, hint: list[int] | None)
     return out
 
 
+def _fill_ahead(pieces: list[_Piece], orders: list[list[int]], grid: _Grid, gap: float, deadline: float):
+    """A `processes.ForkedStream` of `_fill_pages` of the second of `orders`, begun now, while
+    `pack_outlines` fills the first (the same fill, from the same pieces, as the one made here
+    after it; killed unused when the first meets the bound); None where it would not pay
+    (PARALLEL_PACK_OUTLINES) or there is one order, one core or no fork."""
+    from ..processes import ForkedStream, can_fork, usable_cores
+
+    if len(orders) < 2 or len(pieces) < PARALLEL_PACK_OUTLINES or usable_cores() < 2 or not can_fork():
+        return None
+    return ForkedStream(lambda: iter([_fill_pages(pieces, orders[1], grid, gap, deadline)]))
+
+
 def pack_outlines(
     outlines: list[Polygon | MultiPolygon],
     page_size: tuple[float, float],
@@ -764,7 +780,8 @@ def pack_outlines(
     height mm) as the bottom-left fill finds, inside `margin` and at least `gap` apart. Raises
     PolyfoldError naming a piece (and the largest scale that fits) if one cannot fit an empty page.
     The order `hint` (piece indices) is filled first, then larger first (`_orders`; `tries` = 1:
-    only the first of them); the first with the fewest pages is kept. The same seed gives the same
+    only the first of them; the second is filled in a forked process meanwhile, `_fill_ahead`);
+    the first with the fewest pages is kept. The same seed gives the same
     packing; a seed other than 0 turns the tried rotations by a random phase. After `time_limit`
     seconds no further order is tried and the remaining pieces of the one being filled are
     shelf-packed onto new pages (`Packing.ran_out`)."""
@@ -785,18 +802,25 @@ def pack_outlines(
     bound = math.ceil(areas.sum() / (pw * ph) - 1e-9)  # no fewer pages can hold the area
     deadline = clock() + time_limit  # (the Deadline clock: compiling is not packing)
     best, best_pages, best_order, tried, ran_out = None, math.inf, [], 0, False
-    for order in _orders(areas, rng, hint)[:max(1, tries)]:
-        if tried and clock() > deadline:
-            ran_out = True
-            break
-        place, cut_short = _fill_pages(pieces, order, grid, gap, deadline)
-        tried += 1
-        ran_out |= cut_short
-        n_pages = max(pl.page for pl in place.values()) + 1
-        if n_pages < best_pages:
-            best, best_pages, best_order = place, n_pages, order
-        if best_pages <= bound:
-            break
+    orders = _orders(areas, rng, hint)[:max(1, tries)]
+    ahead = _fill_ahead(pieces, orders, grid, gap, deadline)
+    try:
+        for k, order in enumerate(orders):
+            if tried and clock() > deadline:
+                ran_out = True
+                break
+            got, filled = ahead.next() if ahead is not None and k == 1 else (False, None)
+            place, cut_short = filled if got else _fill_pages(pieces, order, grid, gap, deadline)
+            tried += 1
+            ran_out |= cut_short
+            n_pages = max(pl.page for pl in place.values()) + 1
+            if n_pages < best_pages:
+                best, best_pages, best_order = place, n_pages, order
+            if best_pages <= bound:
+                break
+    finally:
+        if ahead is not None:
+            ahead.close()
 
     placements = [best[i] for i in range(len(geoms))]
     # the grid argument is exact, but never hand out a packing that fails the independent check

@@ -10,12 +10,28 @@ from html import escape
 from .pdf import binary_streams
 from .sheet_style import MM_TO_PT
 
+
 def _image(pic, width_pt: float):
-    """A reportlab Image flowable of a guide Picture, width_pt wide."""
+    """A reportlab Image flowable of a guide Picture, width_pt wide: its JPEG, embedded as it is
+    (DCTDecode), and named by its bytes.
+
+    reportlab names every image it embeds (its XObject) by a digest of its reader's
+    `getRGBData()`, the decoded pixels: for a JPEG, embedded undecoded, that is a decode and a
+    hash of 200 KB a picture for the name alone, a third of a 1,500-face model's guide.pdf at the
+    end of its make. The flowable's reader here gives the JPEG's own bytes instead, which name
+    it as well (tests/formats/test_guide_pdf.py: every image embedded is its picture's JPEG)."""
+    from reportlab.lib.utils import ImageReader
     from reportlab.platypus import Image
 
+    class JpegReader(ImageReader):
+        def getRGBData(self) -> bytes:
+            return pic.jpeg
+
     h, w = pic.shape
-    return Image(io.BytesIO(pic.jpeg), width=width_pt, height=width_pt * h / w)
+    flowable = Image(io.BytesIO(pic.jpeg), width=width_pt, height=width_pt * h / w)
+    flowable._img = JpegReader(io.BytesIO(pic.jpeg))
+    flowable._img._dataA = None  # (no transparency mask, as getRGBData finds for a JPEG)
+    return flowable
 
 
 def _grid(pics, per_row: int, width_pt: float):
