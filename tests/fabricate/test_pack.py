@@ -223,6 +223,40 @@ def test_the_hint_goes_first_and_larger_first_is_kept_when_better(snakes):
     assert list(partial.order[:2]) == [3, 1] and sorted(partial.order) == list(range(len(snakes)))
 
 
+def test_the_second_order_filled_in_a_forked_process_gives_the_packing_filled_here(snakes, monkeypatch):
+    """From PARALLEL_PACK_OUTLINES outlines on, with two cores, the second order is filled in a
+    forked process while the first is filled here: the same packing as both filled here, whether
+    the first order misses the bound (40 mixed pieces: the forked fill is taken) or meets it (the
+    snakes: it is not)."""
+    import polyfold.fabricate.pack as pack
+    import polyfold.processes as processes
+
+    rng = np.random.default_rng(0)
+    mixed = [snake(rng, int(rng.integers(3, 10)), rng.uniform(6, 14)) for _ in range(30)]
+    mixed += [l_shape(*rng.uniform([40, 30, 8], [90, 80, 20])) for _ in range(10)]
+    monkeypatch.setattr(pack, "PARALLEL_PACK_OUTLINES", 1)
+    forked = []
+
+    class Counted(processes.ForkedStream):
+        def __init__(self, gen):
+            forked.append(1)
+            super().__init__(gen)
+
+    monkeypatch.setattr(processes, "ForkedStream", Counted)
+    for pieces, tried in ((mixed, 2), (snakes, 1)):
+        smaller_first = sorted(range(len(pieces)), key=lambda i: pieces[i].area)
+        got = {}
+        for cores in (1, 2):
+            monkeypatch.setattr(processes, "usable_cores", lambda cores=cores: cores)
+            got[cores] = pack_outlines(pieces, A4, gap=2.0, seed=4, hint=smaller_first)
+        one, two = got[1], got[2]
+        assert one.orders_tried == two.orders_tried == tried
+        assert (one.n_pages, one.order, one.placements, one.ran_out) == (two.n_pages, two.order, two.placements,
+                                                                         two.ran_out)
+        assert_valid(pieces, two, 2.0)
+    assert forked == [1, 1]  # (with two cores only)
+
+
 def test_page_filler_puts_outlines_where_pack_outlines_does(snakes):
     order = list(np.random.default_rng(5).permutation(len(snakes)))
     packing = pack_outlines(snakes, A4, margin=10.0, gap=2.0, seed=3, hint=order, tries=1)
