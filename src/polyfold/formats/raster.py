@@ -25,10 +25,12 @@ def part_colors(n: int, saturation: float = 0.65, value: float = 0.92) -> np.nda
 
 
 @njit(cache=True)
-def _zindex(index, zbuf, tri, depth):
+def _zindex(index, zbuf, tri, depth, ids):
     """Rasterise 2D pixel-space triangles tri (n, 3, 2) with corner depths (n, 3) (smaller is
-    nearer): where a triangle covers a pixel's centre nearer than zbuf (H, W) says, index (H, W)
-    int64 gets its number and zbuf its depth, in place (a tie keeps the triangle drawn first)."""
+    nearer) over index (H, W) int64 and zbuf (H, W), in place: where a triangle covers a pixel's
+    centre nearer than zbuf says, or as near with a smaller id, index gets its id (ids (n,)) and
+    zbuf its depth. So each pixel ends with the nearest triangle, ties to the smallest id, in
+    whatever order and batches the triangles come."""
     H, W = zbuf.shape
     for t in range(tri.shape[0]):
         ax, ay = tri[t, 0, 0], tri[t, 0, 1]
@@ -42,6 +44,7 @@ def _zindex(index, zbuf, tri, depth):
         y0 = max(0, int(math.floor(min(ay, by, cy))))
         y1 = min(H - 1, int(math.ceil(max(ay, by, cy))))
         inv = 1.0 / area2
+        own = ids[t]
         for py in range(y0, y1 + 1):
             yy = py + 0.5
             for px in range(x0, x1 + 1):
@@ -52,19 +55,22 @@ def _zindex(index, zbuf, tri, depth):
                 if w0 < -1e-9 or w1 < -1e-9 or w2 < -1e-9:
                     continue
                 z = w0 * depth[t, 0] + w1 * depth[t, 1] + w2 * depth[t, 2]
-                if z < zbuf[py, px]:
+                if z < zbuf[py, px] or (z == zbuf[py, px] and own < index[py, px]):
                     zbuf[py, px] = z
-                    index[py, px] = t
+                    index[py, px] = own
 
 
-def triangle_index(shape: tuple[int, int], tris: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(index (H, W) int64, the nearest triangle at each pixel centre, -1 where none; depth (H, W),
-    inf where none) of 2D pixel-space triangles tris (n, 3, 2) with corner depths (n, 3)."""
-    index = np.full(shape, -1, dtype=np.int64)
-    zbuf = np.full(shape, np.inf)
+def triangle_index(shape: tuple[int, int], tris: np.ndarray, depth: np.ndarray, ids: np.ndarray | None = None,
+                   into: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(index (H, W) int64, the nearest triangle at each pixel centre (ties: the smaller id), -1
+    where none; depth (H, W), inf where none) of 2D pixel-space triangles tris (n, 3, 2) with
+    corner depths (n, 3). ids (n,): the triangles' numbers in index (default 0..n-1). into: the
+    (index, depth) of triangles drawn before, drawn over in place and returned (the same as
+    drawing all at once)."""
+    index, zbuf = into if into is not None else (np.full(shape, -1, dtype=np.int64), np.full(shape, np.inf))
     if len(tris):
-        _zindex(index, zbuf, np.ascontiguousarray(tris, dtype=np.float64),
-                np.ascontiguousarray(depth, dtype=np.float64))
+        _zindex(index, zbuf, np.ascontiguousarray(tris, dtype=np.float64), np.ascontiguousarray(depth, dtype=np.float64),
+                np.arange(len(tris), dtype=np.int64) if ids is None else np.ascontiguousarray(ids, dtype=np.int64))
     return index, zbuf
 
 

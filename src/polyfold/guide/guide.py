@@ -183,8 +183,9 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
     """The guide (see the module docstring). pieces: the sheets' pieces (net pieces first, in
     the order of `folded`, then glue strips); glue: the seams; pages: 0-based page per piece;
     scale: mm per model unit. The steps and their views are planned in order (a view changes
-    only when it must); the pictures, which depend on their step alone, are then drawn, from
-    PARALLEL_PICTURES faces x steps in processes forked from this one."""
+    only when it must); the pictures, which depend on their step alone, are then drawn (runs of
+    steps seen from one view together: `_step_chunks`), from PARALLEL_PICTURES faces x steps in
+    processes forked from this one."""
     from ..processes import fork_map, usable_cores
 
     t0 = time.perf_counter()
@@ -212,9 +213,9 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
         placed_faces.append(placed)
 
     def draw(item: tuple[str, int]):
-        """One job of pictures: ("sides", -1) the model's, ("sides", k) part k's, ("step", n) step n's
-        picture and its instructions (with the folding pictures of its piece); every picture
-        encoded (`Picture.encoded`), on the core that drew it."""
+        """One job of pictures: ("sides", -1) the model's, ("sides", k) part k's, ("steps", k) the
+        pictures of the steps of chunks[k] and their instructions (with the folding pictures of
+        their pieces); every picture encoded (`Picture.encoded`), on the core that drew it."""
         kind, k = item
         if kind == "sides" and k < 0:
             return tuple(p.encoded() for p in _sides(mesh, tris, np.arange(mesh.n_faces), face_piece, palette, pieces,
@@ -223,22 +224,29 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
             inside = [i for i in range(n_net) if pieces[i].part == k]
             return tuple(p.encoded() for p in _sides(mesh, tris, np.flatnonzero(np.isin(face_piece, inside)),
                                                      face_piece, palette, pieces, pages, PART_PX, f"part {k + 1}"))
-        st = plan.steps[k]
-        picture = _step_picture(mesh, tris, placed_faces[k], face_piece, palette, st, seams, glue, rotations[views[k]],
-                                k + 1)
-        lines, notes, folding = _instructions(st, seams, pieces, pages, folded, paths, palette)
-        return picture.encoded(), (lines, notes, tuple(p.encoded() for p in folding))
+        group = chunks[k]  # ("steps", k): the steps of chunks[k], seen from one view
+        pictures = _step_pictures(mesh, tris, [placed_faces[n] for n in group], face_piece, palette,
+                                  [plan.steps[n] for n in group], seams, glue, rotations[views[group[0]]],
+                                  [n + 1 for n in group])
+        out = []
+        for n, picture in zip(group, pictures):
+            lines, notes, folding = _instructions(plan.steps[n], seams, pieces, pages, folded, paths, palette)
+            out.append((picture.encoded(), (lines, notes, tuple(p.encoded() for p in folding))))
+        return out
 
+    chunks = _step_chunks(views, placed_faces)
     jobs = ([("sides", -1)] + ([("sides", k) for k in part_ids] if len(part_ids) > 1 else [])
-            + [("step", n) for n in range(len(plan.steps))])
+            + [("steps", k) for k in range(len(chunks))])
     workers = usable_cores() if mesh.n_faces * len(plan.steps) >= PARALLEL_PICTURES else 1
     drawn = fork_map(draw, jobs, workers)
-    overview, parts_pics = drawn[0], tuple(drawn[1:len(jobs) - len(plan.steps)])
+    overview, parts_pics = drawn[0], tuple(drawn[1:len(jobs) - len(chunks)])
+    by_step = {n: one for group, got in zip(chunks, drawn[len(jobs) - len(chunks):]) for n, one in zip(group, got)}
+    drawn = [by_step[n] for n in range(len(plan.steps))]
     runs: dict[str, list[int]] = {}
     for k, g in enumerate(glue):
         runs.setdefault(g.printed, []).append(k)
     steps = []
-    for n, (st, (picture, (lines, notes, folding))) in enumerate(zip(plan.steps, drawn[len(jobs) - len(plan.steps):])):
+    for n, (st, (picture, (lines, notes, folding))) in enumerate(zip(plan.steps, drawn, strict=True)):
         done_runs, glue_lines, labels, strips = set(), [], [], []
         for k in st.seams:
             labels.append(glue[k].label)
@@ -266,6 +274,26 @@ def build_guide(mesh: Mesh, pieces, glue, pages: list[int], folded, scale: float
                                strips=tuple(strips)))
     return Guide(overview=overview, parts=parts_pics, steps=tuple(steps), plan=plan,
                  seconds=time.perf_counter() - t0)
+
+
+# steps whose pictures one job draws at most (`_step_chunks`): their faces are drawn once for all of
+# them, so more save drawing, fewer share the steps out between the two cores more evenly
+STEP_CHUNK = 8
+
+
+def _step_chunks(views: list[int], placed: list[np.ndarray]) -> list[list[int]]:
+    """The steps in groups of at most STEP_CHUNK seen from one view, in order (the steps of a view
+    need not follow one another: a model's steps turn between a dozen views), each step's placed
+    faces holding the last's (`_step_pictures`); every step in one group."""
+    out: list[list[int]] = []
+    open_group: dict[int, list[int]] = {}  # view: its group being filled
+    for k, view in enumerate(views):
+        group = open_group.get(view)
+        if group is None or len(group) >= STEP_CHUNK or not np.isin(placed[group[-1]], placed[k]).all():
+            group = open_group[view] = []
+            out.append(group)
+        group.append(k)
+    return out
 
 
 def _sides(mesh: Mesh, tris: np.ndarray, faces: np.ndarray, face_piece: np.ndarray, palette: np.ndarray, pieces,
@@ -319,16 +347,29 @@ def _best_view(tris: np.ndarray, placed: np.ndarray, focus: np.ndarray, rotation
     return best
 
 
-def _step_picture(mesh: Mesh, tris: np.ndarray, placed: np.ndarray, face_piece: np.ndarray, palette: np.ndarray,
-                  st, seams: list[Seam], glue, rotation: np.ndarray, number: int) -> Picture:
-    """The model after a step: the new piece (or the pieces glued) in full colour, the rest
-    lighter, the model still to come faint, this step's seams dark with their labels."""
+def _step_pictures(mesh: Mesh, tris: np.ndarray, placed: list[np.ndarray], face_piece: np.ndarray,
+                   palette: np.ndarray, steps: list, seams: list[Seam], glue, rotation: np.ndarray,
+                   numbers: list[int]) -> list[Picture]:
+    """`_step_picture` of steps (numbered `numbers`) seen from one `rotation` whose placed faces
+    grow (each holding the last), their faces drawn once for all of them
+    (`pictures.growing_face_ids`)."""
     cam = P.fit_camera(tris, rotation, *STEP_PX)
+    return [_step_picture(mesh, tris, faces, face_piece, palette, st, seams, glue, cam, raster, number)
+            for faces, st, raster, number in zip(placed, steps, P.growing_face_ids(cam, tris, placed), numbers)]
+
+
+def _step_picture(mesh: Mesh, tris: np.ndarray, placed: np.ndarray, face_piece: np.ndarray, palette: np.ndarray,
+                  st, seams: list[Seam], glue, cam, raster: tuple[np.ndarray, np.ndarray, np.ndarray],
+                  number: int) -> Picture:
+    """The model after a step: the new piece (or the pieces glued) in full colour, the rest
+    lighter, the model still to come faint, this step's seams dark with their labels. cam: the
+    step's camera (`fit_camera` of the whole model, STEP_PX); raster: the placed faces' ids and
+    depths and the ghost's cover (`pictures.growing_face_ids`)."""
     involved = {st.piece} if st.piece is not None else {q for k in st.seams for q in seams[k].pieces}
     own = face_piece[placed]
     front = np.where(np.isin(own, list(involved))[:, None], palette[own], P.lighter(palette[own], 0.6))
-    ghost = np.setdiff1d(np.arange(mesh.n_faces), placed)
-    img, ids, zbuf = P.draw_faces(cam, tris[placed], front, np.full_like(front, P.INSIDE_RGB), tris[ghost])
+    ids, zbuf, ghost = raster
+    img = P.paint_faces(cam, tris[placed], front, np.full_like(front, P.INSIDE_RGB), ids, ghost)
     segs = np.array([mesh.vertices[list(seams[k].mesh_edge)] for k in st.seams]).reshape(-1, 2, 3)
     seen = P.draw_lines(img, cam, zbuf, segs, P.SEAM_RGB, width=3.0)
     texts, shown = [], set()

@@ -105,16 +105,54 @@ def draw_faces(cam: Camera, tris: np.ndarray, front: np.ndarray, back: np.ndarra
     (back: their other side); ghost (G, 3, 3): triangles drawn faintly only where nothing else is
     (the model not built yet)."""
     ids, zbuf = face_ids(cam, tris)
+    covered = face_ids(cam, ghost)[0] >= 0 if ghost is not None and len(ghost) else None
+    return paint_faces(cam, tris, front, back, ids, covered), ids, zbuf
+
+
+def paint_faces(cam: Camera, tris: np.ndarray, front: np.ndarray, back: np.ndarray | None, ids: np.ndarray,
+                ghost: np.ndarray | None) -> np.ndarray:
+    """`draw_faces`' image from the faces' ids (`face_ids` of tris) and where the ghost covers
+    the picture ((H, W) bool, or None)."""
     # one gather from a colour table: the faces, then the ghost, then the background
     table = np.empty((len(tris) + 2, 3), dtype=np.uint8)
     table[-2], table[-1] = GHOST_RGB, BACKGROUND
     if len(tris):
         table[:-2] = shaded(cam, tris, front, back)
     pick = np.where(ids >= 0, ids, len(tris) + 1)
-    if ghost is not None and len(ghost):
-        gids, _ = face_ids(cam, ghost)
-        pick[(gids >= 0) & (ids < 0)] = len(tris)
-    return table[pick], ids, zbuf
+    if ghost is not None:
+        pick[ghost & (ids < 0)] = len(tris)
+    return table[pick]
+
+
+def growing_face_ids(cam: Camera, tris: np.ndarray, placed: list[np.ndarray]
+                     ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """For growing sets of faces (placed[k] ascending indices into tris (F, 3, 3), each holding
+    the one before): per set, `face_ids` of tris[placed[k]] (ids into the set, depth) and where
+    the other faces cover the picture ((H, W) bool), as `draw_faces`
+    of the set with the others as its ghost has them, pixel for pixel. Each face is drawn twice
+    in all instead of once per set: the sets' depths drawn over one another as they grow (the
+    nearest face wins, ties to the smaller index: as drawing a set at once), the others' cover
+    gathered from the last set back."""
+    shape = (cam.height, cam.width)
+    px, depth = cam.project(tris)  # (the same numbers as projecting any subset: row by row)
+    out: list = []
+    drawn, before = None, np.zeros(0, dtype=np.int64)
+    local = np.full(len(tris) + 1, -1, dtype=np.int64)  # face -> its index in the set; [-1]: the background's -1
+    for faces in placed:
+        new = np.setdiff1d(faces, before, assume_unique=True)
+        drawn = triangle_index(shape, px[new], depth[new], new, into=drawn)  # (drawn over in place)
+        local[faces] = np.arange(len(faces))
+        out.append((local[drawn[0]], drawn[1].copy()))
+        before = faces
+    rest = np.setdiff1d(np.arange(len(tris)), before, assume_unique=True)
+    cover = triangle_index(shape, px[rest], depth[rest])[0] >= 0
+    covers: list = [None] * len(placed)
+    for k in range(len(placed) - 1, -1, -1):
+        covers[k] = cover.copy()  # (all False where no face is left: no ghost, as draw_faces without one)
+        if k:
+            added = np.setdiff1d(placed[k], placed[k - 1], assume_unique=True)
+            cover |= triangle_index(shape, px[added], depth[added])[0] >= 0
+    return [(ids, zbuf, covered) for (ids, zbuf), covered in zip(out, covers)]
 
 
 def draw_lines(img: np.ndarray, cam: Camera, zbuf: np.ndarray | None, segs: np.ndarray, color, width: float = 2.5,
