@@ -397,6 +397,28 @@ def test_page_filler_keeps_a_bounded_raster_cache() -> None:
     assert len(filler._pieces) == pack.RASTER_CACHE_PIECES
 
 
+def test_pieces_are_kept_by_their_bytes_and_one_asked_again_is_the_one_kept(monkeypatch) -> None:
+    """`_piece` keeps the pieces it made (a make packs its outlines again after every plan) while
+    their estimated bytes stay under RASTER_CACHE_BYTES, the least recently used dropped first; an
+    outline asked again while kept gets the very piece, after it was dropped an equal one."""
+    from polyfold.fabricate import pack
+
+    monkeypatch.setattr(pack, "_pieces_kept", type(pack._pieces_kept)())
+    monkeypatch.setattr(pack, "_pieces_held", [0])
+    grid = pack._grid(190.0, 277.0, 10.0, 2.0)
+    outlines = [box(0, 0, 10 + (i % 37), 8 + (i % 23)) for i in range(200)]
+    sizes = [pack._piece_bytes(pack._new_piece(g, 8, 0.0, grid)[0]) for g in outlines]
+    monkeypatch.setattr(pack, "RASTER_CACHE_BYTES", sum(sizes[-50:]))  # room for the last 50 or so
+    made = [pack._piece(g, 8, 0.0, grid) for g in outlines]
+    assert pack._pieces_held[0] == sum(b for _, b in pack._pieces_kept.values()) <= pack.RASTER_CACHE_BYTES
+    assert 40 <= len(pack._pieces_kept) < 200
+    assert pack._piece(outlines[-1], 8, 0.0, grid) is made[-1]  # (kept)
+    again = pack._piece(box(0, 0, 10, 8), 8, 0.0, grid)  # outlines[0] (dropped): made again, equal
+    assert again is not made[0]
+    assert [again[0].shape(k).runs.tolist() for k in range(len(again[0].degs))] == [
+        made[0][0].shape(k).runs.tolist() for k in range(len(made[0][0].degs))]
+
+
 def test_points_hull_is_shapelys_hull_of_the_points():
     """`points_hull` (the compiled monotone chain, then shapely on its corners only) gives the same
     geometry as shapely's hull of all the points: random clouds, rounded ones (duplicates, several
