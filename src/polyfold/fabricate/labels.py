@@ -88,10 +88,10 @@ def text_width(text: str, size: float) -> float:
     """Printed width (mm) of `text` at font `size` (mm) in Helvetica, the font of the PDF and the
     first of the SVG's (Arial, the usual stand-in, has the same widths): the advance widths of
     the font's metrics as reportlab, which draws the PDF, has them (its stringWidth: the same
-    float; ASCII text from its width table, `_ascii_widths`)."""
-    widths = _ascii_widths()
-    if all(c in widths for c in text):
-        return sum(map(widths.__getitem__, text)) * 0.001 * size  # (as stringWidth sums and scales)
+    float; ASCII text from its width table, `_ascii_widths`: `width_key`)."""
+    summed = width_key(text)
+    if isinstance(summed, int):
+        return summed * 0.001 * size  # (as stringWidth sums and scales)
     from reportlab.pdfbase.pdfmetrics import stringWidth
 
     return float(stringWidth(text, "Helvetica", size))
@@ -99,9 +99,9 @@ def text_width(text: str, size: float) -> float:
 
 def width_key(text: str) -> int | str:
     """All that a label's place depends on of its text, as a dict key: every test of a spot sees
-    the text only as a `text_width` box, so the sum of its glyphs' advance widths where
-    `text_width` sums them (ASCII; glue numbers are digits, all as wide in Helvetica), else the
-    text itself."""
+    the text only as a `text_width` box, so the sum of its glyphs' advance widths (1/1000 em)
+    where `text_width` sums them (ASCII; glue numbers are digits, all as wide in Helvetica), else
+    the text itself."""
     widths = _ascii_widths()
     return sum(map(widths.__getitem__, text)) if all(c in widths for c in text) else text
 

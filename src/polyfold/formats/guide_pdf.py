@@ -4,6 +4,7 @@ same), then the build steps, each with its picture, its folding pictures and wha
 
 from __future__ import annotations
 
+import functools
 import io
 from html import escape
 
@@ -20,18 +21,26 @@ def _image(pic, width_pt: float):
     hash of 200 KB a picture for the name alone, a third of a 1,500-face model's guide.pdf at the
     end of its make. The flowable's reader here gives the JPEG's own bytes instead, which name
     it as well (tests/formats/test_guide_pdf.py: every image embedded is its picture's JPEG)."""
-    from reportlab.lib.utils import ImageReader
     from reportlab.platypus import Image
-
-    class JpegReader(ImageReader):
-        def getRGBData(self) -> bytes:
-            return pic.jpeg
 
     h, w = pic.shape
     flowable = Image(io.BytesIO(pic.jpeg), width=width_pt, height=width_pt * h / w)
-    flowable._img = JpegReader(io.BytesIO(pic.jpeg))
+    flowable._img = _jpeg_reader()(io.BytesIO(pic.jpeg))
     flowable._img._dataA = None  # (no transparency mask, as getRGBData finds for a JPEG)
     return flowable
+
+
+@functools.lru_cache(maxsize=1)
+def _jpeg_reader() -> type:
+    """reportlab's ImageReader of a JPEG whose `getRGBData` gives the file's bytes (`_image`): a
+    class made once, when reportlab is first needed here."""
+    from reportlab.lib.utils import ImageReader
+
+    class JpegReader(ImageReader):
+        def getRGBData(self) -> bytes:
+            return self.fp.getvalue()  # (the JPEG: reportlab reads files into memory, BytesIO)
+
+    return JpegReader
 
 
 def _grid(pics, per_row: int, width_pt: float):
