@@ -24,13 +24,14 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
     sigs = kernel_signatures()  # (entry points: a kernel called only from compiled code is linked into its caller)
     for kernel in ("unfold.kernels.local_search", "unfold.kernels.evaluate_batch", "fold.checker.segment_free",
                    "segment.merge_kernels.merge_run", "fabricate.pack._scan", "inflate.kernels.run_steps",
-                   "unfold.tabroom._swap_gains", "fabricate.labels._clear_leaders", "fabricate.labels._grid_bfs",
+                   "unfold.tabroom._swap_gains", "fabricate.labels._clear_near", "fabricate.labels._grid_bfs",
                    "fabricate.overlap_kernels.blocked_by", "fabricate.overlap_kernels.grown_box_meets",
                    "fabricate.overlap_kernels.first_clear_box", "fabricate.overlap_kernels.first_box_in_triangle",
                    "fabricate.overlap_kernels.first_leader_spot",
                    "fabricate.overlap_kernels.first_unblocked", "fabricate.overlap_kernels.overlap_area",
                    "fabricate.labels._path_back", "fabricate.labels._path_turns", "fabricate.labels._refresh_free",
-                   "fabricate.pack.mark_rings", "fabricate.overlap_kernels.grown_box_apart",
+                   "fabricate.pack.mark_rings", "fabricate.pack.mark_polygons",
+                   "fabricate.overlap_kernels.grown_box_apart",
                    "unfold.kernels.crease_bfs", "unfold.kernels.place_children", "fabricate.labels._dilated",
                    "fabricate.labels._enclosed"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"

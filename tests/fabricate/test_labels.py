@@ -277,9 +277,11 @@ def test_text_boxes_are_their_corners_at_each_centre():
 
 def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
     """The raster search of `PieceLabels._elsewhere`: the summed-area test of free boxes
-    (`_box_free`) and the free cells near a point (`_free_cells_near`) against numpy's
-    cumulative sums, nonzero and distances on random rasters, windows and points."""
-    from polyfold.fabricate.labels import FREE_CELL_MM, _box_free, _free_cells_near, _half_cells
+    (`_box_free`) against numpy's cumulative sums, and the free cells near a point with a clear
+    leader (`_clear_near`, ring by ring) against numpy: nonzero of the window, distances, a
+    stable argsort, the first LEADER_TRIES, the leader looked up at every point, the first
+    `want` clear; on random rasters, windows, points and limits."""
+    from polyfold.fabricate.labels import _RINGS2, FREE_CELL_MM, _box_free, _clear_near, _half_cells
 
     rng = np.random.default_rng(7)
     for _ in range(60):
@@ -295,21 +297,37 @@ def test_free_spot_kernels_give_numpys_cells_to_the_last_bit():
             want[hh:hh + count.shape[0], hw:hw + count.shape[1]] = count == 0
         assert np.array_equal(_box_free(taken, hw, hh), want)
 
-        free, other, in_faces = ~taken, rng.random((ny, nx)) < 0.6, rng.random((ny, nx)) < 0.5
+    t = np.linspace(0.0, 1.0, 9)
+    for trial in range(120):
+        # up to 300 x 300 cells (60 mm): rings cut across the window and beyond it
+        ny, nx = (int(v) for v in rng.integers(1, 300, 2))
+        free_a, free_b = (rng.random((ny, nx)) < rng.uniform(0.05, 0.9) for _ in range(2))
+        in_faces = rng.random((ny, nx)) < 0.5
+        texts = rng.random((ny, nx)) < rng.uniform(0.0, 0.02)
         origin = rng.uniform(-50, 50, 2)
-        p = origin + rng.uniform(0, 1, 2) * [nx, ny] * FREE_CELL_MM  # (over the raster)
+        p = origin + rng.uniform(-0.2, 1.2, 2) * [nx, ny] * FREE_CELL_MM  # (over the raster, or off it)
         r0, r1 = sorted(int(v) for v in rng.integers(0, ny, 2))
         c0, c1 = sorted(int(v) for v in rng.integers(0, nx, 2))
-        radius2 = float(rng.uniform(0.5, 10.0)) ** 2
-        got_centres, got_d2, counts = _free_cells_near(free, other, in_faces, r0, r1, c0, c1, origin, p, FREE_CELL_MM,
-                                                       radius2)
-        for q, (inside, layer) in enumerate([(True, free), (True, other), (False, free), (False, other)]):
+        tries, k = int(rng.choice([3, 40, 1000])), int(rng.choice([1, 5, 40]))
+        found = np.empty((4, (r1 - r0 + 1) * (c1 - c0 + 1), 3))
+        counts, ring_end = np.zeros(4, dtype=np.int64), np.zeros((4, len(_RINGS2)), dtype=np.int64)
+        scanned = np.zeros(1, dtype=np.int64)
+        for q in rng.permutation(4) if trial % 2 else range(4):  # (the rings are scanned once, for all four)
+            layer, inside = (free_a, free_b)[q % 2], q < 2
             rows, cols = np.nonzero(layer[r0:r1 + 1, c0:c1 + 1] & (in_faces[r0:r1 + 1, c0:c1 + 1] == inside))
             centres = origin + (np.stack([cols + c0, rows + r0], axis=1) + 0.5) * FREE_CELL_MM
             d2 = ((centres - p) ** 2).sum(axis=1)
-            near = np.flatnonzero(d2 <= radius2)
-            n = counts[q]
-            assert np.array_equal(got_centres[q, :n], centres[near]) and np.array_equal(got_d2[q, :n], d2[near])
+            near = np.flatnonzero(d2 <= _RINGS2[-1])
+            looked = centres[near[np.argsort(d2[near], kind="stable")]][:tries]
+            pts = p + t[None, :, None] * (looked - p)[:, None, :]
+            cell = np.clip(((pts - origin) * (1.0 / FREE_CELL_MM)).astype(np.int32), 0, [nx - 1, ny - 1])
+            expected = looked[~texts[cell[..., 1], cell[..., 0]].any(axis=1)][:k]
+            state, got = np.zeros(3, dtype=np.int64), []
+            while len(batch := _clear_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, FREE_CELL_MM, _RINGS2,
+                                           int(q), state, scanned, found, counts, ring_end, tries, texts, t, k)):
+                got.append(batch)
+            got = np.concatenate(got) if got else np.zeros((0, 2))
+            assert np.array_equal(got, expected)
 
 
 def test_bent_leader_kernels_give_the_python_rules_paths():

@@ -540,3 +540,38 @@ def test_mark_rings_sets_the_cells_inside_each_geometry_in_its_window():
         for g in geoms:
             inside |= shapely.contains_xy(g, c + 0.5, r + 0.5)
         assert np.array_equal(grid, before | inside)
+
+
+def test_mark_polygons_marks_what_mark_rings_marks_on_two_rasters():
+    """The labels' raster marks polygons without holes in one pass (`mark_polygons`: a label box,
+    leader strip or off-face label, grown): on a grid and its texts layer of a raster offset from
+    the origin, in cells of 0.2 mm, the same cells and windows as `ring_edges` and `mark_rings`
+    of each layer's polygons, bounds truncated to cells and clipped as `labels._Taken._cells`
+    clips them (polygons reaching past the raster too)."""
+    import shapely
+
+    from polyfold.fabricate.pack import mark_polygons, mark_rings, ring_edges
+
+    rng = np.random.default_rng(11)
+    cell, origin = 0.2, np.array([-3.7, 12.1])
+    ny, nx = 70, 90
+    for _ in range(40):
+        grid, texts = rng.random((ny, nx)) < 0.05, rng.random((ny, nx)) < 0.05
+        k = int(rng.integers(1, 7))
+        geoms = np.array([shapely.Polygon(origin + rng.uniform(-1, [nx * cell + 1, ny * cell + 1], (4, 2))).convex_hull
+                          .buffer(rng.uniform(0.1, 0.6), quad_segs=2) for _ in range(k)], dtype=object)
+        to_texts = rng.random(k) < 0.5
+        bounds = shapely.bounds(geoms)
+        ij = np.clip(((bounds.reshape(-1, 2) - origin) * (1.0 / cell)).astype(np.int32), 0, [nx - 1, ny - 1])
+        ij = ij.reshape(-1, 4)
+        windows = np.stack([ij[:, 1], ij[:, 3], ij[:, 0], ij[:, 2]], axis=1).astype(np.int64)
+        want_grid, want_texts = grid.copy(), texts.copy()
+        for target, chosen in ((want_grid, ~to_texts), (want_texts, to_texts)):
+            if chosen.any():
+                p0, p1, owner = ring_edges(geoms[chosen])
+                start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
+                mark_rings(target, (p0 - origin) * (1.0 / cell), (p1 - origin) * (1.0 / cell), start, windows[chosen])
+        xy, owner = shapely.get_coordinates(geoms, return_index=True)
+        got = mark_polygons(grid, texts, xy, owner, bounds, to_texts, origin, 1.0 / cell)
+        assert np.array_equal(got, windows)
+        assert np.array_equal(grid, want_grid) and np.array_equal(texts, want_texts)

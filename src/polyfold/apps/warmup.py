@@ -94,21 +94,25 @@ def _warm_make(mesh) -> None:
 def _warm_crowded_labels() -> None:
     """The label kernels that only crowded pieces reach (the warm-up's sphere has room for every
     label beside its edge), with the argument types `labels._Taken` gives them."""
-    from ..fabricate.labels import (_box_free, _clear_leaders, _dilated, _enclosed, _free_cells_near, _grid_bfs,
-                                    _path_back, _path_turns, _refresh_free)
-    from ..fabricate.pack import mark_rings
+    from ..fabricate.labels import (_RINGS2, _box_free, _clear_near, _dilated, _enclosed, _grid_bfs, _path_back,
+                                    _path_turns, _refresh_free)
+    from ..fabricate.pack import mark_polygons, mark_rings
 
     free = np.ones((8, 8), dtype=bool)
-    _clear_leaders(~free, np.zeros(2), 5.0, np.zeros(2), np.ones((3, 2)), np.linspace(0.0, 1.0, 5), 2)
+    _clear_near(free, free, free, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, _RINGS2, 0, np.zeros(3, dtype=np.int64),
+                np.zeros(1, dtype=np.int64), np.empty((4, 64, 3)), np.zeros(4, dtype=np.int64),
+                np.zeros((4, len(_RINGS2)), dtype=np.int64), 3, ~free, np.linspace(0.0, 1.0, 5), 2)
     dist, _found = _grid_bfs(free, 1, 1, 5, np.ones((1, 8, 8), dtype=bool), 2)
     _path_back(dist, 3, 3)
     _path_turns(np.ones((3, 2)), ~free, np.zeros(2), 5.0, 0.4)
-    _free_cells_near(free, free, free, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, 4.0)
     _box_free(~free, 1, 1)
     _enclosed(_dilated(~free, np.ones((3, 3), dtype=bool)))
     window = np.array([[0, 3, 0, 3]], dtype=np.int64)
     mark_rings(~free, np.zeros((3, 2)), np.ones((3, 2)), np.array([0, 3]), window)
     _refresh_free(free.copy(), ~free, window, 1, 1)
+    ring = np.array([[0.1, 0.1], [1.0, 0.1], [1.0, 1.0], [0.1, 0.1]])
+    mark_polygons(~free, ~free, ring, np.zeros(4, dtype=np.int64), np.array([[0.1, 0.1, 1.0, 1.0]]),
+                  np.zeros(1, dtype=bool), np.zeros(2), 5.0)
     # a label box near another across its corner: `_grown_box_hits` asks the distance test
     from ..fabricate.overlap_kernels import grown_box_apart
 

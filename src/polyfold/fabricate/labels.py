@@ -475,41 +475,6 @@ def _path_turns(pts, texts, origin, inv_cell, step):
 
 
 @njit(cache=True)
-def _free_cells_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, r2):
-    """The cells of rows r0..r1 and columns c0..c1 (inclusive) within squared distance r2 of p
-    (their centres origin + (column or row + 0.5) cell) that are True in free_a, free_b (ny, nx)
-    and in `in_faces` or not, as four lists: (a, in a face), (b, in a face), (a, off the faces),
-    (b, off the faces), each in row order: (centres (4, m, 2), their squared distances from p
-    (4, m), counts (4,)), what numpy's nonzero of each map's window, the in_faces test and that
-    distance test give, to the last bit."""
-    n = (r1 - r0 + 1) * (c1 - c0 + 1)
-    centres = np.empty((4, n, 2))
-    d2 = np.empty((4, n))
-    counts = np.zeros(4, dtype=np.int64)
-    for r in range(r0, r1 + 1):
-        y = origin[1] + (r + 0.5) * cell
-        dy = y - p[1]
-        for c in range(c0, c1 + 1):
-            a, b = free_a[r, c], free_b[r, c]
-            if not (a or b):
-                continue
-            x = origin[0] + (c + 0.5) * cell
-            dx = x - p[0]
-            dd = dx * dx + dy * dy
-            if dd > r2:
-                continue
-            off = 0 if in_faces[r, c] else 2
-            for k in range(2):
-                if (a, b)[k]:
-                    q = off + k
-                    i = counts[q]
-                    centres[q, i, 0], centres[q, i, 1] = x, y
-                    d2[q, i] = dd
-                    counts[q] = i + 1
-    return centres, d2, counts
-
-
-@njit(cache=True)
 def _dilated(cells, disc):
     """(ny, nx) bool: `cells` (ny, nx) bool grown by the symmetric structure `disc` (2r + 1, 2r + 1)
     bool centred on each True cell, nothing beyond the raster (scipy.ndimage's binary_dilation)."""
@@ -568,27 +533,144 @@ def _taken_at(texts, x, y, origin, inv_cell):
     return texts[r, c]
 
 
+@njit(cache=True, inline="always")
+def _leader_clear(texts, origin, inv_cell, p, x, y, t):
+    """Whether the leader from p to (x, y) crosses no True cell of `texts` (ny, nx): looked up at
+    the points p + t ((x, y) - p), each in the cell (column, row) = int((point - origin) inv_cell),
+    clipped to the raster (as `_Taken._cells`), and given up at its first taken point."""
+    for j in range(len(t)):
+        if _taken_at(texts, p[0] + t[j] * (x - p[0]), p[1] + t[j] * (y - p[1]), origin, inv_cell):
+            return False
+    return True
+
+
+# `_clear_near`'s rings around a point, their outer radii (mm, squared; the last ELSEWHERE_MM's):
+# a search that finds a spot near its point scans only the rings out to it
+_RINGS2 = np.array([6.0, 12.0, 20.0, ELSEWHERE_MM]) ** 2
+
+
 @njit(cache=True)
-def _clear_leaders(texts, origin, inv_cell, p, centres, t, want):
-    """Indices (up to want, in order) of the centres (k, 2) whose leader from p crosses no True
-    cell of `texts` (ny, nx): the leader is looked up at the points p + t (centre - p), each in the
-    cell (column, row) = int((point - origin) inv_cell), clipped to the raster (as
-    `_Taken._cells`), and given up at its first taken point."""
-    out = np.empty(min(want, len(centres)), dtype=np.int64)
-    n = 0
-    for i in range(len(centres)):
-        if n == want:
-            break
-        clear = True
-        for j in range(len(t)):
-            if _taken_at(texts, p[0] + t[j] * (centres[i, 0] - p[0]), p[1] + t[j] * (centres[i, 1] - p[1]), origin,
-                         inv_cell):
-                clear = False
+def _scan_ring(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, lo2, hi2, found, counts):
+    """Append to four lists the cells of rows r0..r1 and columns c0..c1 (inclusive) whose squared
+    distance dd from p (their centres origin + (column or row + 0.5) cell) has lo2 < dd <= hi2
+    and that are True in free_a, free_b (ny, nx), in `in_faces` or not: (a, in a face), (b, in a
+    face), (a, off the faces), (b, off the faces), found[q, counts[q]:] (4, n, 3: x, y, dd),
+    counts (4,) advanced; in row order (numpy's nonzero). Rows and columns that cannot reach the
+    ring are not read, nor the columns of a row well inside its inner circle."""
+    inv_cell = 1.0 / cell
+    radius = math.sqrt(hi2)
+    # rows and columns whose centres may lie within the outer radius (a cell wider)
+    ra = max(r0, int(math.floor((p[1] - radius - origin[1]) * inv_cell - 0.5)) - 1)
+    rb = min(r1, int(math.ceil((p[1] + radius - origin[1]) * inv_cell - 0.5)) + 1)
+    ca = max(c0, int(math.floor((p[0] - radius - origin[0]) * inv_cell - 0.5)) - 1)
+    cb = min(c1, int(math.ceil((p[0] + radius - origin[0]) * inv_cell - 0.5)) + 1)
+    for r in range(ra, rb + 1):
+        y = origin[1] + (r + 0.5) * cell
+        dy = y - p[1]
+        # the columns inside the inner circle, a cell narrower on each side, are skipped
+        skip0, skip1 = 1, 0
+        if lo2 > dy * dy:
+            half = math.sqrt(lo2 - dy * dy)
+            skip0 = int(math.ceil((p[0] - half - origin[0]) * inv_cell - 0.5)) + 1
+            skip1 = int(math.floor((p[0] + half - origin[0]) * inv_cell - 0.5)) - 1
+        c = ca
+        while c <= cb:
+            if skip0 <= c <= skip1:
+                c = skip1 + 1
+                continue
+            a, b = free_a[r, c], free_b[r, c]
+            if a or b:
+                x = origin[0] + (c + 0.5) * cell
+                dx = x - p[0]
+                dd = dx * dx + dy * dy
+                if lo2 < dd <= hi2:
+                    off = 0 if in_faces[r, c] else 2
+                    for k in range(2):
+                        if (a, b)[k]:
+                            q = off + k
+                            i = counts[q]
+                            found[q, i, 0], found[q, i, 1], found[q, i, 2] = x, y, dd
+                            counts[q] = i + 1
+            c += 1
+
+
+@njit(cache=True)
+def _clear_near(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, rings2, q, state, scanned, found, counts,
+                ring_end, tries, texts, t, want):
+    """The next batch of free cells of list q (`_scan_ring`'s: 0, 1 free_a, free_b in a face; 2,
+    3 off the faces) whose leader from p crosses no label (`_leader_clear`, cells of 1 / cell),
+    looked at nearest first (the order of numpy's stable argsort of the distances of numpy's
+    nonzero, found bucket by bucket: what a search that ends early did not read is not sorted) up
+    to squared distance rings2[-1], at most `tries` of them, until `want` are found clear. Ring
+    by ring (rings2: their squared outer radii): list q from ring state[0], state[1]
+    cells looked at and state[2] found so far (updated here); the rings are scanned once for
+    all four lists when first needed (scanned[0] of them so far: found, counts as `_scan_ring`
+    fills them; ring_end (4, rings): the lists' lengths after each ring). Returns the centres
+    (m, 2) of those found clear in the first ring that has any, in order; none (0, 2) when the
+    search of list q is over."""
+    inv_cell = 1.0 / cell
+    while state[0] < rings2.shape[0]:
+        k = state[0]
+        state[0] = k + 1
+        while scanned[0] <= k:
+            j = scanned[0]
+            _scan_ring(free_a, free_b, in_faces, r0, r1, c0, c1, origin, p, cell, rings2[j - 1] if j > 0 else -1.0,
+                       rings2[j], found, counts)
+            for g in range(4):
+                ring_end[g, j] = counts[g]
+            scanned[0] = j + 1
+        lo, hi = ring_end[q, k - 1] if k > 0 else 0, ring_end[q, k]
+        n = hi - lo
+        out = np.empty((min(n, want), 2))
+        m = 0
+        if n == 0:
+            continue
+        # nearest first: the ring's cells counted into buckets of squared distance (row order kept
+        # within each), each bucket sorted by insertion (stable) when reached
+        base = max(rings2[k - 1], 0.0) if k > 0 else 0.0
+        n_buckets = max(1, n // 4)
+        scale = n_buckets / max(rings2[k] - base, 1e-300)
+        start = np.zeros(n_buckets + 1, dtype=np.int64)
+        bucket = np.empty(n, dtype=np.int64)
+        for i in range(n):
+            b = min(max(int((found[q, lo + i, 2] - base) * scale), 0), n_buckets - 1)
+            bucket[i] = b
+            start[b + 1] += 1
+        for b in range(n_buckets):
+            start[b + 1] += start[b]
+        fill = start[:n_buckets].copy()
+        perm = np.empty(n, dtype=np.int64)
+        for i in range(n):
+            perm[fill[bucket[i]]] = lo + i
+            fill[bucket[i]] += 1
+        done = False
+        for b in range(n_buckets):
+            s, e = start[b], start[b + 1]
+            for j in range(s + 1, e):
+                i = perm[j]
+                v = found[q, i, 2]
+                h = j - 1
+                while h >= s and found[q, perm[h], 2] > v:
+                    perm[h + 1] = perm[h]
+                    h -= 1
+                perm[h + 1] = i
+            for j in range(s, e):
+                if state[1] >= tries or state[2] >= want:
+                    done = True
+                    break
+                state[1] += 1
+                i = perm[j]
+                if _leader_clear(texts, origin, inv_cell, p, found[q, i, 0], found[q, i, 1], t):
+                    out[m, 0], out[m, 1] = found[q, i, 0], found[q, i, 1]
+                    m += 1
+                    state[2] += 1
+            if done:
                 break
-        if clear:
-            out[n] = i
-            n += 1
-    return out[:n]
+        if state[1] >= tries or state[2] >= want:
+            state[0] = rings2.shape[0]
+        if m:
+            return out[:m]
+    return np.empty((0, 2))
 
 
 class _Taken:
@@ -676,21 +758,27 @@ class _Taken:
             return
         import shapely
 
-        from .pack import mark_rings, ring_edges
+        from .pack import mark_polygons, mark_rings, ring_edges
 
         geoms, grows, to_texts = (np.array(v, dtype=t) for v, t in zip(zip(*self._pending), (object, float, bool)))
         self._pending = []
         grown = shapely.buffer(geoms, grows, quad_segs=2)
         bounds = shapely.bounds(grown)
-        (c0, r0), (c1, r1) = self._cells(bounds[:, :2]).T, self._cells(bounds[:, 2:]).T
-        windows = np.stack([r0, r1, c0, c1], axis=1).astype(np.int64)
-        for target, chosen in ((self.grid, ~to_texts), (self.texts, to_texts)):
-            if not chosen.any():
-                continue
-            p0, p1, owner = ring_edges(grown[chosen])
-            start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
-            p0, p1 = (p0 - self.origin) * (1.0 / FREE_CELL_MM), (p1 - self.origin) * (1.0 / FREE_CELL_MM)
-            mark_rings(target, p0, p1, start, windows[chosen])
+        if (shapely.get_type_id(grown) == 3).all() and not shapely.get_num_interior_rings(grown).any():
+            # polygons without holes (all but a bent leader's turns): one compiled pass
+            xy, owner = shapely.get_coordinates(grown, return_index=True)
+            windows = mark_polygons(self.grid, self.texts, xy, owner, bounds, to_texts, self.origin,
+                                     1.0 / FREE_CELL_MM)
+        else:
+            (c0, r0), (c1, r1) = self._cells(bounds[:, :2]).T, self._cells(bounds[:, 2:]).T
+            windows = np.stack([r0, r1, c0, c1], axis=1).astype(np.int64)
+            for target, chosen in ((self.grid, ~to_texts), (self.texts, to_texts)):
+                if not chosen.any():
+                    continue
+                p0, p1, owner = ring_edges(grown[chosen])
+                start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
+                p0, p1 = (p0 - self.origin) * (1.0 / FREE_CELL_MM), (p1 - self.origin) * (1.0 / FREE_CELL_MM)
+                mark_rings(target, p0, p1, start, windows[chosen])
         if (~to_texts).any():
             self._refresh(windows[~to_texts])
 
@@ -719,28 +807,25 @@ class _Taken:
         """Centres of level boxes of each of the two sizes (w, h mm) that touch no taken cell and whose
         leader from p crosses no label, within ELSEWHERE_MM of p: up to `want` per size and place,
         nearest first, centred in a face (each size in turn), then off the faces (the same), as
-        (index into sizes, centres (m, 2)), each list made when asked for. The raster's window is scanned
-        once for all of them (`_free_cells_near`); nothing may be placed between two asks."""
+        (index into sizes, centres (m, 2)) in batches, each made when asked for: a ring around p at a
+        time (`_clear_near`), the raster scanned once for all four, so a spot found near p costs a
+        scan of the rings out to it; nothing may be placed between two asks."""
         self._flush()
         (c0, r0), (c1, r1) = self._cells(np.array([p - ELSEWHERE_MM, p + ELSEWHERE_MM]))
         if self.grid[r0:r1 + 1, c0:c1 + 1].all():
             return
         p = np.asarray(p, dtype=np.float64)
-        centres, d2, counts = _free_cells_near(self.free(*sizes[0]), self.free(*sizes[1]), self.in_faces, int(r0),
-                                               int(r1), int(c0), int(c1), self.origin, p, FREE_CELL_MM, ELSEWHERE_MM ** 2)
+        free_a, free_b = self.free(*sizes[0]), self.free(*sizes[1])
+        found = np.empty((4, int((r1 - r0 + 1) * (c1 - c0 + 1)), 3))  # (`_scan_ring`'s lists: filled as needed)
+        counts, ring_end = np.zeros(4, dtype=np.int64), np.zeros((4, len(_RINGS2)), dtype=np.int64)
+        scanned = np.zeros(1, dtype=np.int64)
         for q in range(4):  # in a face first (each size), then off the faces
-            n = int(counts[q])
-            if not n:
-                continue
-            found, dist2 = centres[q, :n], d2[q, :n]
-            near = np.arange(n)
-            if n > LEADER_TRIES:
-                near = np.argpartition(dist2, LEADER_TRIES)[:LEADER_TRIES]
-            found = found[near[np.argsort(dist2[near], kind="stable")]]
             # a leader from p to the centre crosses no label: its points (LEADER_STEP_MM apart at
-            # most) are free; nearest first, until `want` are found
-            clear = found[_clear_leaders(self.texts, self.origin, 1.0 / FREE_CELL_MM, p, found, _LEADER_T, want)]
-            if len(clear):
+            # most) are free; nearest first among the LEADER_TRIES nearest, until `want` are found
+            state = np.zeros(3, dtype=np.int64)
+            while len(clear := _clear_near(free_a, free_b, self.in_faces, int(r0), int(r1), int(c0), int(c1),
+                                           self.origin, p, FREE_CELL_MM, _RINGS2, q, state, scanned, found, counts,
+                                           ring_end, LEADER_TRIES, self.texts, _LEADER_T, want)):
                 yield q % 2, clear
 
     def routed_near(self, p: np.ndarray, sizes: list[tuple[float, float]], want: int

@@ -316,6 +316,46 @@ def mark_rings(target, p0, p1, start, windows):
                     target[r0 + r, c0 + c] = True
 
 
+@njit(cache=True)
+def mark_polygons(grid, texts, xy, owner, bounds, to_texts, origin, inv_cell):
+    """Mark polygons without holes on two rasters of one grid (the labels' `_Taken`): the cells
+    of grid (ny, nx), or of texts where to_texts[g], whose centres lie inside polygon g, its ring
+    the points xy[owner == g] (m, 2; owner (m,) ascending: `shapely.get_coordinates` with
+    return_index), over its window: its bounds (k, 4: x0, y0, x1, y1) in cells of 1 / inv_cell
+    from origin, truncated and clipped to the raster. The cells are `mark_rings`' of its edges in
+    cell units, (point - origin) inv_cell, to the last bit. Returns the windows (k, 4: first and
+    last row, first and last column)."""
+    k = bounds.shape[0]
+    ny, nx = grid.shape
+    windows = np.empty((k, 4), dtype=np.int64)
+    a = 0
+    for g in range(k):
+        b = a
+        while b < owner.shape[0] and owner[b] == g:
+            b += 1
+        c0 = min(max(np.int32((bounds[g, 0] - origin[0]) * inv_cell), 0), nx - 1)
+        r0 = min(max(np.int32((bounds[g, 1] - origin[1]) * inv_cell), 0), ny - 1)
+        c1 = min(max(np.int32((bounds[g, 2] - origin[0]) * inv_cell), 0), nx - 1)
+        r1 = min(max(np.int32((bounds[g, 3] - origin[1]) * inv_cell), 0), ny - 1)
+        windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3] = r0, r1, c0, c1
+        e = max(b - a - 1, 0)
+        q0 = np.empty((e, 2))
+        q1 = np.empty((e, 2))
+        for i in range(e):
+            q0[i, 0] = (xy[a + i, 0] - origin[0]) * inv_cell - float(c0)
+            q0[i, 1] = (xy[a + i, 1] - origin[1]) * inv_cell - float(r0)
+            q1[i, 0] = (xy[a + i + 1, 0] - origin[0]) * inv_cell - float(c0)
+            q1[i, 1] = (xy[a + i + 1, 1] - origin[1]) * inv_cell - float(r0)
+        inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
+        target = texts if to_texts[g] else grid
+        for r in range(r1 - r0 + 1):
+            for c in range(c1 - c0 + 1):
+                if inside[r, c]:
+                    target[r0 + r, c0 + c] = True
+        a = b
+    return windows
+
+
 @dataclass
 class _Shape:
     """One piece in one rotation, rasterised on a grid aligned with its rotated bounding box."""
