@@ -30,8 +30,7 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
                    "fabricate.overlap_kernels.first_leader_spot",
                    "fabricate.overlap_kernels.first_unblocked", "fabricate.overlap_kernels.overlap_area",
                    "fabricate.labels._path_back", "fabricate.labels._path_turns", "fabricate.labels._refresh_free",
-                   "fabricate.pack.mark_rings", "fabricate.pack.mark_polygons",
-                   "fabricate.overlap_kernels.grown_box_apart",
+                   "fabricate.pack.mark_edges", "fabricate.overlap_kernels.grown_box_apart",
                    "unfold.kernels.crease_bfs", "unfold.kernels.place_children", "fabricate.labels._dilated",
                    "fabricate.labels._enclosed"):
         assert sigs.get(kernel), f"{kernel} was not compiled (or loaded from the cache) by the warm-up"

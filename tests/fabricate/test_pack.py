@@ -515,63 +515,74 @@ def test_shape_runs_are_the_rasters_runs_widest_first_ties_in_row_order():
                for p0, p1, h, w in cases) > 1000
 
 
-def test_mark_rings_sets_the_cells_inside_each_geometry_in_its_window():
-    """Several geometries rasterised into one grid at once, each over its own window (what a label
-    raster marks after a placement): the cells whose centres shapely finds inside one of them,
-    on top of what the grid held."""
+def test_mark_edges_sets_the_cells_inside_each_geometry_in_its_window_on_its_layer():
+    """Several geometries rasterised at once onto two layers of one grid, each over its own window
+    (what a label raster marks after placements: label boxes, leader strips, a bent leader's turns
+    as discs that may part): on a raster offset from the origin, in cells of 0.2 mm, the cells
+    whose centres shapely finds inside each geometry, on its layer, on top of what the layers
+    held; the windows are the geometries' bounds in cells, truncated and clipped to the raster
+    (geometries reach past it too)."""
     import shapely
 
-    from polyfold.fabricate.pack import mark_rings, ring_edges
-
-    rng = np.random.default_rng(4)
-    for _ in range(20):
-        grid = rng.random((60, 80)) < 0.05
-        before = grid.copy()
-        geoms = [shapely.Polygon(rng.uniform([2, 2], [75, 55], (3, 2))).buffer(rng.uniform(0.3, 2), quad_segs=2)
-                 for _ in range(int(rng.integers(1, 6)))]
-        p0, p1, owner = ring_edges(np.array(geoms, dtype=object))
-        start = np.searchsorted(owner, np.arange(len(geoms) + 1))
-        b = shapely.bounds(np.array(geoms, dtype=object))
-        windows = np.stack([np.floor(b[:, 1]), np.ceil(b[:, 3]), np.floor(b[:, 0]), np.ceil(b[:, 2])],
-                           axis=1).astype(np.int64).clip(0, [59, 59, 79, 79])
-        mark_rings(grid, p0, p1, start, windows)
-        r, c = np.mgrid[0:60, 0:80]
-        inside = np.zeros((60, 80), dtype=bool)
-        for g in geoms:
-            inside |= shapely.contains_xy(g, c + 0.5, r + 0.5)
-        assert np.array_equal(grid, before | inside)
-
-
-def test_mark_polygons_marks_what_mark_rings_marks_on_two_rasters():
-    """The labels' raster marks polygons without holes in one pass (`mark_polygons`: a label box,
-    leader strip or off-face label, grown): on a grid and its texts layer of a raster offset from
-    the origin, in cells of 0.2 mm, the same cells and windows as `ring_edges` and `mark_rings`
-    of each layer's polygons, bounds truncated to cells and clipped as `labels._Taken._cells`
-    clips them (polygons reaching past the raster too)."""
-    import shapely
-
-    from polyfold.fabricate.pack import mark_polygons, mark_rings, ring_edges
+    from polyfold.fabricate.pack import mark_edges, ring_edges
 
     rng = np.random.default_rng(11)
     cell, origin = 0.2, np.array([-3.7, 12.1])
     ny, nx = 70, 90
-    for _ in range(40):
+    centres_x = origin[0] + (np.arange(nx) + 0.5) * cell
+    centres_y = origin[1] + (np.arange(ny) + 0.5) * cell
+    cx, cy = np.meshgrid(centres_x, centres_y)
+    for trial in range(40):
         grid, texts = rng.random((ny, nx)) < 0.05, rng.random((ny, nx)) < 0.05
+        before = grid.copy(), texts.copy()
         k = int(rng.integers(1, 7))
-        geoms = np.array([shapely.Polygon(origin + rng.uniform(-1, [nx * cell + 1, ny * cell + 1], (4, 2))).convex_hull
-                          .buffer(rng.uniform(0.1, 0.6), quad_segs=2) for _ in range(k)], dtype=object)
+        geoms = []
+        for _ in range(k):
+            pts = origin + rng.uniform(-1, [nx * cell + 1, ny * cell + 1], (4, 2))
+            if trial % 4 == 3:  # discs that may part (a MultiPolygon), and a ring with a hole
+                g = shapely.MultiPoint(pts[:2]).buffer(rng.uniform(0.3, 1.5), quad_segs=2)
+                if rng.random() < 0.5:
+                    g = g.difference(shapely.Point(pts[0]).buffer(0.2))
+            else:
+                g = shapely.Polygon(pts).convex_hull.buffer(rng.uniform(0.1, 0.6), quad_segs=2)
+            geoms.append(g)
+        geoms = np.array(geoms, dtype=object)
         to_texts = rng.random(k) < 0.5
         bounds = shapely.bounds(geoms)
+        p0, p1, owner = ring_edges(geoms)
+        start = np.searchsorted(owner, np.arange(k + 1))
+        windows = mark_edges(grid, texts, p0, p1, start, bounds, to_texts, origin, 1.0 / cell)
         ij = np.clip(((bounds.reshape(-1, 2) - origin) * (1.0 / cell)).astype(np.int32), 0, [nx - 1, ny - 1])
         ij = ij.reshape(-1, 4)
-        windows = np.stack([ij[:, 1], ij[:, 3], ij[:, 0], ij[:, 2]], axis=1).astype(np.int64)
-        want_grid, want_texts = grid.copy(), texts.copy()
-        for target, chosen in ((want_grid, ~to_texts), (want_texts, to_texts)):
-            if chosen.any():
-                p0, p1, owner = ring_edges(geoms[chosen])
-                start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
-                mark_rings(target, (p0 - origin) * (1.0 / cell), (p1 - origin) * (1.0 / cell), start, windows[chosen])
-        xy, owner = shapely.get_coordinates(geoms, return_index=True)
-        got = mark_polygons(grid, texts, xy, owner, bounds, to_texts, origin, 1.0 / cell)
-        assert np.array_equal(got, windows)
-        assert np.array_equal(grid, want_grid) and np.array_equal(texts, want_texts)
+        assert np.array_equal(windows, np.stack([ij[:, 1], ij[:, 3], ij[:, 0], ij[:, 2]], axis=1))
+        want = [before[0].copy(), before[1].copy()]
+        for g, layer, (r0, r1, c0, c1) in zip(geoms, to_texts, windows):
+            inside = np.zeros((ny, nx), dtype=bool)
+            inside[r0:r1 + 1, c0:c1 + 1] = shapely.contains_xy(g, cx[r0:r1 + 1, c0:c1 + 1], cy[r0:r1 + 1, c0:c1 + 1])
+            want[int(layer)] |= inside
+        assert np.array_equal(grid, want[0]) and np.array_equal(texts, want[1])
+
+
+def test_ring_edges_of_polygons_without_holes_are_those_of_their_rings():
+    """`ring_edges` takes the geometries' own coordinates when every one is a polygon without
+    holes: the same edges and owners as going through their parts and rings (a MultiPolygon or a
+    hole among them takes that way)."""
+    import shapely
+
+    from polyfold.fabricate.pack import ring_edges
+
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        polys = [shapely.Polygon(rng.uniform(0, 50, (5, 2))).convex_hull.buffer(rng.uniform(0.1, 2), quad_segs=2)
+                 for _ in range(int(rng.integers(1, 6)))]
+        geoms = np.array(polys, dtype=object)
+        got = ring_edges(geoms)
+        parts, part_owner = shapely.get_parts(geoms, return_index=True)
+        rings, ring_part = shapely.get_rings(parts, return_index=True)
+        xy, idx = shapely.get_coordinates(rings, return_index=True)
+        same = idx[1:] == idx[:-1]
+        want = (xy[:-1][same], xy[1:][same], part_owner[ring_part[idx[:-1][same]]])
+        assert all(np.array_equal(a, b) for a, b in zip(got, want))
+        mixed = np.array([*polys, shapely.MultiPoint(rng.uniform(0, 50, (2, 2))).buffer(1.0)], dtype=object)
+        p0, _p1, owner = ring_edges(mixed)
+        assert np.array_equal(p0[owner < len(polys)], got[0]) and (owner == len(polys)).sum() >= 8

@@ -96,7 +96,7 @@ def _warm_crowded_labels() -> None:
     label beside its edge), with the argument types `labels._Taken` gives them."""
     from ..fabricate.labels import (_RINGS2, _box_free, _clear_near, _dilated, _enclosed, _grid_bfs, _path_back,
                                     _path_turns, _refresh_free)
-    from ..fabricate.pack import mark_polygons, mark_rings
+    from ..fabricate.pack import mark_edges
 
     free = np.ones((8, 8), dtype=bool)
     _clear_near(free, free, free, 0, 7, 0, 7, np.zeros(2), np.ones(2), 0.2, _RINGS2, 0, np.zeros(3, dtype=np.int64),
@@ -107,12 +107,9 @@ def _warm_crowded_labels() -> None:
     _path_turns(np.ones((3, 2)), ~free, np.zeros(2), 5.0, 0.4)
     _box_free(~free, 1, 1)
     _enclosed(_dilated(~free, np.ones((3, 3), dtype=bool)))
-    window = np.array([[0, 3, 0, 3]], dtype=np.int64)
-    mark_rings(~free, np.zeros((3, 2)), np.ones((3, 2)), np.array([0, 3]), window)
+    window = mark_edges(~free, ~free, np.zeros((3, 2)), np.ones((3, 2)), np.array([0, 3]),
+                        np.array([[0.0, 0.0, 1.0, 1.0]]), np.zeros(1, dtype=bool), np.zeros(2), 5.0)
     _refresh_free(free.copy(), ~free, window, 1, 1)
-    ring = np.array([[0.1, 0.1], [1.0, 0.1], [1.0, 1.0], [0.1, 0.1]])
-    mark_polygons(~free, ~free, ring, np.zeros(4, dtype=np.int64), np.array([[0.1, 0.1, 1.0, 1.0]]),
-                  np.zeros(1, dtype=bool), np.zeros(2), 5.0)
     # a label box near another across its corner: `_grown_box_hits` asks the distance test
     from ..fabricate.overlap_kernels import grown_box_apart
 

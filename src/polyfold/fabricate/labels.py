@@ -751,34 +751,22 @@ class _Taken:
     def _flush(self) -> None:
         """Mark what `mark` and `close` were given since the last flush, all at once (a piece places
         a hundred labels beside their edges between two searches of the raster): each geometry
-        grown (shapely's buffer, quad_segs=2) and rasterised by its cells' centres over its bounds
-        (`pack._raster`, the packer's: compiled by every make already); then `free`'s maps again
-        where cells were taken."""
+        grown (shapely's buffer, quad_segs=2) and rasterised by its cells' centres over its bounds,
+        both layers in one compiled pass (`pack.mark_edges`, over the packer's `_raster`); then
+        `free`'s maps again where cells were taken."""
         if not self._pending:
             return
         import shapely
 
-        from .pack import mark_polygons, mark_rings, ring_edges
+        from .pack import mark_edges, ring_edges
 
         geoms, grows, to_texts = (np.array(v, dtype=t) for v, t in zip(zip(*self._pending), (object, float, bool)))
         self._pending = []
         grown = shapely.buffer(geoms, grows, quad_segs=2)
-        bounds = shapely.bounds(grown)
-        if (shapely.get_type_id(grown) == 3).all() and not shapely.get_num_interior_rings(grown).any():
-            # polygons without holes (all but a bent leader's turns): one compiled pass
-            xy, owner = shapely.get_coordinates(grown, return_index=True)
-            windows = mark_polygons(self.grid, self.texts, xy, owner, bounds, to_texts, self.origin,
-                                     1.0 / FREE_CELL_MM)
-        else:
-            (c0, r0), (c1, r1) = self._cells(bounds[:, :2]).T, self._cells(bounds[:, 2:]).T
-            windows = np.stack([r0, r1, c0, c1], axis=1).astype(np.int64)
-            for target, chosen in ((self.grid, ~to_texts), (self.texts, to_texts)):
-                if not chosen.any():
-                    continue
-                p0, p1, owner = ring_edges(grown[chosen])
-                start = np.searchsorted(owner, np.arange(int(chosen.sum()) + 1))
-                p0, p1 = (p0 - self.origin) * (1.0 / FREE_CELL_MM), (p1 - self.origin) * (1.0 / FREE_CELL_MM)
-                mark_rings(target, p0, p1, start, windows[chosen])
+        p0, p1, owner = ring_edges(grown)
+        start = np.searchsorted(owner, np.arange(len(grown) + 1))
+        windows = mark_edges(self.grid, self.texts, p0, p1, start, shapely.bounds(grown), to_texts, self.origin,
+                             1.0 / FREE_CELL_MM)
         if (~to_texts).any():
             self._refresh(windows[~to_texts])
 

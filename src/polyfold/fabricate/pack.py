@@ -253,6 +253,12 @@ def fits_page(outline: Polygon | MultiPolygon, page_size: tuple[float, float], m
 def ring_edges(geoms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Start and end points (e, 2) of every edge of every ring of (Multi)Polygons `geoms` (a
     geometry or an array of them), and the index (e,) of each edge's geometry, in order."""
+    if (shapely.get_type_id(geoms) == 3).all() and not shapely.get_num_interior_rings(geoms).any():
+        # polygons without holes (grown outlines, label boxes, leader strips): one ring each, so
+        # the geometries' own coordinates are their rings' (one shapely call instead of three)
+        xy, owner = shapely.get_coordinates(geoms, return_index=True)
+        same = owner[1:] == owner[:-1]
+        return xy[:-1][same], xy[1:][same], owner[:-1][same]
     parts, part_owner = shapely.get_parts(geoms, return_index=True)
     rings, ring_part = shapely.get_rings(parts, return_index=True)
     xy, idx = shapely.get_coordinates(rings, return_index=True)
@@ -280,7 +286,7 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
     """(h, w) bool: cells whose centre (c + 0.5, r + 0.5) is inside the rings p0 -> p1 (e, 2) given
     in cell units (even-odd rule, so holes work). Scanline: each edge toggles, in every row whose
     centre line it crosses, the first cell whose centre lies right of the crossing; a running
-    parity along the row then says inside. (The labels' rasters, `mark_rings`; a piece's rotations
+    parity along the row then says inside. (The labels' rasters, `mark_edges`; a piece's rotations
     are rasterised as their runs, `_shape_runs`, which reads the same crossings.)"""
     toggles = np.zeros((h, w + 1), dtype=np.uint8)
     for e in range(p0.shape[0]):
@@ -297,62 +303,37 @@ def _raster(p0: np.ndarray, p1: np.ndarray, h: int, w: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def mark_rings(target, p0, p1, start, windows):
-    """Set the cells of target (ny, nx) whose centres lie inside geometry g's rings, edges
-    p0[start[g]:start[g + 1]] -> p1[...] (e, 2) in cell units, within its window windows[g] (first
-    and last row, first and last column): `_raster` of each over its window, even-odd."""
-    for g in range(windows.shape[0]):
-        r0, r1, c0, c1 = windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3]
-        a, b = start[g], start[g + 1]
-        q0 = np.empty((b - a, 2))
-        q1 = np.empty((b - a, 2))
-        for e in range(b - a):
-            q0[e, 0], q0[e, 1] = p0[a + e, 0] - float(c0), p0[a + e, 1] - float(r0)
-            q1[e, 0], q1[e, 1] = p1[a + e, 0] - float(c0), p1[a + e, 1] - float(r0)
-        inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
-        for r in range(r1 - r0 + 1):
-            for c in range(c1 - c0 + 1):
-                if inside[r, c]:
-                    target[r0 + r, c0 + c] = True
-
-
-@njit(cache=True)
-def mark_polygons(grid, texts, xy, owner, bounds, to_texts, origin, inv_cell):
-    """Mark polygons without holes on two rasters of one grid (the labels' `_Taken`): the cells
-    of grid (ny, nx), or of texts where to_texts[g], whose centres lie inside polygon g, its ring
-    the points xy[owner == g] (m, 2; owner (m,) ascending: `shapely.get_coordinates` with
-    return_index), over its window: its bounds (k, 4: x0, y0, x1, y1) in cells of 1 / inv_cell
-    from origin, truncated and clipped to the raster. The cells are `mark_rings`' of its edges in
-    cell units, (point - origin) inv_cell, to the last bit. Returns the windows (k, 4: first and
-    last row, first and last column)."""
+def mark_edges(grid, texts, p0, p1, start, bounds, to_texts, origin, inv_cell):
+    """Mark geometries on two rasters of one grid (the labels' `_Taken`: what labels may not touch,
+    and the labels alone): the cells of grid (ny, nx), or of texts where to_texts[g], whose
+    centres lie inside geometry g, its rings' edges p0[start[g]:start[g + 1]] -> p1[...] (e, 2 mm:
+    `ring_edges`), even-odd (holes work), within its window: its bounds (k, 4: x0, y0, x1, y1) in
+    cells of 1 / inv_cell mm from origin, truncated and clipped to the raster. Cell (c, r) has its
+    centre at origin + (c + 0.5, r + 0.5) / inv_cell. Returns the windows (k, 4: first and last
+    row, first and last column)."""
     k = bounds.shape[0]
     ny, nx = grid.shape
     windows = np.empty((k, 4), dtype=np.int64)
-    a = 0
     for g in range(k):
-        b = a
-        while b < owner.shape[0] and owner[b] == g:
-            b += 1
         c0 = min(max(np.int32((bounds[g, 0] - origin[0]) * inv_cell), 0), nx - 1)
         r0 = min(max(np.int32((bounds[g, 1] - origin[1]) * inv_cell), 0), ny - 1)
         c1 = min(max(np.int32((bounds[g, 2] - origin[0]) * inv_cell), 0), nx - 1)
         r1 = min(max(np.int32((bounds[g, 3] - origin[1]) * inv_cell), 0), ny - 1)
         windows[g, 0], windows[g, 1], windows[g, 2], windows[g, 3] = r0, r1, c0, c1
-        e = max(b - a - 1, 0)
-        q0 = np.empty((e, 2))
+        a, e = start[g], start[g + 1] - start[g]
+        q0 = np.empty((e, 2))  # the edges in cells of the window
         q1 = np.empty((e, 2))
         for i in range(e):
-            q0[i, 0] = (xy[a + i, 0] - origin[0]) * inv_cell - float(c0)
-            q0[i, 1] = (xy[a + i, 1] - origin[1]) * inv_cell - float(r0)
-            q1[i, 0] = (xy[a + i + 1, 0] - origin[0]) * inv_cell - float(c0)
-            q1[i, 1] = (xy[a + i + 1, 1] - origin[1]) * inv_cell - float(r0)
+            q0[i, 0] = (p0[a + i, 0] - origin[0]) * inv_cell - float(c0)
+            q0[i, 1] = (p0[a + i, 1] - origin[1]) * inv_cell - float(r0)
+            q1[i, 0] = (p1[a + i, 0] - origin[0]) * inv_cell - float(c0)
+            q1[i, 1] = (p1[a + i, 1] - origin[1]) * inv_cell - float(r0)
         inside = _raster(q0, q1, r1 - r0 + 1, c1 - c0 + 1)
         target = texts if to_texts[g] else grid
         for r in range(r1 - r0 + 1):
             for c in range(c1 - c0 + 1):
                 if inside[r, c]:
                     target[r0 + r, c0 + c] = True
-        a = b
     return windows
 
 
