@@ -11,7 +11,8 @@ user runs it (a fresh `polyfold` process, warm kernels, defaults: fold on, A4 at
 wall-clock, --rounds times. Prints per mesh its seconds, the layout stage's share, pieces, pages
 and the labels left small (crowding: the slow case), then how many meshes took at most --limit
 seconds (by their median round), the median and the slowest. --markdown: the table as the
-README has it.
+README has it. The machine's speed (`machine_probe.py`) is read before the makes and after them:
+this VM's host runs the same code up to 1.8 times slower in some hours than in others.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
 from bench_build import MODELS, _obj_text, decimated, hull_of_points  # noqa: E402
+from machine_probe import probe_seconds  # noqa: E402
 
 CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "polyfold").exists() else [
     sys.executable, "-m", "polyfold"]
@@ -80,6 +82,7 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench-many-"))
     todo = meshes(tmp, a.faces, [int(s) for s in a.hull_seeds.split(",") if s], a.only)
     subprocess.run([*CLI, "make", str(ROOT / "examples" / "bunny-128.obj"), "-o", str(tmp / "prime"), "-q"])
+    probe_before = probe_seconds()
     if a.markdown:
         print("| mesh | faces | wall s | layout s | pieces | pages | labels left small |\n|---|---|---|---|---|---|---|")
     else:
@@ -111,6 +114,7 @@ def main() -> None:
         slowest = max(medians)
         print(f"\n{within} of {len(medians)} meshes made in at most {a.limit:g} s; median "
               f"{statistics.median(m for m, _ in medians):.2f} s, slowest {slowest[0]:.2f} s ({slowest[1]})")
+    print(f"machine probe (bench/machine_probe.py): {probe_before:.3f} s before the makes, {probe_seconds():.3f} s after")
 
 
 if __name__ == "__main__":

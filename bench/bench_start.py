@@ -30,7 +30,8 @@ project's cache is left alone):
   faces, faces of every size and shape; the convex hull of 752 random points, 1,500 faces, many
   slivers; a 50 x 15 torus, 1,500 faces), warm cache, fold on, A4 at 150 mm: seconds and peak
   memory.
-Prints a table; compile seconds per stage are the cold make's own (report.json "compile_seconds").
+Prints a table; compile seconds per stage are the cold make's own (report.json "compile_seconds"),
+and the machine's speed before and after the rows (`machine_probe.py`: the host's hours differ).
 """
 
 from __future__ import annotations
@@ -53,6 +54,8 @@ BUNNY = ROOT / "examples" / "bunny-128.obj"
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
 DENSE = "bunny-348:1,horse-302:1,fish-472:1,moneybox-128:2,bumpy-528:1"  # (--dense) name:Loop subdivisions
 DECIMATED = "bumpy-528,bunny-348,fish-472,horse-302"  # (--decimated) Loop-subdivided twice, then to 1,500 faces
+sys.path.insert(0, str(ROOT / "bench"))
+from machine_probe import probe_seconds  # noqa: E402
 
 
 def _tree_pss_mb(pid: int) -> float:
@@ -166,6 +169,7 @@ def main() -> None:
     ap.add_argument("--no-server", action="store_true", help="no rows through `polyfold server`")
     a = ap.parse_args()
     rows: list[tuple[str, float, float, str]] = []
+    probe_before = probe_seconds()
     tmp = Path(tempfile.mkdtemp(prefix="bench-start-"))
     if not a.skip_cold:
         env = dict(OWN, NUMBA_CACHE_DIR=str(tmp / "cache-cold"))
@@ -264,6 +268,7 @@ def main() -> None:
     print(f"{'what':52s} {'wall s':>8s} {'peak MB':>8s}  notes")
     for label, wall, mb, note in rows:
         print(f"{label:52s} {wall:8.2f} {mb:8.0f}  {note}")
+    print(f"machine probe (bench/machine_probe.py): {probe_before:.3f} s before the rows, {probe_seconds():.3f} s after")
 
 
 if __name__ == "__main__":
