@@ -49,12 +49,13 @@ def strip(rng: np.random.Generator, n_tris: int, side: float) -> Polygon:
     a, b = np.array([0.0, 0.0]), np.array([side, 0.0])
     tris: list[Polygon] = []
     union = Polygon()
+    other, free = (a, b), 0  # the last triangle's other free edge, and whether it is still free
     while len(tris) < n_tris:
         d = b - a
         c = (a + b) / 2 + np.array([-d[1], d[0]]) * 0.866 * rng.uniform(0.85, 1.15)
         t = Polygon([a, b, c])
         if union.intersection(t).area > 1e-6 * t.area:
-            if not tris or free == 0:
+            if free == 0:
                 break  # both free edges of the last triangle are blocked: the strip ends here
             free -= 1
             a, b = other  # the last triangle's other free edge
