@@ -12,7 +12,8 @@ wall-clock, --rounds times. Prints per mesh its seconds, the layout stage's shar
 and the labels left small (crowding: the slow case), then how many meshes took at most --limit
 seconds (by their median round), the median and the slowest. --markdown: the table as the
 README has it. The machine's speed (`machine_probe.py`) is read before the makes and after them:
-this VM's host runs the same code up to 1.8 times slower in some hours than in others.
+this VM's host runs the same code up to 1.9 times slower in some hours than in others. A warning
+says when the ahead-of-time kernels are stale (an edited source): the makes are then slower.
 """
 
 from __future__ import annotations
@@ -82,6 +83,11 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench-many-"))
     todo = meshes(tmp, a.faces, [int(s) for s in a.hull_seeds.split(",") if s], a.only)
     subprocess.run([*CLI, "make", str(ROOT / "examples" / "bunny-128.obj"), "-o", str(tmp / "prime"), "-q"])
+    ahead = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
+                           capture_output=True, text=True).stdout.strip() == "True"
+    if not ahead:  # (any edit of polyfold's sources, a revert too, makes the module stale: its stamp)
+        print("warning: no up-to-date ahead-of-time kernels (run `polyfold warm-up`): these makes run "
+              "numba's dispatchers, slower than a set-up install's", file=sys.stderr)
     probe_before = probe_seconds()
     if a.markdown:
         print("| mesh | faces | wall s | layout s | pieces | pages | labels left small |\n|---|---|---|---|---|---|---|")

@@ -97,6 +97,44 @@ def test_layout_after_folding_keeps_the_planned_pages_and_pieces(models_dir):
     assert lay_out(mesh, unsplit, scale, opts, w, h, deadline, lambda *a: None).packing.n_pages > split.pages
 
 
+def test_the_first_page_plan_made_beside_the_packing_is_the_one_made_after_it(models_dir, monkeypatch):
+    """With two cores split_for_pages makes its first page plan in a forked process while it packs
+    the pieces (`sheets._plan_ahead`), and takes it when that packing needs more pages: the same
+    cuts, pieces, packing and piece order as one core planning after the packing."""
+    from polyfold import processes
+    from polyfold.pipeline import sheets
+
+    mesh, opts, scale, w, h, fitted = fitted_parts(models_dir, "bunny-348")
+    monkeypatch.setattr(sheets, "PARALLEL_PLAN_PIECES", 1)  # (bunny-348 has fewer pieces than a dense mesh)
+    read = []
+    real = sheets.ForkedStream
+
+    def recorded(gen):
+        stream = real(gen)
+        plain = stream.next
+
+        def next_value():
+            got = plain()
+            read.append((got[0], type(got[1]).__name__))
+            return got
+
+        stream.next = next_value
+        return stream
+
+    monkeypatch.setattr(sheets, "ForkedStream", recorded)
+    runs = {}
+    for cores in (1, 2):
+        monkeypatch.setattr(processes, "usable_cores", lambda cores=cores: cores)
+        runs[cores] = split_for_pages(mesh, fitted, scale, opts, pack_box(w, h, opts), Deadline.after(60),
+                                      lambda *a: None)
+    assert read == [(True, "PagePlan")]  # made ahead with two cores only, and taken
+    one, two = runs[1], runs[2]
+    assert one.cuts == two.cuts > 0 and (one.pieces, one.net_pieces, one.pages) == (two.pieces, two.net_pieces, two.pages)
+    assert one.packing.placements == two.packing.placements and one.order == two.order
+    assert np.array_equal(one.rank, two.rank)
+    assert [p.footprint.equals_exact(q.footprint, 0.0) for p, q in zip(one.drawn[0], two.drawn[0])] == [True] * one.pieces
+
+
 def test_a_drawing_after_folding_split_a_piece_takes_what_it_can_from_the_planned_drawings(models_dir):
     """When folding splits a piece, lay_out draws the pieces again with split_for_pages' memo: the
     pieces not split keep their tabs and labels found before, and the drawing is the one made

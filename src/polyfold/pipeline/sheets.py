@@ -34,6 +34,7 @@ from ..fabricate.pieces import (GlueEdge, LayoutStats, PieceInput, SheetPiece, b
                                 with_side_notes)
 from ..fabricate.split import PagePlan, plan_label_cuts, plan_pages
 from ..mesh.mesh import Mesh
+from ..processes import ForkedStream
 from ..unfold.net import cut_creases, piece_net
 from .folding import FoldedPiece
 from .options import MakeOptions
@@ -182,6 +183,19 @@ def _owner(inputs: list[PieceInput], n_faces: int) -> np.ndarray:
     return owner
 
 
+# from this many pieces on, the first page plan is made beside the first packing (`split_for_pages`):
+# a 1,500-face model's 190-290 pieces take 0.4 s to pack and 0.6-0.8 s to plan, each on one core
+PARALLEL_PLAN_PIECES = 100
+
+
+def _plan_ahead(n_pieces: int) -> bool:
+    """Whether `split_for_pages` makes its first page plan in a forked process beside its first
+    packing: two cores or more, and PARALLEL_PLAN_PIECES pieces or more."""
+    from ..processes import can_fork, usable_cores
+
+    return n_pieces >= PARALLEL_PLAN_PIECES and usable_cores() >= 2 and can_fork()
+
+
 LABEL_ROUNDS = 3  # rounds of cuts for labels with no readable place (each redraws every piece)
 
 
@@ -228,7 +242,9 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     other choice. Kept: the fewest pages, then the fewest pieces; the first page count met ends the
     search. Then one page fewer than the best so far is planned with compact parts (`plan_pages`'
     cap, each of CAPS in turn, emptiest page first) while the outlines grown by half the gap would
-    fill at most MAX_FILL of the pages; when that is met, one page fewer again. `box`:
+    fill at most MAX_FILL of the pages; when that is met, one page fewer again. With two cores the
+    first plan (the fewest pages, the first choice) is made in a forked process while the pieces
+    are packed (`_plan_ahead`: the same plan, ready when the packing needs fewer pages). `box`:
     `pack_box`. Time: `pack_budget` and one drawing's time (as long as the first drawing took),
     from after the first drawing (`lay_out` reuses it when folding splits nothing); a plan is only
     started with that drawing's time left. `deadline` ends this optional work (the label rounds
@@ -254,29 +270,26 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
     parts, inputs, drawn, label_cuts, labels_ran_out = _split_for_labels(mesh, parts, inputs, drawn, draw, say,
                                                                          deadline, draw_seconds)
     pieces = drawn[0]
-    packing = pack(pieces, None, pack_budget(deadline))
-    # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
-    # (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1 planned or not by chance)
-    budget = deadline.within(pack_budget(deadline) + draw_seconds)
-    best = (packing.n_pages, len(pieces), parts, inputs, 0, drawn, packing)
     box_area = (box[2] - box[0]) * (box[3] - box[1])
     grown = float(shapely.area(shapely.buffer([p.footprint for p in pieces], GAP_MM / 2)).sum()) / box_area
     fewest = max(1, math.ceil(grown / MAX_FILL - 1e-9))
-    ran_out = packing.ran_out
     rasters: dict[int, tuple] = {}  # per drawing: (the drawing, kept alive so its id stays its own, rasters)
 
-    def attempt(n_pages: int, cap: float | None, emptiest_first: bool) -> None:
+    def attempt(n_pages: int, cap: float | None, emptiest_first: bool, planned: ForkedStream | None = None) -> None:
         """Plan the cuts for `n_pages` (rounds of plan, cut, redraw), pack the cut pieces in the
-        plan's order and keep them in `best` when they beat it."""
+        plan's order and keep them in `best` when they beat it. planned: the first round's plan,
+        made ahead in a forked process, or None."""
         nonlocal best, ran_out
         cur_parts, cur_inputs, cur_drawn, cuts, hint = parts, inputs, drawn, 0, None
-        for _ in range(PLAN_ROUNDS):
+        for k in range(PLAN_ROUNDS):
             if budget.left() < draw_seconds:  # no time to draw the pieces this plan would cut
                 ran_out = True
                 break
-            plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
-                              budget.at, seed=opts.seed, emptiest_first=emptiest_first,
-                              rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1], cap=cap)
+            got, plan = (False, None) if k or planned is None else planned.next()
+            if not got:  # (none made ahead, or its process died: made here)
+                plan = plan_pages(cur_drawn[0], [inp.net for inp in cur_inputs], page, margin, GAP_MM, n_pages,
+                                  budget.at, seed=opts.seed, emptiest_first=emptiest_first,
+                                  rasters=rasters.setdefault(id(cur_drawn), (cur_drawn, {}))[1], cap=cap)
             if plan is None:
                 ran_out |= budget.expired()
                 break
@@ -297,14 +310,36 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
                 best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cuts, cur_drawn, cut_packing)
 
-    for n_pages in range(fewest, packing.n_pages):
-        say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
-        for emptiest_first in PAGE_CHOICES:
-            attempt(n_pages, None, emptiest_first)
+    first_plan = None
+    if _plan_ahead(len(pieces)):
+        # the first plan (the fewest pages, the first choice) is made in a forked process while this
+        # one packs the pieces as they are, each on one core: read when that packing needs more
+        # pages (the same plan: the process starts from this one's state; the plans' time from here)
+        budget = deadline.within(pack_budget(deadline) + draw_seconds)
+        first_plan = ForkedStream(lambda: iter([plan_pages(pieces, [inp.net for inp in inputs], page, margin, GAP_MM,
+                                                           fewest, budget.at, seed=opts.seed,
+                                                           emptiest_first=PAGE_CHOICES[0], cap=None)]))
+    try:
+        packing = pack(pieces, None, pack_budget(deadline))
+        if first_plan is None:
+            # the plans' time and one drawing of the pieces they cut: a plan is pointless without the
+            # drawing (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1
+            # planned or not by chance)
+            budget = deadline.within(pack_budget(deadline) + draw_seconds)
+        best = (packing.n_pages, len(pieces), parts, inputs, 0, drawn, packing)
+        ran_out = packing.ran_out
+        for n_pages in range(fewest, packing.n_pages):
+            say("layout", f"splitting pieces to fit {n_pages} page{'s' * (n_pages > 1)}")
+            for emptiest_first in PAGE_CHOICES:
+                first = n_pages == fewest and emptiest_first == PAGE_CHOICES[0]
+                attempt(n_pages, None, emptiest_first, first_plan if first else None)
+                if best[0] <= n_pages or ran_out:
+                    break
             if best[0] <= n_pages or ran_out:
                 break
-        if best[0] <= n_pages or ran_out:
-            break
+    finally:
+        if first_plan is not None:
+            first_plan.close()  # (when the packing needed no more pages, the plan is not read)
     # one page fewer than that, with the parts cut compact (hulls of at most CAPS of a page, the
     # largest first); when that is met, one page fewer again
     n_pages = best[0] - 1
