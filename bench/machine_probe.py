@@ -9,8 +9,8 @@ buffered triangles (shapely), 200 MB of fresh memory touched (page faults: a mak
 forked workers fault in pages by the hundred thousand) and 20 forks of this process, one core,
 seeded. `probe_seconds` is the fastest of `repeat`
 runs; a slower hour (the host's other guests) reads higher. bench_make_many.py and
-bench_start.py print it before and after their rows. First read on 2026-12-07 at 17:30 UTC:
-0.27-0.29 s, in an hour when the code of 2026-12-06 (75af39f) made the 1,500-face meshes of
+bench_start.py print it before and after their rows. It read 0.38-0.40 s on 2026-12-07 at
+17:45-18:30 UTC, an evening when the code of 2026-12-06 (75af39f) made the 1,500-face meshes of
 bench_make_many 1.6-2.7 times as slowly (median 1.9) as that day's README table says.
 """
 
