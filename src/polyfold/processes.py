@@ -13,6 +13,7 @@ interpreter. Linux only (fork is unsafe on macOS); elsewhere the work runs here.
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
 import sys
@@ -20,6 +21,30 @@ import types
 from typing import Any, Callable, Sequence, TypeVar
 
 T = TypeVar("T")
+
+
+@contextlib.contextmanager
+def _interrupt_after_fork():
+    """Around a fork in the main thread: a Ctrl-C that comes while it forks is taken after it,
+    in this process. (Python runs a signal's handler at the next line of Python code, and a fork
+    runs some, the at-fork hooks (logging's lock); KeyboardInterrupt raised in one of them is
+    printed as "Exception ignored" and lost, and the interrupted command ran on to its end.) The
+    interrupt is only noted while forking, then handed to the handler that was there before."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():  # (only there may handlers change)
+        yield
+        return
+    caught: list[int] = []
+    here = os.getpid()
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)  # (in the child too, as it was forked from)
+        if caught and callable(previous) and os.getpid() == here:
+            previous(signal.SIGINT, None)
 
 
 def usable_cores() -> int:
@@ -163,7 +188,8 @@ def fork_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> li
         for _ in range(workers):
             out = _results_file()
             try:
-                pid = os.fork()
+                with _interrupt_after_fork():
+                    pid = os.fork()
             except OSError:  # no more processes to be had: those forked do the work
                 out.close()
                 break
@@ -226,7 +252,8 @@ class Forked:
     def __init__(self, fn: Callable[[], Any]) -> None:
         self.returncode: int | None = None
         self._ended, ending = os.pipe()
-        pid = os.fork()
+        with _interrupt_after_fork():
+            pid = os.fork()
         if pid == 0:  # the child: never returns into the caller's code
             code = 1
             try:
@@ -290,7 +317,8 @@ class ForkedStream:
         parent = os.getpid()
         gc.freeze()  # (see fork_map)
         try:
-            pid = os.fork()
+            with _interrupt_after_fork():
+                pid = os.fork()
         except OSError:
             pid = -1
         finally:
@@ -366,7 +394,8 @@ def beside(here: Callable[[], Any], there: Callable[[], Any]) -> tuple[Any, Any]
     try:
         proc = ctx.Process(target=child)
         try:
-            proc.start()
+            with _interrupt_after_fork():
+                proc.start()
         except OSError:
             return here(), there()
         send.close()  # (the child's copy stays open: its end tells this one the child is gone)
@@ -439,7 +468,8 @@ class Standby:
         gc.freeze()  # (see fork_map)
         try:
             self._proc: Any = ctx.Process(target=serve, daemon=True)
-            self._proc.start()
+            with _interrupt_after_fork():
+                self._proc.start()
         except OSError:
             self._proc, self._gone = None, True
         finally:
