@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
 from bench_build import MODELS, _obj_text, decimated, hull_of_points  # noqa: E402
-from machine_probe import probe_seconds  # noqa: E402
+from machine_probe import kernels_ahead, probe_seconds  # noqa: E402
 
 CLI = [str(ROOT / ".venv" / "bin" / "polyfold")] if (ROOT / ".venv" / "bin" / "polyfold").exists() else [
     sys.executable, "-m", "polyfold"]
@@ -83,9 +83,7 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench-many-"))
     todo = meshes(tmp, a.faces, [int(s) for s in a.hull_seeds.split(",") if s], a.only)
     subprocess.run([*CLI, "make", str(ROOT / "examples" / "bunny-128.obj"), "-o", str(tmp / "prime"), "-q"])
-    ahead = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
-                           capture_output=True, text=True).stdout.strip() == "True"
-    if not ahead:  # (any edit of polyfold's sources, a revert too, makes the module stale: its stamp)
+    if not kernels_ahead():
         print("warning: no up-to-date ahead-of-time kernels (run `polyfold warm-up`): these makes run "
               "numba's dispatchers, slower than a set-up install's", file=sys.stderr)
     probe_before = probe_seconds()

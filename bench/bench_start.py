@@ -55,7 +55,7 @@ MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models
 DENSE = "bunny-348:1,horse-302:1,fish-472:1,moneybox-128:2,bumpy-528:1"  # (--dense) name:Loop subdivisions
 DECIMATED = "bumpy-528,bunny-348,fish-472,horse-302"  # (--decimated) Loop-subdivided twice, then to 1,500 faces
 sys.path.insert(0, str(ROOT / "bench"))
-from machine_probe import probe_seconds  # noqa: E402
+from machine_probe import kernels_ahead, probe_seconds  # noqa: E402
 
 
 def _tree_pss_mb(pid: int) -> float:
@@ -193,8 +193,7 @@ def main() -> None:
     run(["make", str(BUNNY), "-o", str(tmp / "prime"), "-q"])  # the project's cache, as after setup
     warm = (("info bunny-128", ["info", str(BUNNY)]),
             ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"]))
-    ahead = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
-                           env=OWN, capture_output=True, text=True).stdout.strip() == "True"
+    ahead = kernels_ahead(OWN)
     for label, args in (("--help", ["--help"]), *warm):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
         how = "" if label == "--help" else ("; kernels ahead of time (no numba)" if ahead

@@ -45,6 +45,18 @@ def _work() -> float:
     return s + area + sum(counts.values())
 
 
+def kernels_ahead(env: dict | None = None) -> bool:
+    """Whether a polyfold process (with `env`) finds its kernels compiled ahead of time for this
+    very code (`polyfold.jit.ahead_ready`): any edit of its sources, a revert too, makes them
+    stale until `polyfold warm-up` runs, and makes then run numba's slower dispatchers."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", "from polyfold.jit import ahead_ready; print(ahead_ready())"],
+                          env=env, capture_output=True, text=True)
+    return done.stdout.strip() == "True"
+
+
 def probe_seconds(repeat: int = 5) -> float:
     """The fastest of `repeat` timings of the fixed work (seconds, wall, this process)."""
     _work()  # (imports and first-touch allocations out of the timings)

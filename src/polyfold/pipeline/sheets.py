@@ -310,22 +310,19 @@ def split_for_pages(mesh: Mesh, parts: list[Part], scale: float, opts: MakeOptio
             if (cut_packing.n_pages, len(cur_drawn[0])) < best[:2]:
                 best = (cut_packing.n_pages, len(cur_drawn[0]), cur_parts, cur_inputs, cuts, cur_drawn, cut_packing)
 
+    # the plans' time and one drawing of the pieces they cut: a plan is pointless without the drawing
+    # (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1 planned or not by chance)
+    budget = deadline.within(pack_budget(deadline) + draw_seconds)
     first_plan = None
     if _plan_ahead(len(pieces)):
         # the first plan (the fewest pages, the first choice) is made in a forked process while this
         # one packs the pieces as they are, each on one core: read when that packing needs more
-        # pages (the same plan: the process starts from this one's state; the plans' time from here)
-        budget = deadline.within(pack_budget(deadline) + draw_seconds)
+        # pages (the same plan: the process starts from this one's state)
         first_plan = ForkedStream(lambda: iter([plan_pages(pieces, [inp.net for inp in inputs], page, margin, GAP_MM,
                                                            fewest, budget.at, seed=opts.seed,
                                                            emptiest_first=PAGE_CHOICES[0], cap=None)]))
     try:
         packing = pack(pieces, None, pack_budget(deadline))
-        if first_plan is None:
-            # the plans' time and one drawing of the pieces they cut: a plan is pointless without the
-            # drawing (1,000+ faces: 7-10 s, as long as the budget, so without it horse-302-loop1
-            # planned or not by chance)
-            budget = deadline.within(pack_budget(deadline) + draw_seconds)
         best = (packing.n_pages, len(pieces), parts, inputs, 0, drawn, packing)
         ran_out = packing.ran_out
         for n_pages in range(fewest, packing.n_pages):
