@@ -79,7 +79,7 @@ def test_kernels_run_just_in_time_without_ahead_code_and_call_kernels():
 
 
 _BUILD = r"""
-import json, sys
+import json, os, sys
 from polyfold.jit import build_ahead, record_calls
 import numpy as np
 import jit_kernels as K
@@ -88,7 +88,7 @@ K.row_sums_of_squares(np.arange(6.0).reshape(2, 3))
 K.ratio(1.0, 2.0)
 K.shifted((np.zeros(3), 0.5), 2, True)
 K.first_negative(np.array([1.0, -1.0]))
-print(json.dumps(build_ahead(calls)))
+print(json.dumps(build_ahead(calls, processes=int(os.environ.get("BUILD_PROCESSES", "1")))))
 """
 
 _CALL = r"""
@@ -119,15 +119,20 @@ def _python(code: str, cache: Path, **env: str) -> dict:
     return json.loads(proc.stdout.splitlines()[-1])
 
 
-def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path):
-    """Recorded calls built into a module (a C compiler: pycc), then a process of its own: the
-    same results as just in time (numpy's division by zero, a tuple in and out, an exception from
-    compiled code) with numba never imported, until a call with other argument types needs it."""
-    said = _python(_BUILD, tmp_path, POLYFOLD_AHEAD="off")
+@pytest.mark.parametrize("processes", [1, 2])
+def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path, processes):
+    """Recorded calls built into modules (a C compiler: pycc; two built at once by two processes),
+    then a process of its own: the same results as just in time (numpy's division by zero, a
+    tuple in and out, an exception from compiled code) with numba never imported, until a call
+    with other argument types needs it."""
+    said = _python(_BUILD, tmp_path, POLYFOLD_AHEAD="off", BUILD_PROCESSES=str(processes))
     assert said.startswith("4 calls of 4 kernels compiled"), said
     table = json.loads((tmp_path / jit.TABLE).read_text())
-    assert (tmp_path / table["file"]).is_file() and set(table["kernels"]) == {
+    assert len(table["modules"]) == processes and all((tmp_path / file).is_file() for _, file in table["modules"])
+    assert set(table["kernels"]) == {
         f"jit_kernels.{k}" for k in ("row_sums_of_squares", "ratio", "shifted", "first_negative")}
+    assert {m for rows in table["kernels"].values() for m, _, _ in rows} == set(range(processes))
+    assert sorted(p.name for p in tmp_path.glob("polyfold_ahead_*")) == sorted(file for _, file in table["modules"])
 
     got = _python(_CALL, tmp_path)
     jit_got = _python(_CALL, tmp_path, POLYFOLD_AHEAD="off")
@@ -167,6 +172,21 @@ print(json.dumps(out))
 """
 
 
+def test_ahead_groups_split_the_calls_once_each_and_keep_a_kernel_with_the_kernels_it_calls():
+    """Every call in exactly one group, none empty; a kernel called from Python and from another
+    kernel goes into the module that has the other already (each module compiles what its calls
+    reach), and the groups stay about equal."""
+    import jit_kernels as K
+
+    calls = [(K.row_sums_of_squares, ()), (K._square, ()), (K.ratio, ()), (K.shifted, ()), (K.first_negative, ())]
+    assert jit.ahead_groups(calls, 1) == [[0, 1, 2, 3, 4]]
+    for n in (2, 3, 10):
+        groups = jit.ahead_groups(calls, n)
+        assert sorted(i for g in groups for i in g) == list(range(5)) and all(groups) and len(groups) <= n
+        assert len(groups) == min(n, 4)  # (_square rides with row_sums_of_squares: four groups at most)
+        assert next(g for g in groups if 0 in g) == next(g for g in groups if 1 in g)
+
+
 def test_start_compiler_sets_numba_up_once_for_forked_processes_and_caches_nothing(tmp_path):
     """`start_compiler` does numba's one-time set-up here (its registries of array functions
     loaded), caching nothing: a process forked after it compiles a kernel into the cache without
@@ -203,9 +223,12 @@ def test_a_missing_or_foreign_table_means_just_in_time(tmp_path, monkeypatch):
     assert jit._load_table() == {}  # none
     (tmp_path / jit.TABLE).write_text("{not json")
     assert jit._load_table() == {}
+    (tmp_path / jit.TABLE).write_text(json.dumps({"stamp": jit.stamp(), "modules": [["polyfold_ahead_x", "gone.so"]],
+                                                  "kernels": {}}))
+    assert jit._load_table() == {}  # its module is gone
     (tmp_path / jit.TABLE).write_text(json.dumps({"stamp": jit.stamp(), "module": "polyfold_ahead_x",
                                                   "file": "gone.so", "kernels": {}}))
-    assert jit._load_table() == {}  # its module is gone
+    assert jit._load_table() == {}  # an older table (one module)
     monkeypatch.setenv(jit.SWITCH, "off")
     assert jit._load_table() == {}
 

@@ -37,11 +37,16 @@ def test_warm_up_reaches_the_kernels_of_every_stage():
 
 
 def test_warm_up_in_two_processes_runs_every_section():
-    """`make setup` on two cores: segmentation and inflation compile in a second process (the
-    entry point `python -m polyfold.apps.warmup SECTION...` prints their seconds as JSON)."""
+    """`make setup` on two cores: the sections split between this process and a second one, which
+    between them run every section one process runs (the entry point `python -m
+    polyfold.apps.warmup SECTION...` prints their seconds as JSON)."""
     import json
 
-    assert set(warm_up(processes=2, ahead=False)) == {"bytecode", "make", "fold", "segment", "inflate"}
+    from polyfold.apps.warmup import HERE, SECOND_PROCESS, WARM_UP
+
+    assert set(warm_up(processes=2, ahead=False)) == {"bytecode", *HERE, *SECOND_PROCESS}
+    # what one process runs, the two run between them
+    assert set(WARM_UP) <= set(HERE) | set(SECOND_PROCESS) and not set(HERE) & set(SECOND_PROCESS)
     proc = subprocess.run([sys.executable, "-m", "polyfold.apps.warmup", "segment", "inflate"], capture_output=True,
                           text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr

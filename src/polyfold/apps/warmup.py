@@ -329,10 +329,15 @@ SECTIONS: dict[str, tuple[str, Callable]] = {
     "guide": ("make's assembly guide: folded poses and pictures", _warm_guide),
 }
 WARM_UP = ("make", "fold", "segment", "inflate")  # what `polyfold warm-up` runs (the rest: in make's)
-# run beside the others in a second process when there are two cores: segmentation's and
-# inflation's kernels share little with make's, so the two halves take about as long (a fresh
-# machine: 61 + 10 s against 32 + 7 s; 110 s in one process)
-SECOND_PROCESS = ("segment", "inflate")
+# with two cores, the same kernels in two processes at once: make's own sections split between
+# them, each taking about half the compiling (seconds of each section on an empty cache, one
+# process, the twenty-ninth session's slow machine: fold-plan 53, fold-check 15, segment 42 there;
+# unfold 33, tabs 14, labels 24, guide 6, inflate 15, then make and fold mostly from the cache,
+# here). The fold stage's sections go first there, so they are in the cache by the time this
+# process's make reaches them (it would otherwise compile them too). Before: make and fold here
+# (136 s), segmentation and inflation there (57 s), idle for the last 80 s.
+HERE = ("unfold", "tabs", "labels", "guide", "inflate", "make", "fold")
+SECOND_PROCESS = ("fold-plan", "fold-check", "segment")
 BESIDE_WAIT_S = 300.0  # the longest a first run waits for `Beside` (its sections take 15-17 s here)
 
 
@@ -449,9 +454,9 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
     """Call every compiled kernel a command can reach once, just in time (into numba's cache);
     then, with `ahead`, compile the kernel calls of those sections ahead of time (`compile_ahead`);
     seconds per section ("ahead": that step). processes: 1 runs every section here; 2 (the default
-    with two or more cores) runs SECOND_PROCESS in a second Python process at the same time (numba
-    compiles in one thread; its cache is written file by file, a temporary file renamed, so two
-    processes may fill it together)."""
+    with two or more cores) runs SECOND_PROCESS in a second Python process and HERE in this one at
+    the same time (numba compiles in one thread; its cache is written file by file, a temporary
+    file renamed, so two processes may fill it together)."""
     import json
 
     from ..jit import just_in_time
@@ -466,8 +471,9 @@ def warm_up(progress: Callable[[str], None] | None = None, processes: int | None
     if processes >= 2:
         beside = start_sections(SECOND_PROCESS, capture=True)
         if progress:
-            progress(f"warm-up: {' and '.join(SECTIONS[n][0] for n in SECOND_PROCESS)}, in a second process")
-    here = [n for n in WARM_UP if beside is None or n not in SECOND_PROCESS]
+            what = [SECTIONS[n][0] for n in SECOND_PROCESS]
+            progress(f"warm-up: {'; '.join(what[:-1])} and {what[-1]}, in a second process")
+    here = list(WARM_UP if beside is None else HERE)
     with just_in_time():
         seconds = run_sections(here, progress)
         if beside is not None:
@@ -513,11 +519,14 @@ def _record_and_build(names: list[str]) -> str:
     """The process of `compile_ahead`: the sections with their kernel calls recorded, then the build."""
     from ..jit import build_ahead, record_calls
 
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})  # (usable_cores() 1: nothing forked)
+    cores = os.sched_getaffinity(0) if hasattr(os, "sched_setaffinity") else None
+    if cores:
+        os.sched_setaffinity(0, {min(cores)})  # (usable_cores() 1: nothing forked)
     calls = record_calls()
     run_sections(names)
-    return build_ahead(calls)
+    if cores:
+        os.sched_setaffinity(0, cores)
+    return build_ahead(calls, processes=usable_cores())
 
 
 if __name__ == "__main__":  # the second process of warm_up: sections named on the command line
