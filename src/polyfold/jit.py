@@ -352,6 +352,7 @@ def build_ahead(calls: dict[Kernel, set[tuple]], processes: int = 1) -> str:
     modules removed). processes: how many modules, each built in a process of its own at the same
     time (`ahead_groups`: pycc compiles a module in one thread). Returns a one-line account (what
     was built, or why nothing was)."""
+    import importlib
     import shutil
     import tempfile
     import warnings
@@ -359,7 +360,7 @@ def build_ahead(calls: dict[Kernel, set[tuple]], processes: int = 1) -> str:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # (pycc is pending deprecation: numba says so on import)
-            from numba.pycc import CC  # noqa: F401  (here: without pycc nothing is built)
+            importlib.import_module("numba.pycc")  # (here: without pycc nothing is built)
     except ImportError as exc:
         return f"not built: this numba has no pycc ({exc})"
     exports = []
