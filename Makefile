@@ -9,9 +9,11 @@ STAMP := $(VENV)/.installed
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	# --no-compile: Python writes the bytecode of what is imported at its first import, instead of pip
-	# compiling every module of every package (35 of pip's 61 s here: matplotlib, scipy, dask...)
+# the packages' bytecode compiled on every core at once, not by pip on one (35 s of pip's 61 s on
+# a slow machine: 19.5 s this way); the same files. (Not left to Python's first imports: where
+# PYTHONDONTWRITEBYTECODE is set, as on this project's machines, nothing would ever write it.)
 	$(BIN)/pip install --quiet --no-compile -e '.[test,viewer,batch,bench]'
+	$(BIN)/python -c "import compileall, sysconfig; compileall.compile_dir(sysconfig.get_paths()['purelib'], quiet=2, workers=0)"
 	@echo "compiling polyfold's numba kernels into their cache, make's kernels ahead of time (with the C compiler) and its modules to bytecode (a minute or two, once, on two cores), so no run waits for them"
 	$(BIN)/polyfold warm-up
 	touch $(STAMP)
