@@ -428,6 +428,9 @@ def test_an_interrupt_while_forking_is_taken_after_the_fork() -> None:
 
     script = textwrap.dedent("""
         import os, signal, sys
+        # (Python's own handler, whatever this test's process was started with: a command started in
+        # the background by a shell without job control, as `.ci/run ... &`, inherits SIGINT ignored)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         from polyfold import processes as P
         armed = [False]
         def interrupt_me():
