@@ -83,6 +83,9 @@ import json, os, sys
 from polyfold.jit import build_ahead, record_calls
 import numpy as np
 import jit_kernels as K
+if os.environ.get("BUILD_NO_FORK"):  # (as where there is no fork: the modules one after another, here)
+    import polyfold.processes
+    polyfold.processes.can_fork = lambda: False
 calls = record_calls()
 K.row_sums_of_squares(np.arange(6.0).reshape(2, 3))
 K.ratio(1.0, 2.0)
@@ -119,13 +122,15 @@ def _python(code: str, cache: Path, **env: str) -> dict:
     return json.loads(proc.stdout.splitlines()[-1])
 
 
-@pytest.mark.parametrize("processes", [1, 2])
-def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path, processes):
-    """Recorded calls built into modules (a C compiler: pycc; two built at once by two processes),
+@pytest.mark.parametrize("processes,fork", [(1, True), (2, True), (2, False)])
+def test_built_ahead_a_fresh_process_calls_the_kernels_without_numba(tmp_path, processes, fork):
+    """Recorded calls built into modules (a C compiler: pycc; two built at once by two processes,
+    or one after another where there is no fork),
     then a process of its own: the same results as just in time (numpy's division by zero, a
     tuple in and out, an exception from compiled code) with numba never imported, until a call
     with other argument types needs it."""
-    said = _python(_BUILD, tmp_path, POLYFOLD_AHEAD="off", BUILD_PROCESSES=str(processes))
+    said = _python(_BUILD, tmp_path, POLYFOLD_AHEAD="off", BUILD_PROCESSES=str(processes),
+                   BUILD_NO_FORK="" if fork else "1")
     assert said.startswith("4 calls of 4 kernels compiled"), said
     table = json.loads((tmp_path / jit.TABLE).read_text())
     assert len(table["modules"]) == processes and all((tmp_path / file).is_file() for _, file in table["modules"])

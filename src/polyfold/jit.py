@@ -352,17 +352,9 @@ def build_ahead(calls: dict[Kernel, set[tuple]], processes: int = 1) -> str:
     modules removed). processes: how many modules, each built in a process of its own at the same
     time (`ahead_groups`: pycc compiles a module in one thread). Returns a one-line account (what
     was built, or why nothing was)."""
-    import importlib
     import shutil
     import tempfile
-    import warnings
 
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # (pycc is pending deprecation: numba says so on import)
-            importlib.import_module("numba.pycc")  # (here: without pycc nothing is built)
-    except ImportError as exc:
-        return f"not built: this numba has no pycc ({exc})"
     exports = []
     for kernel in sorted(calls, key=lambda k: (k.py_func.__module__, k.py_func.__qualname__)):
         for types in sorted(calls[kernel], key=str):
@@ -404,27 +396,21 @@ def build_ahead(calls: dict[Kernel, set[tuple]], processes: int = 1) -> str:
 
 def _build_modules(modules: list[str], exports: list[list[tuple]], build: Path) -> list[str] | str:
     """Each module of `modules` compiled from its (export name, kernel, argument types) into
-    `build`, the first here and each other in a process forked from this one at the same time; the
-    modules' file names, or the one-line account of the first failure."""
+    `build`, the first here and each other in a process forked from this one at the same time
+    (one after another here where there is no fork); the modules' file names, or the one-line
+    account of the first failure."""
     from .processes import Forked, can_fork
 
-    if not can_fork():  # (one after another, here)
-        files = []
-        for module, group in zip(modules, exports):
-            said = _build_module(module, group, build)
-            if said.startswith("not built"):
-                return said
-            files.append(said)
-        return files
+    forked = len(modules) > 1 and can_fork()
     children = []
-    for module, group in zip(modules[1:], exports[1:]):
+    for module, group in zip(modules[1:], exports[1:]) if forked else ():
         read, write = os.pipe()
 
         def child(module=module, group=group, write=write) -> None:
             os.write(write, _build_module(module, group, build).encode())
 
         children.append((Forked(child), read, write))
-    files = [_build_module(modules[0], exports[0], build)]
+    files = [_build_module(module, group, build) for module, group in zip(modules[:1] if forked else modules, exports)]
     for proc, read, write in children:
         os.close(write)
         proc.wait()
@@ -436,13 +422,13 @@ def _build_modules(modules: list[str], exports: list[list[tuple]], build: Path) 
 
 def _build_module(module: str, exports: list[tuple], build: Path) -> str:
     """One ahead-of-time module compiled into `build` (numba's pycc, then the C compiler): its
-    file's name, or "not built: ..." (no C compiler or Python headers)."""
+    file's name, or "not built: ..." (no pycc in this numba, no C compiler or no Python headers)."""
     import warnings
 
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            from numba.pycc import CC
+            warnings.simplefilter("ignore")  # (pycc is pending deprecation: numba says so on import)
+            from numba.pycc import CC  # (a numba without pycc: ImportError, said below)
 
             cc = CC(module)  # (its toolchain: no C compiler raises here already)
             cc.output_dir = str(build)
@@ -453,7 +439,7 @@ def _build_module(module: str, exports: list[tuple], build: Path) -> str:
                 returns = dispatcher.overloads[types].signature.return_type
                 cc.export(export, returns(*types))(_calling(dispatcher, len(types)))
             cc.compile()
-    except Exception as exc:  # (no C compiler or Python headers: numba's and distutils' errors, each its own class)
+    except Exception as exc:  # (no pycc, C compiler or Python headers: numba's and distutils' errors, each its own class)
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         return f"not built: {type(exc).__name__}" + (f": {first}" if first else "")
     return cc.output_file
