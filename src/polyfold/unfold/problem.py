@@ -22,6 +22,10 @@ from . import kernels as K
 from . import setup_kernels as S
 
 MERGED_WEIGHT = -1.0  # the weight of a merged edge in Prim's tree: below every genome weight (>= 0)
+# A vertex whose angle sum exceeds 2 pi by less than this may still end a cut in
+# `single_net_blocked`'s disk rule: a wedge that thin overlaps by less than the overlap test may
+# see, so only vertices clearly hyperbolic (saddles exceed 2 pi by 0.01-1 rad) count as needing two
+LEAF_EXCESS = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,25 +85,58 @@ class UnfoldProblem:
             cut_candidates=cut_candidates,
         )
 
-    def single_net_blocked(self) -> bool:
-        """True when the flat regions kept whole leave no overlap-free single net. An interior
-        hyperbolic vertex needs two cuts (with one, its faces overlap around it); one with at most
-        two edges that may be cut (the others merged) has them all cut: when such a vertex has
-        fewer than two, or those forced cuts split the dual graph, no spanning tree is left."""
-        if not self.merged.any():
-            return False  # every vertex has three edges or more that may be cut
+    def single_net_blocked(self) -> str | None:
+        """Why no overlap-free single net exists (one line), or None when one may. An interior
+        hyperbolic vertex needs two cuts (with one, its faces overlap around it). Two cases found
+        without a search:
+
+        - flat regions kept whole: a hyperbolic vertex with at most two edges that may be cut (the
+          others merged) has them all cut; when it has fewer than two, or those forced cuts split
+          the dual graph, no spanning tree is left;
+        - a disk whose interior vertices all need two cuts: a net of a disk cuts along trees that
+          each meet the boundary at one vertex (its cuts and the boundary make one cycle, the
+          boundary), so each tree has another leaf, an interior vertex with one cut, which only a
+          vertex of angle sum 2 pi or less allows (every saddle-shaped patch of a torus's inside).
+        """
         topo = self.mesh.topology
         ends = topo.edges[self.cut_candidates]
         count = np.bincount(ends.ravel(), minlength=self.mesh.n_vertices)
-        on_boundary = np.zeros(self.mesh.n_vertices, dtype=bool)
-        on_boundary[topo.edges[~topo.interior].ravel()] = True
+        boundary_degree = np.bincount(topo.edges[~topo.interior].ravel(), minlength=self.mesh.n_vertices)
+        on_boundary = boundary_degree > 0
+        if self._disk_without_leaves(count, boundary_degree):
+            return ("no single-piece net of a disk whose interior vertices are all hyperbolic (each cut "
+                    "must end at an interior vertex of angle sum 360 degrees or less)")
+        if not self.merged.any():
+            return None  # every vertex has three edges or more that may be cut
         tight = self.hyperbolic & ~on_boundary & (count <= 2)
+        flat = ("no single-piece net can keep the flat regions whole (hyperbolic vertices on their edges "
+                "need cuts that split the net)")
         if (tight & (count < 2)).any():
-            return True
+            return flat
         forced = np.zeros(topo.n_edges, dtype=bool)
         forced[self.cut_candidates] = tight[ends].any(axis=1)
-        return bool(forced.any()) and face_components(self.mesh.n_faces, topo, ~forced).max() > 0
+        if forced.any() and face_components(self.mesh.n_faces, topo, ~forced).max() > 0:
+            return flat
+        return None
 
+    def _disk_without_leaves(self, count: np.ndarray, boundary_degree: np.ndarray) -> bool:
+        """True when the component is a disk (manifold, one boundary loop: Euler characteristic 1,
+        every boundary vertex on two boundary edges) with interior vertices, none of which can end a
+        cut: each is hyperbolic by more than LEAF_EXCESS or has no edge that may be cut (count (n,):
+        cut candidates at each vertex; boundary_degree (n,): boundary edges at each vertex)."""
+        mesh, topo = self.mesh, self.mesh.topology
+        if not boundary_degree.any() or (topo.face_count > 2).any():
+            return False
+        if ((boundary_degree != 0) & (boundary_degree != 2)).any():
+            return False  # a pinched boundary: not a disk
+        used = np.bincount(mesh.faces.ravel(), minlength=mesh.n_vertices) > 0
+        if int(used.sum()) - topo.n_edges + mesh.n_faces != 1:
+            return False
+        interior = used & (boundary_degree == 0)
+        if not interior.any():
+            return False  # a strip: no cut at all
+        leaf = interior & (count > 0) & (mesh.angle_sums <= 2 * np.pi + LEAF_EXCESS)
+        return not leaf.any()
     def tree_weights(self, weights: np.ndarray) -> np.ndarray:
         """The weights Prim's algorithm runs on: genomes (E,) or (B, E) with every merged edge set
         to MERGED_WEIGHT (float64, C order; the genome itself is not changed)."""

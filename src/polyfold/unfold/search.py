@@ -646,8 +646,7 @@ def unfold(
     problem = UnfoldProblem.from_mesh(mesh)
     blocked = problem.single_net_blocked()
     if max_pieces == 1 and blocked:  # no search can succeed: say so at once
-        raise NoNetFound("no single-piece net can keep the flat regions whole (hyperbolic vertices on their "
-                         "edges need cuts that split the net)")
+        raise NoNetFound(blocked)
     if blocked and time_limit > BLOCKED_SEARCH_S:  # a net in pieces whatever the search: a short one
         deadline, time_limit = Deadline(min(deadline.at, clock() + BLOCKED_SEARCH_S)), BLOCKED_SEARCH_S
     if np.count_nonzero(mesh.topology.interior) == mesh.n_faces - 1:
