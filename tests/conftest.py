@@ -198,6 +198,27 @@ def subdivided_box(times: int = 2) -> Mesh:
     return Mesh(box.vertices, box.faces)
 
 
+def height_grid(n: int, height) -> Mesh:
+    """An n x n grid of unit squares over z = height(x, y), each split along one diagonal."""
+    x, y = np.meshgrid(np.arange(n + 1.0) - n / 2, np.arange(n + 1.0) - n / 2, indexing="ij")
+    vertices = np.column_stack([x.ravel(), y.ravel(), height(x.ravel(), y.ravel())])
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    a = (i * (n + 1) + j).ravel()
+    b, c, d = a + n + 1, a + n + 2, a + 1
+    return Mesh(vertices, np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])]))
+
+
+def torus_inside(major: int) -> Mesh:
+    """`major` x 4 quads of a 24 x 10 torus's inside, a disk whose interior vertices are all
+    hyperbolic (each quad split in two, kept whole as a flat region)."""
+    torus = trimesh.creation.torus(1.0, 0.35, major_sections=24, minor_sections=10)
+    v = torus.vertices
+    radius, angle = np.hypot(v[:, 0], v[:, 1]), np.arctan2(v[:, 1], v[:, 0])
+    inside = (radius < 1.0 - 0.35 * np.cos(2 * np.pi / 5) + 1e-9) & (angle > -1e-9) & (angle < major * np.pi / 12 + 1e-9)
+    keep = inside[torus.faces].all(axis=1)
+    return Mesh(v, torus.faces[keep]).submesh(np.arange(int(keep.sum())))
+
+
 def assert_flat_regions_whole(net: Net) -> None:
     """Every flat region of the net's mesh (faces joined by `merged_edges`) is one polygon of the
     net: its faces are joined by merged creases, and exactly the cycles of its dual graph are left

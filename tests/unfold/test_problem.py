@@ -7,10 +7,9 @@ import time
 import networkx as nx
 import numpy as np
 import pytest
-import trimesh
 from shapely.geometry import Polygon
 
-from conftest import single_component, sorted_side_lengths
+from conftest import height_grid, single_component, sorted_side_lengths, torus_inside
 from polyfold.errors import NoNetFound
 from polyfold.mesh.mesh import Mesh
 from polyfold.unfold.problem import UnfoldProblem, local_frames
@@ -22,26 +21,6 @@ def test_local_frames_keep_side_lengths(models_dir):
     loc = local_frames(mesh.vertices, mesh.faces)
     np.testing.assert_allclose(sorted_side_lengths(loc), sorted_side_lengths(mesh.vertices[mesh.faces]), rtol=1e-12)
     assert (loc[:, 2, 1] > 0).all()
-
-
-def _height_grid(n: int, height) -> Mesh:
-    """An n x n grid of unit squares over z = height(x, y), each split along one diagonal."""
-    x, y = np.meshgrid(np.arange(n + 1.0) - n / 2, np.arange(n + 1.0) - n / 2, indexing="ij")
-    vertices = np.column_stack([x.ravel(), y.ravel(), height(x.ravel(), y.ravel())])
-    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
-    a = (i * (n + 1) + j).ravel()
-    b, c, d = a + n + 1, a + n + 2, a + 1
-    return Mesh(vertices, np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])]))
-
-
-def _torus_saddle() -> Mesh:
-    """Two by four quads of a 24 x 10 torus's inside (quads split in two, kept whole as flat regions)."""
-    torus = trimesh.creation.torus(1.0, 0.35, major_sections=24, minor_sections=10)
-    v = torus.vertices
-    radius, angle = np.hypot(v[:, 0], v[:, 1]), np.abs(np.arctan2(v[:, 1], v[:, 0]))
-    inside = (radius < 1.0 - 0.35 * np.cos(2 * np.pi / 5) + 1e-9) & (angle < 2 * np.pi / 24 + 1e-9)
-    keep = inside[torus.faces].all(axis=1)
-    return Mesh(v, torus.faces[keep]).submesh(np.arange(int(keep.sum())))
 
 
 def _single_nets(mesh: Mesh) -> int:
@@ -93,13 +72,13 @@ def _apex(a2, b2, away2, a3, b3, tip3) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name, mesh, blocked, nets", [
-    ("torus inside, 2 x 4 quads", _torus_saddle(), True, False),
-    ("saddle z = (x^2 - y^2) / 3, 3 x 3", _height_grid(3, lambda x, y: (x * x - y * y) / 3), True, False),
-    ("bowl z = (x^2 + y^2) / 3, 3 x 3", _height_grid(3, lambda x, y: (x * x + y * y) / 3), False, True),
+    ("torus inside, 2 x 4 quads", torus_inside(2), True, False),
+    ("saddle z = (x^2 - y^2) / 3, 3 x 3", height_grid(3, lambda x, y: (x * x - y * y) / 3), True, False),
+    ("bowl z = (x^2 + y^2) / 3, 3 x 3", height_grid(3, lambda x, y: (x * x + y * y) / 3), False, True),
     # the rule only rules nets out: here a cut may end at the peak, and it is overlaps farther from
     # the vertices that leave no single net, which only a search (or brute force) finds
     ("saddle with one vertex raised to a peak",
-     _height_grid(3, lambda x, y: (x * x - y * y) / 3 + 0.6 * (x == 0.5) * (y == 0.5)), False, False),
+     height_grid(3, lambda x, y: (x * x - y * y) / 3 + 0.6 * (x == 0.5) * (y == 0.5)), False, False),
 ])
 def test_a_disk_of_saddle_vertices_has_no_single_net(name, mesh, blocked, nets):
     # "no single net" is checked against every spanning tree the mesh has

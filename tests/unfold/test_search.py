@@ -3,13 +3,15 @@ at hyperbolic vertices, every method, the same net for the same seed, the multi-
 the time budget (time_limit or a Deadline), flat regions (coplanar faces, input polygons) whole in
 every net."""
 
+import itertools
 import time
 
 import numpy as np
 import pytest
+from shapely.geometry import Polygon
 
 from conftest import (NO_SINGLE_NET, assert_flat_regions_whole, closed_meshes, single_component, sorted_side_lengths,
-                      subdivided_box)
+                      subdivided_box, torus_inside)
 from polyfold.collide.flat import find_overlaps
 from polyfold.deadline import Deadline
 from polyfold.errors import NoNetFound
@@ -272,22 +274,25 @@ def test_a_blocked_mesh_is_unfolded_into_pieces_after_a_short_search(models_dir,
     import polyfold.unfold.search as S
 
     given = []
-    run = S.run_memetic
+    searches = {"run_memetic": S.run_memetic, "fewest_pieces": S.fewest_pieces}
 
-    def recorded(problem, rng, deadline, *args, **kwargs):
-        given.append(deadline.left())
-        return run(problem, rng, deadline, *args, **kwargs)
+    def recorded(name):
+        def run(problem, rng, deadline, *args, **kwargs):
+            given.append((name, deadline.left()))
+            return searches[name](problem, rng, deadline, *args, **kwargs)
+        return run
 
-    monkeypatch.setattr(S, "run_memetic", recorded)
+    for name in searches:
+        monkeypatch.setattr(S, name, recorded(name))
     mesh = single_component(models_dir, "star-4split-96")
     net, stats = unfold(mesh, seed=1, time_limit=60)
-    assert len(given) == 1 and given[0] <= S.BLOCKED_SEARCH_S
-    assert stats.timed_out and stats.pieces > 1
+    assert len(given) == 1 and given[0][0] == "fewest_pieces" and given[0][1] <= S.BLOCKED_SEARCH_S
+    assert stats.timed_out and stats.pieces > 1 and stats.method == "fewest-pieces"
     assert_valid_net(net, n_pieces=stats.pieces)
     assert_flat_regions_whole(net)
     given.clear()
     unfold(single_component(models_dir, "bunny-128"), seed=1, time_limit=60)  # not blocked: its time limit
-    assert len(given) == 1 and given[0] > 50
+    assert len(given) == 1 and given[0][0] == "run_memetic" and given[0][1] > 50
 
 
 def test_fallback_cuts_only_cuttable_creases(models_dir):
@@ -477,3 +482,23 @@ def test_two_racing_searches_give_the_earlier_rounds_net_on_one_core_or_two(mode
     G, L = problem.evaluate(w1[None, :])
     assert float(search._fitness(G, L)[0]) == 0.0
     assert {4: (2, 0), 65: (2, 1), 86: (2, 0)}[seed] == expected
+
+
+@pytest.mark.parametrize("major", [2, 3])
+def test_a_disk_with_no_single_net_is_cut_into_the_fewest_pieces(major):
+    # 2 x 4 and 3 x 4 quads of a torus's inside have no single net (every interior vertex is a
+    # saddle, tests/unfold/test_problem.py) and two pieces suffice (strips along the minor circle);
+    # the GA this search replaced cut its fewest-overlaps tree into 3 and 4. Each piece is checked
+    # apart from polyfold's overlap test: no two of its faces overlap by more than a sliver (shapely).
+    mesh = torus_inside(major)
+    assert mesh.n_faces == 8 * major
+    for seed in (1, 2, 3):
+        net, stats = unfold(mesh, seed=seed, time_limit=60)
+        assert stats.pieces == net.n_pieces == 2 and stats.method == "fewest-pieces"
+        assert_valid_net(net, n_pieces=2)
+        assert_flat_regions_whole(net)
+        faces = [Polygon(c) for c in net.coords]
+        sliver = 1e-9 * min(f.area for f in faces)
+        for f, g in itertools.combinations(range(mesh.n_faces), 2):
+            if net.piece[f] == net.piece[g]:
+                assert faces[f].intersection(faces[g]).area <= sliver

@@ -9,6 +9,8 @@ face keeps light edges as creases. Fitness = -(G + 100 L), G = overlapping face 
 at cuts around hyperbolic vertices. The GA stops at the first valid net. When the time (a
 `Deadline`) or the generation budget runs out, the best tree is split into the fewest overlap-free
 pieces found by a set cover of the crease paths between overlapping faces (ALGORITHMS.md 5.6).
+Where no single net exists (`UnfoldProblem.single_net_blocked`), "auto" runs no GA: a short search
+for the tree cut into the fewest pieces (`fewest_pieces`).
 The merged edges of flat regions (`UnfoldProblem.merged`) are creases of every tree; the local
 search and the fallback never cut them (the fallback only when two faces of one region overlap).
 """
@@ -49,6 +51,12 @@ class UnfoldStats:
 # faces, star-4split-96's and a subdivided bunny's, seeds 1-3: the same piece counts at 0.25-0.5 s as
 # at 5-10 s; make had spent 51 s of the star's 53 s searching its four blocked parts)
 BLOCKED_SEARCH_S = 0.5
+# `fewest_pieces` (method "auto" on such a mesh) stops sooner when this many trees in a row are cut
+# into no fewer pieces. Against the GA it replaced there (0.5 s, seeds 1-3): 14 blocked parts of 16-96
+# faces (a 24 x 10 torus's inside, star-4split-96 and its parts) 141 -> 100 pieces, 0.72 -> 0.18 s a
+# search (the GA's generation on 16 faces overran its deadline by up to 0.4 s); saddles z = x^2 - y^2
+# of 32-392 faces 87 -> 64 pieces, 1.0 -> 0.46 s; twice the time saved at most one piece
+BLOCKED_STALL = 500
 FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
 RESTART_GENERATIONS = 3  # the memetic search's restart unit (generations, times the Luby sequence)
 
@@ -590,6 +598,48 @@ def split_into_pieces(parent: np.ndarray, parent_edge: np.ndarray, order: np.nda
     return cut
 
 
+def _cuttable(problem: UnfoldProblem, parent_edge: np.ndarray) -> np.ndarray:
+    """(F,) faces whose crease to their parent the fallback may cut (not the base, no merged edge)."""
+    return (parent_edge >= 0) & ~problem.merged[parent_edge]
+
+
+def _pieces_of(problem: UnfoldProblem, genome: np.ndarray) -> tuple[int, int]:
+    """(pieces, overlapping pairs) of a genome's tree cut by `split_into_pieces`' greedy cover."""
+    parent, parent_edge, order, coords = problem.decode(genome)
+    pairs = problem.overlaps(coords, parent)
+    if len(pairs) == 0:
+        return 1, 0
+    cut = split_into_pieces(parent, parent_edge, order, pairs, exact_limit=0, cuttable=_cuttable(problem, parent_edge))
+    return int(np.count_nonzero(cut)) + 1, len(pairs)
+
+
+def fewest_pieces(problem: UnfoldProblem, rng: np.random.Generator, deadline: Deadline) -> tuple[np.ndarray, int]:
+    """For a mesh with no single net (`UnfoldProblem.single_net_blocked`): a genome whose tree the
+    fallback cuts into few pieces, and how many trees were scored. The tree with the fewest
+    overlapping pairs (what the GA looks for) is not the one cut into the fewest pieces (a 24-face
+    part of a torus's inside: 6 pairs, 3 pieces; 14 pairs, 2), so trees are scored here by their
+    pieces (`split_into_pieces`' greedy cover), then their pairs: the heuristics' trees, then one to
+    three cut candidates' weights of the best drawn afresh, kept when no worse, until the deadline or
+    BLOCKED_STALL trees in a row without a better one."""
+    best, best_score, trees, stall = None, (0, 0), 0, 0
+    starts = iter(HEURISTICS.values())
+    candidates = problem.cut_candidates
+    while best is None or (best_score[0] > 1 and stall < BLOCKED_STALL and not deadline.expired()):
+        start = next(starts, None)
+        if start is not None:
+            trial = start(problem, rng)
+        else:
+            trial = best.copy()
+            drawn = rng.choice(candidates, size=min(int(rng.integers(1, 4)), len(candidates)), replace=False)
+            trial[drawn] = rng.random(len(drawn))
+        score = _pieces_of(problem, trial)
+        trees += 1
+        stall = 0 if best is None or score < best_score else stall + 1
+        if best is None or score <= best_score:
+            best, best_score = trial, score
+    return best, trees
+
+
 def _cuttable_paths(ptr: np.ndarray, members: np.ndarray, cuttable: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The tree paths (CSR ptr, members: creases named by their child face) without the creases
     that may not be cut, except on paths made of such creases only (kept whole)."""
@@ -629,7 +679,7 @@ def unfold(
     method: "auto" (heuristics' best first, then the GA), "ga", or a heuristic name. max_pieces=1
     raises `NoNetFound` instead of falling back to several pieces (at once when
     `UnfoldProblem.single_net_blocked`; without max_pieces such a mesh is searched for at most
-    BLOCKED_SEARCH_S). Deterministic for a given seed
+    BLOCKED_SEARCH_S, by `fewest_pieces` under "auto"). Deterministic for a given seed
     (the time limit can only make it stop earlier). accept (method "auto" only): keep searching,
     within the time limit, for a valid net that also passes this test (e.g. linear foldability);
     `UnfoldStats.accepted` says whether one did. deadline: when given, the search stops there
@@ -661,8 +711,13 @@ def unfold(
                 return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
         # Large meshes: a smaller seed population, so the local search gets the time budget.
         population = min(max(200_000 // mesh.n_faces, 50), 400)
-        weights, fitness, generations, evaluations, winner = run_memetic(
-            problem, rng, deadline, max_generations, population=population, progress=progress, accept=accept_genome)
+        if blocked:  # no single net to find: the tree cut into the fewest pieces instead
+            weights, evaluations = fewest_pieces(problem, rng, deadline)
+            fitness, generations, winner = 0.0, 0, "fewest-pieces"
+        else:
+            weights, fitness, generations, evaluations, winner = run_memetic(
+                problem, rng, deadline, max_generations, population=population, progress=progress,
+                accept=accept_genome)
     elif method == "ga":
         weights, fitness, generations, evaluations, winner = run_ga(problem, rng, deadline, max_generations, progress=progress)
     else:
@@ -676,9 +731,8 @@ def unfold(
         """The net, cut into pieces where faces overlap (none: as it is)."""
         cut = None
         if len(pairs):
-            cuttable = (parent_edge >= 0) & ~problem.merged[parent_edge]
             cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * time_limit + 0.5),
-                                    cuttable=cuttable)
+                                    cuttable=_cuttable(problem, parent_edge))
         return _net_from_tree(problem, parent, parent_edge, order, coords, cut)
 
     if len(pairs) and max_pieces == 1:
