@@ -104,13 +104,13 @@ class UnfoldProblem:
         boundary_degree = np.bincount(topo.edges[~topo.interior].ravel(), minlength=self.mesh.n_vertices)
         on_boundary = boundary_degree > 0
         if self._disk_without_leaves(count, boundary_degree):
-            return ("no single-piece net of a disk whose interior vertices are all hyperbolic (each cut "
-                    "must end at an interior vertex of angle sum 360 degrees or less)")
+            return ("no single-piece net exists: every interior vertex of this disk is hyperbolic, and a cut "
+                    "must end at one of angle sum 360 degrees or less")
         if not self.merged.any():
             return None  # every vertex has three edges or more that may be cut
         tight = self.hyperbolic & ~on_boundary & (count <= 2)
-        flat = ("no single-piece net can keep the flat regions whole (hyperbolic vertices on their edges "
-                "need cuts that split the net)")
+        flat = ("no single-piece net can keep the flat regions whole: hyperbolic vertices on their edges "
+                "need cuts that split the net")
         if (tight & (count < 2)).any():
             return flat
         forced = np.zeros(topo.n_edges, dtype=bool)

@@ -44,6 +44,7 @@ class UnfoldStats:
     timed_out: bool
     best_overlaps: int = 0
     accepted: bool | None = None  # passed the caller's `accept` test (None: no test asked)
+    no_single_net: str | None = None  # why none exists, when that was told without a search (`single_net_blocked`)
 
 
 # the search's time when no single net exists (`UnfoldProblem.single_net_blocked`): it can only trade
@@ -753,6 +754,6 @@ def unfold(
         accepted = net.n_pieces == 1 and bool(accept(net))
     stats = UnfoldStats(
         seconds=time.perf_counter() - t0, generations=generations, evaluations=evaluations, method=winner,
-        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs), accepted=accepted,
+        pieces=net.n_pieces, timed_out=timed_out, best_overlaps=len(pairs), accepted=accepted, no_single_net=blocked,
     )
     return net, stats

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from conftest import (NO_SINGLE_NET, PARTS, by_class, closed_meshes, models_path, one_line, read_png, run_cli,
-                      straight, unfold_cli)
+                      straight, torus_inside, unfold_cli)
 from fold_checker import check_fold
 from path_checker import check_path
 
@@ -203,6 +203,26 @@ def test_tiny_time_limit_max_pieces_1(models_dir: Path, tmp_path: Path) -> None:
         assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
         assert "bumpy-528" in proc.stderr
         assert list(out_dir.iterdir()) == []
+
+
+def test_a_mesh_without_a_single_net_is_told_so(tmp_path: Path) -> None:
+    # a patch of a torus's inside (every interior vertex a saddle) has no single net: --max-pieces 1
+    # fails at once naming why, and without it the net comes in the fewest pieces (two), which the
+    # independent checker passes
+    import trimesh
+
+    mesh = torus_inside(2)
+    obj = tmp_path / "inside.obj"
+    trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).export(obj)
+    out = tmp_path / "net.fold"
+    proc = unfold_cli(obj, out, "--max-pieces", "1")
+    assert proc.returncode == 1
+    assert "every interior vertex of this disk is hyperbolic" in one_line(proc.stderr)
+    assert not out.exists()
+    proc = unfold_cli(obj, out)
+    assert_single_net(obj, out, proc, single=False)
+    assert check_fold(out, obj).pieces == 2
+    assert "2 pieces" in proc.stderr and "no single-piece net exists" in proc.stderr
 
 
 def test_bad_max_pieces(models_dir: Path, tmp_path: Path) -> None:

@@ -124,7 +124,10 @@ def _say_unfolded(name: str, result, seconds: float) -> None:
     note = "" if path is None else f", folding path {len(path.frames)} frames ({path.planner}, {path.seconds:.2f} s)"
     if result.linear is not None:
         note += ", linearly foldable" if result.linear else ", no linearly foldable net found in time"
-    if any(s.timed_out for s in stats):
+    reasons = sorted({s.no_single_net for s in stats if s.no_single_net})
+    if reasons:
+        note += f" ({'; '.join(reasons)}; cut into the fewest overlap-free pieces found)"
+    elif any(s.timed_out for s in stats):
         note += " (no single net within the time limit: fell back to several overlap-free pieces)"
     say(f"{name}: {pieces} piece{'s' if pieces != 1 else ''}, {seconds:.2f} s, {gens} generations, "
         f"method {methods}{note}")
