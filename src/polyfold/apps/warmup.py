@@ -151,6 +151,7 @@ def _warm_fold(mesh) -> None:
         _, stats = unfold(bumpy, seed=seed, time_limit=10.0)
         if "local-search" in stats.method:
             break
+    _warm_no_single_net()
     net, _ = unfold(mesh, seed=1, time_limit=10.0)
     tree = FoldTree.from_net(net)
     for thickness in (0.0, THICKNESS_REL):
@@ -235,6 +236,20 @@ def _bumpier_sphere() -> "Mesh":
     return Mesh(*bumpy_sphere(subdivisions=2, sigma=0.15, seed=1))
 
 
+def _warm_no_single_net() -> None:
+    """The unfolder on a mesh with no single net (a 3 x 3 grid on the saddle z = (x^2 - y^2) / 3, whose
+    interior vertices are all hyperbolic): `fewest_pieces` and the fallback's set cover, which the
+    sphere's nets never reach (a first blocked part paid 1 s of loading numba for them)."""
+    from ..mesh.mesh import Mesh
+    from ..unfold.search import unfold
+
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(4.0) - 1.5, np.arange(4.0) - 1.5, indexing="ij"))
+    corner = (np.arange(3)[:, None] * 4 + np.arange(3)[None, :]).ravel()
+    faces = np.concatenate([np.column_stack([corner, corner + 4, corner + 5]),
+                            np.column_stack([corner, corner + 5, corner + 1])])
+    unfold(Mesh(np.column_stack([x, y, (x * x - y * y) / 3]), faces), seed=1, time_limit=1.0)
+
+
 def _warm_unfold(mesh) -> None:
     """make's unfold stage (`pipeline.parts.make_parts`: the net search, its local search, the
     moves that make room for tabs) on a bumpier sphere whose heuristic nets overlap, so that the
@@ -249,6 +264,7 @@ def _warm_unfold(mesh) -> None:
         _, _, report = make_parts(bumpy, MakeOptions(seed=seed), Deadline.after(10.0), lambda stage, message: None)
         if any("local-search" in net.method for net in report.nets):
             break
+    _warm_no_single_net()
 
 
 def _warm_fold_plan(mesh) -> None:
@@ -315,7 +331,7 @@ def _warm_inflate(mesh) -> None:
 # name: (what it compiles, how); in this order in one process
 SECTIONS: dict[str, tuple[str, Callable]] = {
     "make": ("make (every stage of the main job)", _warm_make),
-    "fold": ("the unfolder's local search and the folding planners", _warm_fold),
+    "fold": ("the unfolder's local search and fallback, and the folding planners", _warm_fold),
     "segment": ("segmentation", _warm_segment),
     "inflate": ("inflation", _warm_inflate),
     # (make's own: a `polyfold server` makes its sphere through the command line instead)

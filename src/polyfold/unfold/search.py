@@ -621,22 +621,21 @@ def fewest_pieces(problem: UnfoldProblem, rng: np.random.Generator, deadline: De
     part of a torus's inside: 6 pairs, 3 pieces; 14 pairs, 2), so trees are scored here by their
     pieces (`split_into_pieces`' greedy cover), then their pairs: the heuristics' trees, then one to
     three cut candidates' weights of the best drawn afresh, kept when no worse, until the deadline or
-    BLOCKED_STALL trees in a row without a better one."""
-    best, best_score, trees, stall = None, (0, 0), 0, 0
-    starts = iter(HEURISTICS.values())
+    BLOCKED_STALL trees in a row without a better one. The heuristics' trees are scored whatever the
+    deadline (milliseconds), so a slow first call cannot leave the search without them."""
+    scored = [(_pieces_of(problem, genome), k, genome)
+              for k, genome in enumerate(start(problem, rng) for start in HEURISTICS.values())]
+    best_score, _, best = min(scored, key=lambda s: s[:2])
+    trees, stall = len(scored), 0
     candidates = problem.cut_candidates
-    while best is None or (best_score[0] > 1 and stall < BLOCKED_STALL and not deadline.expired()):
-        start = next(starts, None)
-        if start is not None:
-            trial = start(problem, rng)
-        else:
-            trial = best.copy()
-            drawn = rng.choice(candidates, size=min(int(rng.integers(1, 4)), len(candidates)), replace=False)
-            trial[drawn] = rng.random(len(drawn))
+    while best_score[0] > 1 and stall < BLOCKED_STALL and len(candidates) and not deadline.expired():
+        trial = best.copy()
+        drawn = rng.choice(candidates, size=min(int(rng.integers(1, 4)), len(candidates)), replace=False)
+        trial[drawn] = rng.random(len(drawn))
         score = _pieces_of(problem, trial)
         trees += 1
-        stall = 0 if best is None or score < best_score else stall + 1
-        if best is None or score <= best_score:
+        stall = 0 if score < best_score else stall + 1
+        if score <= best_score:
             best, best_score = trial, score
     return best, trees
 
