@@ -264,12 +264,13 @@ def depth_chain(pts, pstart, unxt, ua, ub, eq, limit):
             x, y, z = pts[i, 0], pts[i, 1], pts[i, 2]
             # The facet that bounded the previous point first: neighbouring points share facets.
             m = -(eq[hint, 0] * x + eq[hint, 1] * y + eq[hint, 2] * z + eq[hint, 3])
-            j = 0
+            j, start = 1, hint
             while j < n_f and m > best:  # the point's depth, or any value <= best once it is known to be
-                d = -(eq[j, 0] * x + eq[j, 1] * y + eq[j, 2] * z + eq[j, 3])
+                f = start + j if start + j < n_f else start + j - n_f  # on from the hint
+                d = -(eq[f, 0] * x + eq[f, 1] * y + eq[f, 2] * z + eq[f, 3])
                 if d < m:
                     m = d
-                    hint = j
+                    hint = f
                 j += 1
             if m > best:
                 best = m
