@@ -2,6 +2,7 @@
 without a search (`single_net_blocked`) are ruled out by brute force too."""
 
 import itertools
+import math
 import time
 
 import networkx as nx
@@ -11,7 +12,9 @@ from shapely.geometry import Polygon
 
 from conftest import height_grid, single_component, sorted_side_lengths, torus_inside
 from polyfold.errors import NoNetFound
+from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
+from polyfold.segment.segment import DEFAULT_TAU, segment
 from polyfold.unfold.problem import UnfoldProblem, local_frames
 from polyfold.unfold.search import unfold
 
@@ -94,3 +97,19 @@ def test_a_disk_of_saddle_vertices_has_no_single_net(name, mesh, blocked, nets):
         with pytest.raises(NoNetFound, match="every interior vertex"):
             unfold(mesh, seed=1, time_limit=60, max_pieces=1)
         assert time.perf_counter() - t0 < 5
+
+
+@pytest.mark.parametrize("name, how", [("torus-8x4-64", {"tau": DEFAULT_TAU}), ("torus-12x6-144", {"parts": 6}),
+                                       ("open/tube-132", {"parts": 6})])
+def test_the_disk_rule_on_the_parts_of_shared_models(models_dir, name, how):
+    # the parts segmentation makes of the shared models that the disk rule says have no single net
+    # (patches of a torus's or a tube's inside), checked by brute force where their spanning trees
+    # are few enough to enumerate
+    mesh = load_mesh(models_dir / f"{name}.obj").mesh
+    parts = [mesh.submesh(f) for f in segment(mesh, seed=0, **how).face_ids]
+    ruled_out = [p for p in parts if "every interior vertex" in (UnfoldProblem.from_mesh(p).single_net_blocked() or "")]
+    small = [p for p in ruled_out
+             if math.comb(int(p.topology.interior.sum()), int(p.topology.interior.sum()) - p.n_faces + 1) <= 1000]
+    assert small
+    for part in small:
+        assert _single_nets(part) == 0

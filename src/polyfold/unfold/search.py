@@ -704,6 +704,9 @@ def unfold(
         # spanning tree there is, whatever the weights
         weights = np.zeros(mesh.topology.n_edges)
         fitness, generations, evaluations, winner = 0.0, 0, 0, "trivial"
+    elif method == "auto" and blocked:  # no single net to find: the tree cut into the fewest pieces instead
+        weights, evaluations = fewest_pieces(problem, rng, deadline)
+        fitness, generations, winner = 0.0, 0, "fewest-pieces"
     elif method == "auto":
         accept_genome = None
         if accept is not None:
@@ -711,13 +714,8 @@ def unfold(
                 return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
         # Large meshes: a smaller seed population, so the local search gets the time budget.
         population = min(max(200_000 // mesh.n_faces, 50), 400)
-        if blocked:  # no single net to find: the tree cut into the fewest pieces instead
-            weights, evaluations = fewest_pieces(problem, rng, deadline)
-            fitness, generations, winner = 0.0, 0, "fewest-pieces"
-        else:
-            weights, fitness, generations, evaluations, winner = run_memetic(
-                problem, rng, deadline, max_generations, population=population, progress=progress,
-                accept=accept_genome)
+        weights, fitness, generations, evaluations, winner = run_memetic(
+            problem, rng, deadline, max_generations, population=population, progress=progress, accept=accept_genome)
     elif method == "ga":
         weights, fitness, generations, evaluations, winner = run_ga(problem, rng, deadline, max_generations, progress=progress)
     else:
