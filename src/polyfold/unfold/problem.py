@@ -137,6 +137,7 @@ class UnfoldProblem:
             return False  # a strip: no cut at all
         leaf = interior & (count > 0) & (mesh.angle_sums <= 2 * np.pi + LEAF_EXCESS)
         return not leaf.any()
+
     def tree_weights(self, weights: np.ndarray) -> np.ndarray:
         """The weights Prim's algorithm runs on: genomes (E,) or (B, E) with every merged edge set
         to MERGED_WEIGHT (float64, C order; the genome itself is not changed)."""

@@ -56,7 +56,8 @@ BLOCKED_SEARCH_S = 0.5
 # into no fewer pieces. Against the GA it replaced there (0.5 s, seeds 1-3): 14 blocked parts of 16-96
 # faces (a 24 x 10 torus's inside, star-4split-96 and its parts) 141 -> 100 pieces, 0.72 -> 0.18 s a
 # search (the GA's generation on 16 faces overran its deadline by up to 0.4 s); saddles z = x^2 - y^2
-# of 32-392 faces 87 -> 64 pieces, 1.0 -> 0.46 s; twice the time saved at most one piece
+# of 32-392 faces 87 -> 64 pieces, 1.0 -> 0.46 s (bench/bench_no_single_net.py); 4 s instead of 0.5
+# saved 1 and 3 pieces over three seeds on the 200- and 392-face saddles, none on star-4split-96
 BLOCKED_STALL = 500
 FIRST_BATCH = 25  # heuristic nets built before the memetic search's first local search
 RESTART_GENERATIONS = 3  # the memetic search's restart unit (generations, times the Luby sequence)
