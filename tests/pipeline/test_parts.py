@@ -1,9 +1,9 @@
 """pipeline/parts.py (make's segment + unfold stage): how long a component's single net is
-searched for before it is segmented."""
+searched for before it is segmented; a part with no single net says why."""
 
 from __future__ import annotations
 
-from conftest import single_component
+from conftest import single_component, torus_inside
 
 import polyfold.pipeline.parts as parts_module
 from polyfold.deadline import Deadline
@@ -29,3 +29,15 @@ def test_a_single_net_is_searched_for_as_long_as_its_faces_warrant(models_dir, m
     assert all(limit <= SINGLE_NET_S + SINGLE_NET_S_PER_FACE * n for n, limit in given)
     assert len(parts) >= 2 and seg.segmented_components == (0,)
     assert sum(len(p.faces) for p in parts) == 144 and all(p.net.n_pieces == 1 for p in parts)
+
+
+def test_a_part_with_no_single_net_says_why():
+    # a patch of a torus's inside has no single net (tests/unfold/test_problem.py): make's report
+    # says why beside its pieces, and make says it once for all such parts
+    said: list[tuple[str, str]] = []
+    parts, seg, report = make_parts(torus_inside(2), MakeOptions(), Deadline.after(30.0),
+                                    lambda stage, message: said.append((stage, message)))
+    assert sum(p.net.n_pieces for p in parts) == sum(n.pieces for n in report.nets) == 2
+    assert all("interior vertices are all hyperbolic" in n.no_single_net for n in report.nets)
+    assert [m for s, m in said if "the fewest found" in m] == [
+        f"{len(report.nets)} part(s) cut into 2 pieces, the fewest found: {report.nets[0].no_single_net}"]

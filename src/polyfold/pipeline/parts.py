@@ -134,8 +134,12 @@ def make_parts(mesh: Mesh, opts: MakeOptions, deadline: Deadline, say: Callable[
         net, room = open_notches(net, deadline=Deadline.after(min(TAB_ROOM_S, max(0.1, deadline.left()))))
         unfold_s += time.perf_counter() - tu
         nets.append(NetReport(faces=int(len(faces)), pieces=int(net.n_pieces), seconds=st.seconds, method=st.method,
-                              timed_out=bool(st.timed_out)))
+                              timed_out=bool(st.timed_out), no_single_net=st.no_single_net))
         out.append(Part(faces, net))
+    for reason in sorted({n.no_single_net for n in nets if n.no_single_net}):
+        blocked = [n for n in nets if n.no_single_net == reason]
+        say("unfold", f"{len(blocked)} part(s) cut into {sum(n.pieces for n in blocked)} pieces, the fewest found: "
+                      f"{reason}")
     tau = segmenter.tau if opts.segments else (DEFAULT_TAU if segmented else None)
     seg_report = SegmentReport(mode=mode, tau=tau, parts=len(out), concavity=tuple(segmenter.concavity),
                                seconds=segmenter.seconds, segmented_components=tuple(segmented))

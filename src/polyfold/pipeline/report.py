@@ -112,6 +112,7 @@ class NetReport:
     seconds: float
     method: str
     timed_out: bool
+    no_single_net: str | None = None  # why the part has none, when told without a search (`UnfoldStats`)
 
 
 @dataclass(frozen=True)

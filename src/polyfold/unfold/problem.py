@@ -104,8 +104,8 @@ class UnfoldProblem:
         boundary_degree = np.bincount(topo.edges[~topo.interior].ravel(), minlength=self.mesh.n_vertices)
         on_boundary = boundary_degree > 0
         if self._disk_without_leaves(count, boundary_degree):
-            return ("no single-piece net exists: every interior vertex of this disk is hyperbolic, and a cut "
-                    "must end at one of angle sum 360 degrees or less")
+            return ("no single-piece net exists: a disk whose interior vertices are all hyperbolic needs a cut "
+                    "ending at one of angle sum 360 degrees or less")
         if not self.merged.any():
             return None  # every vertex has three edges or more that may be cut
         tight = self.hyperbolic & ~on_boundary & (count <= 2)
