@@ -114,3 +114,19 @@ def test_the_disk_rule_on_the_parts_of_shared_models(models_dir, name, how):
     assert small
     for part in small:
         assert _single_nets(part) == 0
+
+
+def test_a_vertex_inside_a_flat_region_may_end_a_cut():
+    # a saddle grid whose middle is flat: every interior vertex is hyperbolic but the middle one,
+    # whose edges are all merged (its region is kept whole); a tree cannot hold every merged edge
+    # around it, so a net slits the region there and a cut may end at it: the disk rule claims nothing
+    def height(x, y):
+        return np.where((np.abs(x) <= 1) & (np.abs(y) <= 1) & (np.abs(x - y) <= 1), 0.0, (x * x - y * y) / 3)
+
+    mesh = height_grid(4, height)
+    problem = UnfoldProblem.from_mesh(mesh)
+    middle = int(np.flatnonzero((np.abs(mesh.vertices[:, :2]).sum(axis=1) == 0))[0])
+    interior = np.setdiff1d(np.arange(mesh.n_vertices), mesh.topology.edges[~mesh.topology.interior])
+    assert problem.hyperbolic[np.setdiff1d(interior, [middle])].all() and not problem.hyperbolic[middle]
+    assert middle not in mesh.topology.edges[problem.cut_candidates]
+    assert problem.single_net_blocked() is None

@@ -103,7 +103,7 @@ class UnfoldProblem:
         count = np.bincount(ends.ravel(), minlength=self.mesh.n_vertices)
         boundary_degree = np.bincount(topo.edges[~topo.interior].ravel(), minlength=self.mesh.n_vertices)
         on_boundary = boundary_degree > 0
-        if self._disk_without_leaves(count, boundary_degree):
+        if self._disk_without_leaves(boundary_degree):
             return ("no single-piece net exists: a disk whose interior vertices are all hyperbolic needs a cut "
                     "ending at one of angle sum 360 degrees or less")
         if not self.merged.any():
@@ -119,11 +119,12 @@ class UnfoldProblem:
             return flat
         return None
 
-    def _disk_without_leaves(self, count: np.ndarray, boundary_degree: np.ndarray) -> bool:
+    def _disk_without_leaves(self, boundary_degree: np.ndarray) -> bool:
         """True when the component is a disk (manifold, one boundary loop: Euler characteristic 1,
         every boundary vertex on two boundary edges) with interior vertices, none of which can end a
-        cut: each is hyperbolic by more than LEAF_EXCESS or has no edge that may be cut (count (n,):
-        cut candidates at each vertex; boundary_degree (n,): boundary edges at each vertex)."""
+        cut: each is hyperbolic by more than LEAF_EXCESS (boundary_degree (n,): boundary edges at
+        each vertex). A vertex inside a flat region (all its edges merged) may still end one: a tree
+        cannot hold every merged edge around it, so a net slits the region there."""
         mesh, topo = self.mesh, self.mesh.topology
         if not boundary_degree.any() or (topo.face_count > 2).any():
             return False
@@ -135,7 +136,7 @@ class UnfoldProblem:
         interior = used & (boundary_degree == 0)
         if not interior.any():
             return False  # a strip: no cut at all
-        leaf = interior & (count > 0) & (mesh.angle_sums <= 2 * np.pi + LEAF_EXCESS)
+        leaf = interior & (mesh.angle_sums <= 2 * np.pi + LEAF_EXCESS)
         return not leaf.any()
 
     def tree_weights(self, weights: np.ndarray) -> np.ndarray:
