@@ -22,12 +22,13 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from polyfold.apps.warmup import height_grid
 from polyfold.deadline import Deadline
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.mesh import Mesh
 from polyfold.segment.segment import DEFAULT_TAU, segment
 from polyfold.unfold.problem import UnfoldProblem
-from polyfold.unfold.search import BLOCKED_SEARCH_S, _cuttable, fewest_pieces, run_memetic, split_into_pieces
+from polyfold.unfold.search import BLOCKED_SEARCH_S, fewest_pieces, pieces_of, run_memetic
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models"))
@@ -35,11 +36,7 @@ MODELS = Path(os.environ.get("POLYFOLD_MODELS", ROOT.parent / "shared" / "models
 
 def saddle(n: int) -> Mesh:
     """n x n unit squares over z = (x^2 - y^2) / (n / 1.5), each split along one diagonal."""
-    x, y = (a.ravel() for a in np.meshgrid(np.arange(n + 1.0) - n / 2, np.arange(n + 1.0) - n / 2, indexing="ij"))
-    corner = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
-    faces = np.concatenate([np.column_stack([corner, corner + n + 1, corner + n + 2]),
-                            np.column_stack([corner, corner + n + 2, corner + 1])])
-    return Mesh(np.column_stack([x, y, (x * x - y * y) / (n / 1.5)]), faces)
+    return Mesh(*height_grid(n, lambda x, y: (x * x - y * y) / (n / 1.5)))
 
 
 def blocked_parts(name: str, mesh: Mesh) -> list[tuple[str, Mesh]]:
@@ -61,17 +58,6 @@ def meshes() -> list[tuple[str, Mesh]]:
         out += blocked_parts("star-4split-96", whole) + [("star-4split-96 whole", whole)]
     out += [(f"saddle {n} x {n}", saddle(n)) for n in (4, 6, 10, 14)]
     return out
-
-
-def pieces(problem: UnfoldProblem, genome: np.ndarray) -> int:
-    """Pieces of the genome's tree cut by the exact set cover, as `unfold` cuts it."""
-    parent, parent_edge, order, coords = problem.decode(genome)
-    pairs = problem.overlaps(coords, parent)
-    if len(pairs) == 0:
-        return 1
-    cut = split_into_pieces(parent, parent_edge, order, pairs, exact_seconds=min(5.0, 0.05 * BLOCKED_SEARCH_S + 0.5),
-                            cuttable=_cuttable(problem, parent_edge))
-    return int(cut.sum()) + 1
 
 
 def main() -> None:
@@ -100,7 +86,7 @@ def main() -> None:
                 t = time.perf_counter()
                 genome = search(problem, np.random.default_rng(seed))
                 seconds.append(time.perf_counter() - t)
-                got.append(pieces(problem, genome))
+                got.append(pieces_of(problem, genome, exact_seconds=min(5.0, 0.05 * BLOCKED_SEARCH_S + 0.5))[0])
             total[key][0] += sum(got)
             total[key][1] += sum(seconds)
             cells.append((" ".join(map(str, got)), float(np.mean(seconds))))

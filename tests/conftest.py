@@ -27,6 +27,7 @@ from numba import njit
 from scipy.spatial import ConvexHull, QhullError
 from shapely.geometry import Polygon
 
+from polyfold.apps.warmup import height_grid as warmup_height_grid
 from polyfold.collide.triangles import triangles_collide
 from polyfold.fabricate.page import Page, TextItem
 from polyfold.fold.plan import plan_fold
@@ -199,13 +200,9 @@ def subdivided_box(times: int = 2) -> Mesh:
 
 
 def height_grid(n: int, height) -> Mesh:
-    """An n x n grid of unit squares over z = height(x, y), each split along one diagonal."""
-    x, y = np.meshgrid(np.arange(n + 1.0) - n / 2, np.arange(n + 1.0) - n / 2, indexing="ij")
-    vertices = np.column_stack([x.ravel(), y.ravel(), height(x.ravel(), y.ravel())])
-    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
-    a = (i * (n + 1) + j).ravel()
-    b, c, d = a + n + 1, a + n + 2, a + 1
-    return Mesh(vertices, np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])]))
+    """An n x n grid of unit squares over z = height(x, y), each split along one diagonal
+    (`apps.warmup.height_grid`)."""
+    return Mesh(*warmup_height_grid(n, height))
 
 
 def torus_inside(major: int) -> Mesh:

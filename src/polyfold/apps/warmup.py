@@ -75,6 +75,17 @@ def bumpy_sphere(subdivisions: int = 1, sigma: float = 0.12, seed: int = 7) -> t
     return v * r[:, None], np.asarray(sphere.faces, dtype=np.int64)
 
 
+def height_grid(n: int, height: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (V, 3), faces (F, 3)): an n x n grid of unit squares centred on the origin, over
+    z = height(x, y) (arrays of the grid's x and y in, of z out), each square split along one
+    diagonal: for z = x^2 - y^2 a saddle, every interior vertex hyperbolic (no single net)."""
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(n + 1.0) - n / 2, np.arange(n + 1.0) - n / 2, indexing="ij"))
+    corner = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
+    faces = np.concatenate([np.column_stack([corner, corner + n + 1, corner + n + 2]),
+                            np.column_stack([corner, corner + n + 2, corner + 1])])
+    return np.column_stack([x, y, height(x, y)]), faces
+
+
 def _warm_make(mesh) -> None:
     import trimesh
 
@@ -243,11 +254,7 @@ def _warm_no_single_net() -> None:
     from ..mesh.mesh import Mesh
     from ..unfold.search import unfold
 
-    x, y = (a.ravel() for a in np.meshgrid(np.arange(4.0) - 1.5, np.arange(4.0) - 1.5, indexing="ij"))
-    corner = (np.arange(3)[:, None] * 4 + np.arange(3)[None, :]).ravel()
-    faces = np.concatenate([np.column_stack([corner, corner + 4, corner + 5]),
-                            np.column_stack([corner, corner + 5, corner + 1])])
-    unfold(Mesh(np.column_stack([x, y, (x * x - y * y) / 3]), faces), seed=1, time_limit=1.0)
+    unfold(Mesh(*height_grid(3, lambda x, y: (x * x - y * y) / 3)), seed=1, time_limit=1.0)
 
 
 def _warm_unfold(mesh) -> None:

@@ -605,13 +605,15 @@ def _cuttable(problem: UnfoldProblem, parent_edge: np.ndarray) -> np.ndarray:
     return (parent_edge >= 0) & ~problem.merged[parent_edge]
 
 
-def _pieces_of(problem: UnfoldProblem, genome: np.ndarray) -> tuple[int, int]:
-    """(pieces, overlapping pairs) of a genome's tree cut by `split_into_pieces`' greedy cover."""
+def pieces_of(problem: UnfoldProblem, genome: np.ndarray, exact_seconds: float = 0.0) -> tuple[int, int]:
+    """(pieces, overlapping pairs) of a genome's tree cut by `split_into_pieces`: its greedy cover,
+    and its exact ILP too (for at most exact_seconds) when exact_seconds > 0, as `unfold` cuts it."""
     parent, parent_edge, order, coords = problem.decode(genome)
     pairs = problem.overlaps(coords, parent)
     if len(pairs) == 0:
         return 1, 0
-    cut = split_into_pieces(parent, parent_edge, order, pairs, exact_limit=0, cuttable=_cuttable(problem, parent_edge))
+    exact = {"exact_seconds": exact_seconds} if exact_seconds > 0 else {"exact_limit": 0}
+    cut = split_into_pieces(parent, parent_edge, order, pairs, cuttable=_cuttable(problem, parent_edge), **exact)
     return int(np.count_nonzero(cut)) + 1, len(pairs)
 
 
@@ -624,7 +626,7 @@ def fewest_pieces(problem: UnfoldProblem, rng: np.random.Generator, deadline: De
     three cut candidates' weights of the best drawn afresh, kept when no worse, until the deadline or
     BLOCKED_STALL trees in a row without a better one. The heuristics' trees are scored whatever the
     deadline (milliseconds), so a slow first call cannot leave the search without them."""
-    scored = [(_pieces_of(problem, genome), k, genome)
+    scored = [(pieces_of(problem, genome), k, genome)
               for k, genome in enumerate(start(problem, rng) for start in HEURISTICS.values())]
     best_score, _, best = min(scored, key=lambda s: s[:2])
     trees, stall = len(scored), 0
@@ -633,7 +635,7 @@ def fewest_pieces(problem: UnfoldProblem, rng: np.random.Generator, deadline: De
         trial = best.copy()
         drawn = rng.choice(candidates, size=min(int(rng.integers(1, 4)), len(candidates)), replace=False)
         trial[drawn] = rng.random(len(drawn))
-        score = _pieces_of(problem, trial)
+        score = pieces_of(problem, trial)
         trees += 1
         stall = 0 if score < best_score else stall + 1
         if score <= best_score:
@@ -709,10 +711,8 @@ def unfold(
         weights, evaluations = fewest_pieces(problem, rng, deadline)
         fitness, generations, winner = 0.0, 0, "fewest-pieces"
     elif method == "auto":
-        accept_genome = None
-        if accept is not None:
-            def accept_genome(genome: np.ndarray) -> bool:
-                return bool(accept(_net_from_tree(problem, *problem.decode(genome))))
+        accept_genome = None if accept is None else (
+            lambda genome: bool(accept(_net_from_tree(problem, *problem.decode(genome)))))
         # Large meshes: a smaller seed population, so the local search gets the time budget.
         population = min(max(200_000 // mesh.n_faces, 50), 400)
         weights, fitness, generations, evaluations, winner = run_memetic(
