@@ -13,7 +13,8 @@ import numpy as np
 from ..arrays import copy_flat
 from ..jit import njit
 from ..sorting import sorted_unique
-from .hull_kernels import HULL_FLAT_EPS, NOISE, convex_hull, copy_row, denoise, depth_chain, max_depth
+from ..mesh.hull_kernels import HULL_FLAT_EPS, convex_hull
+from .hull_kernels import NOISE, copy_row, denoise, depth_chain, max_depth
 
 
 # ----------------------------------------------------------------------------------------------

@@ -44,13 +44,13 @@ from typing import Callable
 
 import numpy as np
 
-from .hull_kernels import HULL_FLAT_EPS, convex_hull, denoise, max_depth
+from .hull_kernels import denoise, max_depth
 from .memo_kernels import make_units, new_memo
 from .merge_kernels import merge_run
 from .table_kernels import (face_groups, face_keys, face_lengths, first_face_order, inner_edges, part_concavities, part_tables,
                             sample_points, unit_groups)
 from ..deadline import Deadline
-from ..mesh.geometry import merged_edges
+from ..mesh.geometry import hull_planes, merged_edges
 from ..mesh.mesh import Mesh
 
 DEFAULT_TAU = 0.05  # relative to the bounding-box diagonal of the whole mesh
@@ -105,18 +105,8 @@ SMALL_HULL = 64  # up to this many points our kernel; beyond, qhull (its ~45 us 
 
 def _hull(points: np.ndarray):
     """(hull vertex coordinates, facet equations) or (points, None) when the set has no volume."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    if len(points) < 4:
-        return points, None
-    if len(points) <= SMALL_HULL:
-        verts, eq = convex_hull(np.ascontiguousarray(points, dtype=np.float64), HULL_FLAT_EPS)
-        return (points, None) if len(eq) == 0 else (points[verts], eq)
-    try:
-        h = ConvexHull(points)
-    except (QhullError, ValueError):
-        return points, None  # flat or degenerate: the surface is its own hull, concavity 0
-    return points[h.vertices], h.equations
+    hull = hull_planes(points, SMALL_HULL)
+    return (points, None) if hull is None else (points[hull[0]], hull[1])
 
 
 def part_concavity(mesh: Mesh, face_ids: np.ndarray, samples: np.ndarray | None = None, seed: int = 0) -> float:

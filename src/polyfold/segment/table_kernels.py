@@ -13,7 +13,8 @@ import numpy as np
 from ..graphs import union_labels
 from ..jit import njit
 from ..sorting import sort_in_place, stable_argsort
-from .hull_kernels import HULL_FLAT_EPS, convex_hull, copy_row, denoise, max_depth
+from ..mesh.hull_kernels import HULL_FLAT_EPS, convex_hull
+from .hull_kernels import copy_row, denoise, max_depth
 
 
 # ----------------------------------------------------------------------------------------------

@@ -75,15 +75,31 @@ def test_info_into_a_pipe_nobody_reads_stops_quietly(models_dir: Path) -> None:
 
 def test_info_imports_no_numba(models_dir: Path) -> None:
     """`info` starts fast (issue 23): it compiles nothing, so numba (about 0.35 s to import and
-    start loading kernels) is not imported, on a plain mesh nor on a textured one."""
+    start loading kernels) is not imported, on a plain mesh nor on a textured one. With the
+    kernels compiled ahead of time (`make setup`) it imports no scipy either for a mesh of up to
+    MESH_HULL_COMPILED_POINTS vertices (scipy.spatial: 0.36-0.44 s, most of its time), and
+    reports what it reports without them."""
+    import json
+    import os
+
+    from polyfold.jit import ahead_ready
+
     probe = ("import atexit, sys, runpy; sys.argv = ['polyfold'] + sys.argv[1:]\n"
-             "atexit.register(lambda: print('numba loaded' if 'numba' in sys.modules else 'no numba'))\n"
+             "atexit.register(lambda: print(*[m for m in ('numba', 'scipy') if m in sys.modules] or ['none']))\n"
              "runpy.run_module('polyfold', run_name='__main__')\n")
-    for rel in ("bunny-128.obj", "textured/spot/spot_triangulated.obj"):
-        proc = subprocess.run([CLI[0], "-c", probe, "info", str(models_dir / rel), "--json"], capture_output=True,
-                              text=True, timeout=120)
-        assert proc.returncode == 0 and proc.stdout.strip().splitlines()[-1] == "no numba", \
-            (rel, proc.stdout[-300:], proc.stderr[-500:])
+    for rel, light in (("bunny-128.obj", ahead_ready()), ("textured/spot/spot_triangulated.obj", False)):
+        reports = []
+        for switch in ("on", "off"):
+            proc = subprocess.run([CLI[0], "-c", probe, "info", str(models_dir / rel), "--json"], capture_output=True,
+                                  text=True, timeout=120, env={**os.environ, "POLYFOLD_AHEAD": switch})
+            assert proc.returncode == 0, (rel, proc.stderr[-500:])
+            *report, loaded = proc.stdout.strip().splitlines()
+            assert "numba" not in loaded.split(), (rel, switch, loaded)
+            if switch == "on" and light:
+                assert loaded == "none", (rel, loaded)
+            reports.append(json.loads("\n".join(report)))
+        on, off = reports
+        assert abs(on.pop("concavity") - off.pop("concavity")) <= 1e-9 and on == off, (rel, on, off)
 
 
 def test_info_rejects(models_dir: Path) -> None:
