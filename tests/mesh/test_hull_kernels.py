@@ -11,7 +11,7 @@ from scipy.spatial import ConvexHull, QhullError
 from conftest import depth_below_hull, height_grid
 from polyfold.formats.meshes import load_mesh
 from polyfold.mesh.geometry import MESH_HULL_COMPILED_POINTS, concavity, hull_planes
-from polyfold.mesh.hull_kernels import HULL_FLAT_EPS, convex_hull
+from polyfold.mesh.hull_kernels import DENSE_EDGES, HULL_FLAT_EPS, _hull_at, convex_hull
 from polyfold.mesh.mesh import Mesh
 
 
@@ -31,7 +31,7 @@ def _hull_sets(models_dir: Path):
             faces = rng.choice(mesh.n_faces, size=min(mesh.n_faces, 12), replace=False)
             yield mesh.vertices[np.unique(mesh.faces[faces])]
         yield mesh.vertices  # a whole mesh, as `concavity` gives it
-    for n in (200, 600, MESH_HULL_COMPILED_POINTS):  # up to the most points a whole mesh's hull compiles
+    for n in (200, DENSE_EDGES + 1, 600, 3000):  # beyond DENSE_EDGES the edge counts are hashed
         sphere = rng.normal(size=(n, 3))
         yield sphere / np.linalg.norm(sphere, axis=1)[:, None] * (1 + 0.01 * rng.random((n, 1)))
         yield rng.random((n, 3))
@@ -60,6 +60,29 @@ def test_hull_kernel_matches_qhull(models_dir):
     assert checked > 400
     flat = np.c_[np.random.default_rng(1).random((12, 2)), np.full(12, 2.0)]
     assert len(convex_hull(flat, HULL_FLAT_EPS)[1]) == 0
+
+
+def test_hashed_edge_counts_make_the_dense_tables_hull(models_dir):
+    """Counting the facets on each directed edge in a hash table (beyond DENSE_EDGES points) or in
+    the n x n table gives the same hull, facet for facet."""
+    for pts in _hull_sets(models_dir):
+        for eps in (HULL_FLAT_EPS, 1e-8):
+            dense, hashed = _hull_at(pts, eps, True), _hull_at(pts, eps, False)
+            assert np.array_equal(dense[0], hashed[0]) and np.array_equal(dense[1], hashed[1]), len(pts)
+
+
+def test_a_whole_meshs_worth_of_points(models_dir):
+    """Up to MESH_HULL_COMPILED_POINTS (a whole mesh's vertices for `polyfold info`): qhull's
+    vertices, every point inside, on a sphere (every point on the hull) and in a ball."""
+    rng = np.random.default_rng(12)
+    n = MESH_HULL_COMPILED_POINTS
+    sphere = rng.normal(size=(n, 3))
+    sphere /= np.linalg.norm(sphere, axis=1)[:, None]
+    for pts in (sphere, sphere * rng.random((n, 1)) ** (1 / 3)):
+        verts, eq = convex_hull(pts, HULL_FLAT_EPS)
+        qh = ConvexHull(pts)
+        assert np.array_equal(np.sort(verts), np.sort(qh.vertices)) and len(eq) == len(qh.equations)
+        assert max(float((pts[k:k + 2000] @ eq[:, :3].T + eq[:, 3]).max()) for k in range(0, n, 2000)) <= 1e-9
 
 
 def test_concavity_through_the_kernel_is_qhulls(models_dir, monkeypatch):

@@ -133,10 +133,11 @@ def merged_edges(mesh: Mesh, flat_tol: float = FLAT_REGION_RAD) -> np.ndarray:
 
 
 # A whole mesh's hull (`concavity`, `polyfold info`) is compiled up to this many points when the
-# kernels are compiled ahead of time: 14 ms at 1,000 points, against 5 ms in qhull after importing
-# scipy.spatial (0.36-0.44 s with scipy 1.17, most of `info`'s time). Beyond, the kernel's scan of
-# every facet per point costs more (0.2 s at 3,000 points): qhull.
-MESH_HULL_COMPILED_POINTS = 1024
+# kernels are compiled ahead of time. The kernel tests every point against every facet: with every
+# point on the hull (a convex mesh's vertices) 0.13 s at 5,000 points, 2 s at 20,000 (fewer on it:
+# 18 ms at 3,000, 80-150 ms at 10,000); importing scipy.spatial for qhull costs 0.36-0.8 s (scipy
+# 1.17: most of `info`'s time), then 3-70 ms.
+MESH_HULL_COMPILED_POINTS = 5_000
 
 
 def hull_planes(points: np.ndarray, compiled_up_to: int) -> tuple[np.ndarray, np.ndarray] | None:

@@ -16,7 +16,11 @@ from ..jit import njit
 
 HULL_FLAT_EPS = 1e-12  # relative to the points' extent: thinner sets have no volume (concavity 0)
 MAX_HULL_EPS = 1e-6  # relative: the largest tolerance `convex_hull` retries an inconsistent hull at
-DENSE_EDGES = 1024  # convex_hull counts facets per directed edge in an n x n table up to this many points
+# convex_hull counts facets per directed edge in an n x n table up to this many points, beyond in a hash
+# table: the table's n^2 counts (set to zero per hull) cost more from about 300 points (at 400 points
+# 0.4-1.5 ms a hull against 0.4 ms hashed; at 1,000 points 10 ms against 1.2 ms)
+DENSE_EDGES = 256
+HASH_MUL = 0x9E3779B97F4A7C15  # Fibonacci hashing of the edge keys beyond DENSE_EDGES points (uint64, wrapping)
 
 
 @njit(cache=True)
@@ -46,23 +50,66 @@ def _compact(F, E, alive, nf):
 
 
 @njit(cache=True)
+def _table_size(n):
+    """Slots of the hashed edge table for n points: a power of two at least 8 times the 6 n
+    directed edges of a hull's 2 n facets, so it stays at most half full between rehashes."""
+    size = 1
+    while size < 48 * n:
+        size *= 2
+    return size
+
+
+@njit(cache=True)
+def _slot(keys, fill, key, dense):
+    """The slot of directed edge key `key` (a * n + b): the key itself when dense, else its slot in
+    the open-addressing table `keys` (length a power of two, -1 empty, linear probing), taken
+    (fill[0] counts the keys) if it is not there yet."""
+    if dense:
+        return key
+    mask = keys.shape[0] - 1
+    h = np.int64(((np.uint64(key) * np.uint64(HASH_MUL)) >> np.uint64(29)) & np.uint64(mask))
+    while keys[h] != key:
+        if keys[h] == -1:
+            keys[h] = key
+            fill[0] += 1
+            return h
+        h = (h + 1) & mask
+    return h
+
+
+@njit(cache=True)
+def _rehash(keys, fill, on, F, alive, nf, n):
+    """Empty the hashed edge table and count the live facets' edges again (keys whose facets have
+    all gone stay taken otherwise). `seen` is all zero between points, so it needs no rebuild."""
+    keys[:] = -1
+    on[:] = 0
+    fill[0] = 0
+    for f in range(nf):
+        if alive[f]:
+            for k in range(3):
+                on[_slot(keys, fill, F[f, k] * n + F[f, (k + 1) % 3], False)] += 1
+
+
+@njit(cache=True)
 def convex_hull(p, rel_eps):
     """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)); see
     `_hull_at`. A hull that does not close up as a convex polytope (2 V - 4 facets), which nearly
     coplanar points can make at rel_eps (the flat sides of a subdivided mesh: 24 vertices and 129
     facets where qhull has 16 and 28), is made again with a tolerance 100 times larger, up to
     MAX_HULL_EPS."""
-    v, e = _hull_at(p, rel_eps)
+    dense = p.shape[0] <= DENSE_EDGES
+    v, e = _hull_at(p, rel_eps, dense)
     r = rel_eps
     while e.shape[0] > 0 and e.shape[0] != 2 * v.shape[0] - 4 and r < MAX_HULL_EPS:
         r *= 100.0
-        v, e = _hull_at(p, r)
+        v, e = _hull_at(p, r, dense)
     return v, e
 
 
 @njit(cache=True)
-def _hull_at(p, rel_eps):
-    """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)).
+def _hull_at(p, rel_eps, dense):
+    """3D convex hull of the points p (n, 3): (ids of hull vertices, facet equations (m, 4)); the
+    edge counts in an n x n table when `dense`, else hashed (the same hull either way).
 
     Facet planes are unit outward normals with offsets, n.x + d <= 0 inside (qhull's convention).
     Empty equations when the points span no volume (thinner than rel_eps * their extent).
@@ -70,9 +117,10 @@ def _hull_at(p, rel_eps):
     than the tolerance) replaces them by a cone over their boundary edges, the horizon. The
     horizon is found as the edges whose reverse lies on a kept facet, so the surface stays closed
     even if rounding makes the visible region odd: a count of the live facets on each directed
-    edge answers that per edge (up to DENSE_EDGES points; beyond, a scan of the facets does).
-    Meant for the small sets of the merging (tens of points), where qhull's per-call set-up
-    (about 45 us) is most of its cost.
+    edge answers that per edge.
+    Each point is tested against every live facet, so the time grows as n times the hull's size:
+    meant for small sets (the merging's tens of points, where qhull's per-call set-up, about
+    45 us, is most of its cost) up to a whole mesh's thousands of vertices.
     """
     n = p.shape[0]
     empty_v = np.empty(0, dtype=np.int64)
@@ -136,13 +184,16 @@ def _hull_at(p, rel_eps):
     vl = np.empty(cap, dtype=np.int64)
     hor = np.empty((3 * cap, 2), dtype=np.int64)  # every edge of every visible facet at most
     n_live, nf_kept = nf, nf
-    dense = n <= DENSE_EDGES
-    on = np.zeros(n * n if dense else 1, dtype=np.int32)  # live facets having directed edge a->b (a * n + b)
-    seen = np.zeros(on.shape[0], dtype=np.int32)  # the same among the facets visible from the current point
-    if dense:
-        for f in range(nf):
-            for k in range(3):
-                on[F[f, k] * n + F[f, (k + 1) % 3]] += 1
+    # live facets having directed edge a->b (`on`), and the same among the facets visible from the
+    # current point (`seen`), at slot a * n + b (dense) or at its slot in the hash table `keys`
+    size = n * n if dense else _table_size(n)
+    keys = np.full(1 if dense else size, -1, dtype=np.int64)
+    on = np.zeros(size, dtype=np.int32)
+    seen = np.zeros(size, dtype=np.int32)
+    fill = np.zeros(1, dtype=np.int64)  # keys taken (hashed)
+    for f in range(nf):
+        for k in range(3):
+            on[_slot(keys, fill, F[f, k] * n + F[f, (k + 1) % 3], dense)] += 1
     for i in range(n):
         if i == i0 or i == i1 or i == i2 or i == i3:
             continue
@@ -155,26 +206,26 @@ def _hull_at(p, rel_eps):
                 nv += 1
         if nv == 0:
             continue
+        # Room for this point's keys (the reverse of each visible edge, 3 per horizon edge): the
+        # keys of gone facets dropped, else a table twice as large.
+        if not dense and 2 * (fill[0] + 12 * nv) > size:
+            _rehash(keys, fill, on, F, alive, nf, n)
+            while 2 * (fill[0] + 12 * nv) > size:
+                size *= 2
+                keys = np.full(size, -1, dtype=np.int64)
+                on = np.zeros(size, dtype=np.int32)
+                seen = np.zeros(size, dtype=np.int32)
+                _rehash(keys, fill, on, F, alive, nf, n)
         # horizon: directed edges of visible faces whose reverse lies on an alive invisible face
-        if dense:
-            for q in range(nv):
-                for k in range(3):
-                    seen[F[vl[q], k] * n + F[vl[q], (k + 1) % 3]] += 1
+        for q in range(nv):
+            for k in range(3):
+                seen[_slot(keys, fill, F[vl[q], k] * n + F[vl[q], (k + 1) % 3], dense)] += 1
         nh = 0
         for q in range(nv):
             for k in range(3):
                 a, b = F[vl[q], k], F[vl[q], (k + 1) % 3]
-                if dense:
-                    found = on[b * n + a] > seen[b * n + a]
-                else:
-                    found = False
-                    for g in range(nf):
-                        if not alive[g] or vis[g]:
-                            continue
-                        if (F[g, 0] == b and F[g, 1] == a) or (F[g, 1] == b and F[g, 2] == a) or (F[g, 2] == b and F[g, 0] == a):
-                            found = True
-                            break
-                if found:
+                r = _slot(keys, fill, b * n + a, dense)
+                if on[r] > seen[r]:
                     hor[nh, 0], hor[nh, 1] = a, b
                     nh += 1
         if nf_kept + nh > cap:  # cannot happen for a consistent hull; be safe
@@ -182,11 +233,10 @@ def _hull_at(p, rel_eps):
         for q in range(nv):
             alive[vl[q]] = False
             n_live -= 1
-            if dense:
-                for k in range(3):
-                    e = F[vl[q], k] * n + F[vl[q], (k + 1) % 3]
-                    seen[e] -= 1
-                    on[e] -= 1
+            for k in range(3):
+                e = _slot(keys, fill, F[vl[q], k] * n + F[vl[q], (k + 1) % 3], dense)
+                seen[e] -= 1
+                on[e] -= 1
         if nf + nh > cap:  # nearly coplanar points can make the visible region odd: room first
             nf = _compact(F, E, alive, nf)
             if nf + nh > cap:
@@ -198,10 +248,10 @@ def _hull_at(p, rel_eps):
             E[nf, 0], E[nf, 1], E[nf, 2], E[nf, 3] = nx, ny, nz, d
             alive[nf] = ln > 0
             n_live += ln > 0
-            if dense and ln > 0:
-                on[a * n + b] += 1
-                on[b * n + i] += 1
-                on[i * n + a] += 1
+            if ln > 0:
+                on[_slot(keys, fill, a * n + b, dense)] += 1
+                on[_slot(keys, fill, b * n + i, dense)] += 1
+                on[_slot(keys, fill, i * n + a, dense)] += 1
             nf += 1
         # Compact (keeping the order) once the dead faces are half, so the loops stay short. The
         # safety check above counts the faces as compacting at 2n + 64 kept them (nf_kept), the
