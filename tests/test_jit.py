@@ -268,3 +268,30 @@ def test_make_ahead_of_time_writes_what_it_writes_just_in_time(tmp_path):
     for name in names:
         if name != "report.json" and not name.endswith(".dxf"):
             assert (outs["on"][0] / name).read_bytes() == (outs["off"][0] / name).read_bytes(), name
+
+
+def test_a_kernels_cached_code_is_stale_when_a_module_it_imports_changes(tmp_path):
+    """numba keeps a kernel's machine code (its callees' code in it) fresh by its own file's stamp;
+    polyfold's kernels also by the stamps of the modules of their package they import, so a callee
+    changed in another file is not run from the caller's old code (a stale cache once made the
+    segmenter fail to load a moved module)."""
+    pkg = tmp_path / "stampkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    callee = pkg / "callee.py"
+    callee.write_text("from polyfold.jit import njit\n\n\n@njit(cache=True)\ndef step(x):\n    return x + 1\n")
+    (pkg / "caller.py").write_text("from polyfold.jit import njit\n\nfrom .callee import step\n\n\n"
+                                   "@njit(cache=True)\ndef twice(x):\n    return 2 * step(x)\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), jit.SWITCH: "off",
+           "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    probe = "import stampkg.caller as c; print(c.twice(1), sum(c.twice.stats.cache_hits.values()))"
+
+    def run() -> list[str]:
+        proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, timeout=300)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        return proc.stdout.split()
+
+    assert run()[0] == "4"
+    assert run() == ["4", "1"]  # from the cache
+    callee.write_text(callee.read_text().replace("x + 1", "x + 10"))
+    assert run() == ["22", "0"]  # compiled again, not the cached 4

@@ -21,3 +21,10 @@ def copy_flat(dst: np.ndarray, src: np.ndarray, count: int) -> None:
     s = src.reshape(src.size)
     for i in range(count):
         d[i] = s[i]
+
+
+@njit(cache=True)
+def copy_row(dst, i, src, j):
+    """dst[i] = src[j] for rows of 3, element by element: a row assignment goes through numpy's
+    setitem (a view, a broadcast) and costs ~100 ns, this a few."""
+    dst[i, 0], dst[i, 1], dst[i, 2] = src[j, 0], src[j, 1], src[j, 2]

@@ -91,8 +91,10 @@ class Kernel:
                     import numba
 
                     _prepare_numba()
-                    self._dispatcher = numba.njit(**{k: v for k, v in self.targetoptions.items()
-                                                     if k != "nopython"})(self.py_func)
+                    dispatcher = numba.njit(**{k: v for k, v in self.targetoptions.items()
+                                               if k != "nopython"})(self.py_func)
+                    _stamp_with_imports(dispatcher, self.py_func.__module__)
+                    self._dispatcher = dispatcher
         return self._dispatcher
 
     def jit_signatures(self) -> list:
@@ -111,6 +113,64 @@ class Kernel:
     def __reduce__(self) -> tuple:
         # by name, as a function pickles (its dispatcher and ahead-of-time functions stay here)
         return _kernel_named, (self.py_func.__module__, self.py_func.__qualname__)
+
+
+def _stamp_with_imports(dispatcher: Any, module: str) -> None:
+    """Make the freshness stamp of a dispatcher's numba cache cover the polyfold modules its module
+    imports, transitively, not only its own file (numba's rule). A kernel's cached machine code
+    holds its callees' code and refers to their modules by name: with numba's rule, a callee
+    changed or moved to another file (a `git pull`, an edit) left the caller's stale code in the
+    cache, which then ran the old callee or failed to load its gone module."""
+    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    if cache_file is not None and hasattr(cache_file, "_source_stamp"):
+        cache_file._source_stamp = (cache_file._source_stamp, _imports_stamp(module))
+
+
+_import_stamps: dict[str, tuple] = {}
+_IMPORT_LINE = None  # (compiled at the first need)
+
+
+def _imports_stamp(module: str) -> tuple:
+    """((module, mtime, size), ...) of `module` and of the modules of its top-level package (polyfold
+    for polyfold's kernels) it imports, at its top level or in its functions, transitively, sorted.
+    Not this module's: it compiles no kernel code."""
+    global _IMPORT_LINE
+    if module in _import_stamps:
+        return _import_stamps[module]
+    import re
+
+    if _IMPORT_LINE is None:
+        _IMPORT_LINE = re.compile(r"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+\(?([\w, \t]*)|import[ \t]+(polyfold[\w.]*))",
+                                  re.MULTILINE)
+    top = module.split(".")[0]
+    top_file = getattr(sys.modules.get(top), "__file__", None)
+    if not top_file or not top_file.endswith("__init__.py"):
+        return ()  # (a module of its own, no package: numba's stamp of its file is all)
+    root = Path(top_file).resolve().parent  # (the package's modules' files, read, not imported)
+    seen: dict[str, tuple] = {}
+    todo = [module]
+    while todo:
+        name = todo.pop()
+        if name in seen or name.split(".")[0] != top or name == __name__:
+            continue
+        folder = root.joinpath(*name.split(".")[1:])
+        path = folder / "__init__.py" if folder.is_dir() else folder.with_suffix(".py")
+        if not path.is_file():
+            seen[name] = ()  # (a name imported from a module, not a module)
+            continue
+        st = path.stat()
+        seen[name] = (name, st.st_mtime_ns, st.st_size)
+        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        for dots, base, names, plain in _IMPORT_LINE.findall(path.read_text(encoding="utf-8")):
+            if plain:
+                todo.append(plain)
+                continue
+            if dots:
+                base = ".".join(package[:len(package) - len(dots) + 1] + ([base] if base else []))
+            todo.append(base)
+            todo += [f"{base}.{n.strip()}" for n in names.split(",") if n.strip()]  # (submodules imported by name)
+    _import_stamps[module] = tuple(sorted(v for v in seen.values() if v))
+    return _import_stamps[module]
 
 
 def _kernel_named(module: str, qualname: str) -> Kernel:

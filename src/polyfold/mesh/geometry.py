@@ -177,15 +177,22 @@ def concavity(mesh: Mesh, samples_per_face: int = 3, seed: int = 0) -> float:
     pts = tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
     pts = np.concatenate([mesh.vertices[np.unique(mesh.faces)], pts.reshape(-1, 3)])
     diag = mesh.bbox_diagonal
-    # (without compiled kernels, numba would compile the hull: longer than importing scipy)
-    hull = hull_planes(mesh.vertices[np.unique(mesh.faces)], MESH_HULL_COMPILED_POINTS if ahead_ready() else 0)
+    compiled = ahead_ready()  # (else numba would compile the kernels: longer than scipy and numpy take)
+    hull = hull_planes(mesh.vertices[np.unique(mesh.faces)], MESH_HULL_COMPILED_POINTS if compiled else 0)
     if hull is None:
         return 0.0  # flat or degenerate point set: no volume, the surface is its own hull
-    eq = hull[1]
-    # Chunked so points x facets stays small on large meshes (~8 MB per chunk).
-    rows = max(1, 1_000_000 // len(eq))
-    dist = 0.0
-    for start in range(0, len(pts), rows):
-        depth = -(pts[start:start + rows] @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, per facet
-        dist = max(dist, float(np.clip(depth.min(axis=1), 0.0, None).max()))
+    eq = np.ascontiguousarray(hull[1], dtype=np.float64)
+    if compiled:
+        from .hull_kernels import max_depth
+
+        # (each point's facets scanned from its neighbour's nearest, stopping below the deepest so
+        # far: 82k faces 1.0 s -> 0.03 s)
+        dist = float(max_depth(pts, eq, np.inf))
+    else:
+        # Chunked so points x facets stays small on large meshes (~8 MB per chunk).
+        rows = max(1, 1_000_000 // len(eq))
+        dist = 0.0
+        for start in range(0, len(pts), rows):
+            depth = -(pts[start:start + rows] @ eq[:, :3].T + eq[:, 3])  # >= 0 inside, per facet
+            dist = max(dist, float(np.clip(depth.min(axis=1), 0.0, None).max()))
     return dist / diag if diag > 0 else 0.0

@@ -2,7 +2,6 @@
 
     segment.py          `segment` -> `Segmentation`: merging on the dual graph, the parts=K search on
                         tau (within an optional Deadline), concavity, Rand index
-    hull_kernels.py     numba: depth of points below a hull (the hull: mesh/hull_kernels.py)
     table_kernels.py    numba: the per-mesh arrays (seed groups, face keys, lengths, inner edges,
                         initial clusters, samples) and the parts' tables and concavities
     memo_kernels.py     numba: the memo of union concavities (hash buckets, regrowth, union evaluation)

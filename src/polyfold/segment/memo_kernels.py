@@ -10,11 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import copy_flat
+from ..arrays import copy_flat, copy_row
 from ..jit import njit
+from ..mesh.hull_kernels import HULL_FLAT_EPS, NOISE, convex_hull, denoise, depth_chain, max_depth
 from ..sorting import sorted_unique
-from ..mesh.hull_kernels import HULL_FLAT_EPS, convex_hull
-from .hull_kernels import NOISE, copy_row, denoise, depth_chain, max_depth
 
 
 # ----------------------------------------------------------------------------------------------

@@ -44,7 +44,7 @@ from typing import Callable
 
 import numpy as np
 
-from .hull_kernels import denoise, max_depth
+from ..mesh.hull_kernels import denoise, max_depth
 from .memo_kernels import make_units, new_memo
 from .merge_kernels import merge_run
 from .table_kernels import (face_groups, face_keys, face_lengths, first_face_order, inner_edges, part_concavities, part_tables,

@@ -10,11 +10,11 @@ import math
 
 import numpy as np
 
+from ..arrays import copy_row
 from ..graphs import union_labels
 from ..jit import njit
+from ..mesh.hull_kernels import HULL_FLAT_EPS, convex_hull, denoise, max_depth
 from ..sorting import sort_in_place, stable_argsort
-from ..mesh.hull_kernels import HULL_FLAT_EPS, convex_hull
-from .hull_kernels import copy_row, denoise, max_depth
 
 
 # ----------------------------------------------------------------------------------------------
