@@ -98,6 +98,12 @@ def _concave(poly: list[int], vertices: np.ndarray) -> list[tuple[int, int, int]
 
 def _logical_lines(text: str):
     """(line number, tokens) of the non-empty lines, comments stripped, '\\' continuations joined."""
+    if "\\" not in text:  # (no continuations: the common case, a third faster on big files)
+        for lineno, line in enumerate(text.splitlines(), 1):
+            tokens = (line.split("#", 1)[0] if "#" in line else line).split()
+            if tokens:
+                yield lineno, tokens
+        return
     pending: list[str] = []
     start = 0
     for lineno, line in enumerate(text.splitlines(), 1):
@@ -158,7 +164,7 @@ def _parse_obj(text: str, name: str, path: str = "") -> RawMesh:
                 raise mesh_error(name, f"line {lineno}: face {face} has no vertices")
             idx, vts = [], []
             for tok in tokens[1:]:
-                refs = tok.split("/")
+                refs = tok.split("/") if "/" in tok else (tok,)
                 try:
                     k = int(refs[0])
                 except ValueError:
@@ -173,7 +179,7 @@ def _parse_obj(text: str, name: str, path: str = "") -> RawMesh:
                 if j < 0:
                     raise mesh_error(name, f"line {lineno}: face {face} uses relative index {k} before that many vertices exist")
                 idx.append(j)
-                vts.append(_vt_index(refs, len(uvs)))
+                vts.append(_vt_index(refs, len(uvs)) if len(refs) > 1 else -1)
             polys.append(idx)
             poly_vt.append(vts)
             poly_mtl.append(material)
@@ -203,7 +209,7 @@ def _parse_obj(text: str, name: str, path: str = "") -> RawMesh:
                    warnings=tuple(looks.warnings))
 
 
-def _vt_index(refs: list[str], n_uvs: int) -> int:
+def _vt_index(refs: list[str] | tuple[str, ...], n_uvs: int) -> int:
     """The 0-based texture coordinate of a face corner `v/vt/vn` split at "/" (-1: none or bad;
     negative OBJ indices count back from the last vt so far)."""
     if len(refs) < 2 or not refs[1]:
