@@ -107,6 +107,41 @@ def test_trimesh_formats(tmp_path: Path) -> None:
         assert_valid_component(comp)
 
 
+def test_stl_reads_as_trimesh_reads_it(models_dir: Path, tmp_path: Path) -> None:
+    """polyfold reads STL itself (importing trimesh costs a command about a second): the same
+    vertices and triangles as trimesh's loader, binary (also with a header that begins "solid", as
+    some CAD tools write) and ASCII, on shared models; an ASCII file of two solids gives both."""
+    import trimesh
+
+    from polyfold.formats.meshes import _parse_stl
+
+    checked = 0
+    for name in ("bunny-128", "horse-302", "fish-472", "periscope-28", "cube-12", "torus-12x6-144"):
+        tm = trimesh.load(models_dir / f"{name}.obj", force="mesh", process=False)
+        binary = trimesh.exchange.stl.export_stl(tm)
+        for kind, data in (("binary", binary), ("solid-header", b"solid exported by CAD" + binary[21:]),
+                           ("ascii", trimesh.exchange.stl.export_stl_ascii(tm).encode())):
+            path = tmp_path / f"{name}-{kind}.stl"
+            path.write_bytes(data)
+            ref = trimesh.load(path, force="mesh", process=False)
+            raw = _parse_stl(data, path.name, str(path))
+            assert np.array_equal(raw.vertices, np.asarray(ref.vertices, dtype=np.float64)), (name, kind)
+            assert np.array_equal(raw.tris, ref.faces) and np.array_equal(raw.source, np.arange(len(ref.faces)))
+            checked += 1
+    assert checked == 18
+    box, ico = trimesh.creation.box(), trimesh.creation.icosahedron()
+    two = trimesh.exchange.stl.export_stl_ascii(box) + "\n" + trimesh.exchange.stl.export_stl_ascii(ico)
+    (tmp_path / "two.stl").write_text(two)
+    loaded = load_mesh(tmp_path / "two.stl")
+    assert loaded.mesh.n_faces == 32 and len(loaded.components) == 2
+    for bad, why in ((b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\nendloop\nendfacet\nendsolid\n", "not a number"),
+                     (b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid\n",
+                      "without 3 vertices")):
+        (tmp_path / "bad.stl").write_bytes(bad)
+        with pytest.raises(MeshError, match=f"^bad\\.stl: .*{why}"):
+            load_mesh(tmp_path / "bad.stl")
+
+
 # ----------------------------------------------------------------------------------------------
 # Writers
 

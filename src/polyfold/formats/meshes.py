@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 
 import numpy as np
 
@@ -272,10 +273,42 @@ def _parse_off(text: str, name: str, path: str = "") -> RawMesh:
     return RawMesh(vertices, tris, source, n_big, flines, vlines)
 
 
+# A binary STL triangle: normal, three corners, two bytes some writers use for a colour (50 bytes)
+STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attributes", "<u2")])
+_STL_VERTEX = None  # (the pattern of an ASCII STL's "vertex x y z" line, compiled at the first need)
+
+
+def _parse_stl(data: bytes, name: str, path: str = "") -> RawMesh:
+    """An STL file: binary (an 80-byte header, the triangle count, 50-byte records) when its length
+    is exactly what its count says, else ASCII (every "vertex x y z" line, three a facet, all
+    solids in file order) -- trimesh's rules, read here because importing trimesh costs a command
+    about a second. A triangle soup: every corner a vertex of its own (repair welds them)."""
+    global _STL_VERTEX
+    _stl_counts(data, name)
+    if len(data) >= 84 and len(data) == 84 + STL_RECORD.itemsize * int.from_bytes(data[80:84], "little"):
+        vertices = np.frombuffer(data, dtype=STL_RECORD, offset=84)["corners"].reshape(-1, 3).astype(np.float64)
+    else:
+        if _STL_VERTEX is None:
+            import re
+
+            _STL_VERTEX = re.compile(rb"vertex[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)", re.IGNORECASE)
+        try:
+            vertices = np.array([float(x) for row in _STL_VERTEX.findall(data) for x in row], dtype=np.float64)
+        except ValueError:
+            raise mesh_error(name, "not a readable STL file (a vertex coordinate that is not a number)") from None
+        if len(vertices) % 9:
+            raise mesh_error(name, "not a readable STL file (a facet without 3 vertices)")
+        vertices = vertices.reshape(-1, 3)
+    if len(vertices) == 0:
+        raise mesh_error(name, "no faces could be read (not a valid STL file?)")
+    n = len(vertices) // 3
+    return RawMesh(vertices, np.arange(3 * n, dtype=np.int64).reshape(-1, 3), np.arange(n), 0)
+
+
 def _stl_counts(data: bytes, name: str) -> None:
     """A binary STL whose header promises more triangles than the file holds: MeshError."""
     if len(data) < 84 or data[:5].lower() == b"solid" and b"facet" in data[:1024]:
-        return  # (too short for a binary STL, or ASCII: trimesh's reader and "no faces" say it)
+        return  # (too short for a binary STL, or ASCII: the ASCII reader and "no faces" say it)
     promised = int.from_bytes(data[80:84], "little")
     held = (len(data) - 84) // 50
     if held < promised:
@@ -305,9 +338,7 @@ def _load_trimesh(path: str, name: str, data: bytes) -> RawMesh:
     import trimesh  # imported lazily: slow to import, and only needed for these formats
 
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".stl":
-        _stl_counts(data, name)
-    elif ext == ".ply":
+    if ext == ".ply":
         _ply_counts(data, name)
     try:
         # process=False keeps vertices and faces exactly in file order; force='mesh' concatenates
@@ -338,16 +369,24 @@ def _read(path: str, name: str) -> RawMesh:
         raise mesh_error(name, f"cannot read: {exc.strerror or exc}") from None
     if parse is None:
         return _load_trimesh(path, name, data)
-    nul = data.find(b"\0")
-    if nul >= 0:  # binary data in a text format: no guessing what the rest means
-        line = data.count(b"\n", 0, nul) + 1
-        raise mesh_error(name, f"line {line}: a NUL byte (binary data in a text {ext[1:].upper()} file?)")
-    # Comments may hold any encoding; the data we need is ASCII.
-    return parse(data.decode("utf-8", errors="replace"), name, path)
+    return parse(data, name, path)
 
 
-# The readers by file suffix: a text parser of ours, or None for trimesh's loader.
-READERS = {".obj": _parse_obj, ".off": _parse_off, ".stl": None, ".ply": None, ".glb": None, ".gltf": None}
+def _text(parse: Callable[[str, str, str], RawMesh], kind: str) -> Callable[[bytes, str, str], RawMesh]:
+    """A reader of a file's bytes from a parser of its text: binary data refused, the text decoded."""
+    def read(data: bytes, name: str, path: str) -> RawMesh:
+        nul = data.find(b"\0")
+        if nul >= 0:  # binary data in a text format: no guessing what the rest means
+            line = data.count(b"\n", 0, nul) + 1
+            raise mesh_error(name, f"line {line}: a NUL byte (binary data in a text {kind} file?)")
+        # Comments may hold any encoding; the data we need is ASCII.
+        return parse(data.decode("utf-8", errors="replace"), name, path)
+    return read
+
+
+# The readers by file suffix: (bytes, file name, path) -> RawMesh, or None for trimesh's loader.
+READERS = {".obj": _text(_parse_obj, "OBJ"), ".off": _text(_parse_off, "OFF"), ".stl": _parse_stl, ".ply": None,
+           ".glb": None, ".gltf": None}
 
 
 def obj_text(vertices: np.ndarray, faces: np.ndarray, header: list[str] | str = ()) -> str:

@@ -73,33 +73,37 @@ def test_info_into_a_pipe_nobody_reads_stops_quietly(models_dir: Path) -> None:
     assert proc.returncode == 141 and proc.stderr == "", (proc.returncode, proc.stderr)
 
 
-def test_info_imports_no_numba(models_dir: Path) -> None:
+def test_info_imports_no_numba(models_dir: Path, tmp_path: Path) -> None:
     """`info` starts fast (issue 23): it compiles nothing, so numba (about 0.35 s to import and
-    start loading kernels) is not imported, on a plain mesh nor on a textured one. With the
-    kernels compiled ahead of time (`make setup`) it imports no scipy either for a mesh of up to
-    MESH_HULL_COMPILED_POINTS vertices (scipy.spatial: 0.36-0.44 s, most of its time), and
-    reports what it reports without them."""
+    start loading kernels) is not imported, on a plain mesh, a textured one or an STL file (read
+    without trimesh: about a second to import). With the kernels compiled ahead of time (`make
+    setup`) it imports no scipy either for a mesh of up to MESH_HULL_COMPILED_POINTS vertices
+    (scipy.spatial: 0.36-0.8 s, most of its time), and reports what it reports without them."""
     import json
     import os
 
+    import trimesh
+
     from polyfold.jit import ahead_ready
 
+    stl = tmp_path / "bunny.stl"
+    trimesh.load(models_dir / "bunny-128.obj", force="mesh", process=False).export(stl)
     probe = ("import atexit, sys, runpy; sys.argv = ['polyfold'] + sys.argv[1:]\n"
-             "atexit.register(lambda: print(*[m for m in ('numba', 'scipy') if m in sys.modules] or ['none']))\n"
+             "atexit.register(lambda: print(*[m for m in ('numba', 'scipy', 'trimesh') if m in sys.modules] or ['none']))\n"
              "runpy.run_module('polyfold', run_name='__main__')\n")
-    for rel in ("bunny-128.obj", "textured/spot/spot_triangulated.obj"):  # 66 and 2,930 vertices
+    for path in (models_dir / "bunny-128.obj", models_dir / "textured/spot/spot_triangulated.obj", stl):  # 66, 2,930, 66 vertices
         reports = []
         for switch in ("on", "off"):
-            proc = subprocess.run([CLI[0], "-c", probe, "info", str(models_dir / rel), "--json"], capture_output=True,
+            proc = subprocess.run([CLI[0], "-c", probe, "info", str(path), "--json"], capture_output=True,
                                   text=True, timeout=120, env={**os.environ, "POLYFOLD_AHEAD": switch})
-            assert proc.returncode == 0, (rel, proc.stderr[-500:])
+            assert proc.returncode == 0, (path.name, proc.stderr[-500:])
             *report, loaded = proc.stdout.strip().splitlines()
-            assert "numba" not in loaded.split(), (rel, switch, loaded)
+            assert "numba" not in loaded.split() and "trimesh" not in loaded.split(), (path.name, switch, loaded)
             if switch == "on" and ahead_ready():
-                assert loaded == "none", (rel, loaded)
+                assert loaded == "none", (path.name, loaded)
             reports.append(json.loads("\n".join(report)))
         on, off = reports
-        assert abs(on.pop("concavity") - off.pop("concavity")) <= 1e-9 and on == off, (rel, on, off)
+        assert abs(on.pop("concavity") - off.pop("concavity")) <= 1e-9 and on == off, (path.name, on, off)
 
 
 def test_info_rejects(models_dir: Path) -> None:
