@@ -159,6 +159,70 @@ def test_written_mesh_loads_back(models_dir, tmp_path, suffix):
     assert np.allclose(np.sort(key(back), axis=0), np.sort(key(mesh), axis=0), atol=1e-5)
 
 
+@pytest.mark.parametrize("suffix", [".ply", ".glb", ".off", ".stl"])
+def test_written_mesh_reads_in_trimesh(models_dir, tmp_path, suffix):
+    """polyfold's own writers (not trimesh's: its import costs a command about a second), read back
+    by trimesh: the same triangles (float32 where the format stores it, exact in OFF), the face
+    colours where the format holds them (PLY faces; GLB corners, a face's own), the STL's unit
+    normals, header lines as comments."""
+    import trimesh
+
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    colors = np.random.default_rng(4).integers(0, 256, (mesh.n_faces, 3)).astype(np.uint8)
+    for face_colors in (colors, None):
+        path = tmp_path / f"bunny{suffix}"
+        write_mesh(path, mesh.vertices, mesh.faces, face_colors=face_colors, header=["a bunny", "two\nlines"])
+        tm = trimesh.load(path, force="mesh", process=False)
+        corners = np.asarray(tm.vertices)[np.asarray(tm.faces)]
+        if suffix == ".off":
+            assert np.array_equal(corners, mesh.vertices[mesh.faces]) and b"# two lines" in path.read_bytes()
+        else:
+            assert np.array_equal(corners, mesh.vertices[mesh.faces].astype(np.float32))
+        if suffix == ".stl":
+            stored = np.frombuffer(path.read_bytes(), dtype=[("n", "<f4", (3,)), ("c", "<f4", (9,)), ("a", "<u2")],
+                                   offset=84)["n"]
+            assert np.allclose(stored, trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).face_normals, atol=1e-6)
+        if suffix == ".ply":
+            assert b"comment a bunny" in path.read_bytes()[:400]
+        if face_colors is not None and suffix in (".ply", ".glb"):
+            shown = tm.visual.face_colors if suffix == ".ply" else tm.visual.vertex_colors[np.asarray(tm.faces)[:, 0]]
+            assert np.array_equal(np.asarray(shown)[:, :3], colors) and (np.asarray(shown)[:, 3] == 255).all()
+
+
+VALIDATE_GLB = """
+const validator = require('gltf-validator'); const fs = require('fs');
+(async () => {
+  const out = {};
+  for (const f of process.argv.slice(2)) {
+    const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(f)));
+    out[f] = [report.issues.numErrors, report.issues.numWarnings, report.issues.messages.slice(0, 3)];
+  }
+  console.log(JSON.stringify(out));
+})();
+"""
+
+
+def test_written_glb_passes_khronos_validator(models_dir, tmp_path):
+    """The GLB files polyfold writes (face colours or none) have no error and no warning in the
+    Khronos glTF validator (npm gltf-validator, installed into tests/.node by .ci/run)."""
+    import json
+    import shutil
+    import subprocess
+
+    node, modules = shutil.which("node"), Path(__file__).resolve().parents[1] / ".node" / "node_modules"
+    if node is None or not (modules / "gltf-validator" / "package.json").is_file():
+        pytest.skip("node or npm gltf-validator missing (.ci/run installs it into tests/.node)")
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    colors = np.random.default_rng(5).integers(0, 256, (mesh.n_faces, 3)).astype(np.uint8)
+    write_mesh(tmp_path / "colored.glb", mesh.vertices, mesh.faces, face_colors=colors, header="a bunny")
+    write_mesh(tmp_path / "plain.glb", mesh.vertices, mesh.faces)
+    (tmp_path / "validate.js").write_text(VALIDATE_GLB)
+    proc = subprocess.run([node, "validate.js", "colored.glb", "plain.glb"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120, env={"NODE_PATH": str(modules), "PATH": ""})
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == {"colored.glb": [0, 0, []], "plain.glb": [0, 0, []]}
+
+
 def test_unknown_suffix_is_one_clear_error(tmp_path):
     with pytest.raises(PolyfoldError, match="cannot write '.xyz' meshes"):
         write_mesh(tmp_path / "m.xyz", np.zeros((3, 3)), np.array([[0, 1, 2]]))

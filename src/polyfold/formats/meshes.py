@@ -403,25 +403,90 @@ def _obj(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None
     return obj_text(vertices, faces, header).encode("utf-8")  # (OBJ has no standard face colours)
 
 
-def _trimesh_writer(file_type: str):
-    def write(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
-        import trimesh
+# The writers below are polyfold's own: importing trimesh costs a command about a second (1.4-1.8 s
+# on a slow machine), and these formats' triangle meshes are a few lines each. Files are checked
+# by reading them back with trimesh in the tests.
 
-        rgba = None if face_colors is None else np.concatenate(
-            [face_colors, np.full((len(face_colors), 1), 255, np.uint8)], axis=1)
-        if file_type == "glb" and rgba is not None:
-            # glTF has no face colours: every face gets its own corners, coloured as the face
-            tm = trimesh.Trimesh(vertices[faces].reshape(-1, 3), np.arange(3 * len(faces)).reshape(-1, 3),
-                                 vertex_colors=np.repeat(rgba, 3, axis=0), process=False)
-        else:
-            tm = trimesh.Trimesh(vertices, faces, face_colors=rgba, process=False)
-        return tm.export(file_type=file_type)
-    return write
+def _ply(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+    """Binary little-endian PLY: float x y z, faces as uchar counts of int indices, RGBA face
+    colours when given (as trimesh writes it)."""
+    fields = [("n", "u1"), ("v", "<i4", (3,))] + ([("rgba", "u1", (4,))] if face_colors is not None else [])
+    rows = np.zeros(len(faces), dtype=np.dtype(fields))
+    rows["n"], rows["v"] = 3, faces
+    if face_colors is not None:
+        rows["rgba"][:, :3], rows["rgba"][:, 3] = face_colors, 255
+    head = ["ply", "format binary_little_endian 1.0", *(f"comment {' '.join(h.split())}" for h in header),
+            f"element vertex {len(vertices)}", "property float x", "property float y", "property float z",
+            f"element face {len(faces)}", "property list uchar int vertex_indices"]
+    head += [f"property uchar {c}" for c in ("red", "green", "blue", "alpha")] if face_colors is not None else []
+    return ("\n".join(head + ["end_header"]) + "\n").encode("ascii", "replace") + \
+        vertices.astype("<f4").tobytes() + rows.tobytes()
+
+
+def _off(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+    """OFF text (no colours: the format's face colours are read by few programs); coordinates in
+    repr, so reading the file back gives the same floats."""
+    lines = ["OFF", *(f"# {' '.join(h.split())}" for h in header), f"{len(vertices)} {len(faces)} 0"]
+    lines += [f"{x!r} {y!r} {z!r}" for x, y, z in vertices.tolist()]
+    lines += [f"3 {a} {b} {c}" for a, b, c in np.asarray(faces).tolist()]
+    return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def _stl(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+    """Binary STL: the first header line in the 80-byte header, unit normals (zero for degenerate
+    triangles), no colours (STL has no standard for them)."""
+    corners = vertices[np.asarray(faces)]
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    length = np.linalg.norm(normal, axis=1)
+    normal = np.divide(normal, length[:, None], out=np.zeros_like(normal), where=length[:, None] > 0)
+    rows = np.zeros(len(corners), dtype=STL_RECORD)
+    rows["normal"], rows["corners"] = normal, corners
+    title = (header[0] if header else "polyfold").encode("ascii", "replace")[:80].ljust(80, b" ")
+    return title + len(rows).to_bytes(4, "little") + rows.tobytes()
+
+
+def _glb(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
+    """Binary glTF 2.0 (GLB) of one triangle mesh: float positions, uint32 indices; glTF has no
+    face colours, so with them every face gets corners of its own, coloured as the face (RGBA
+    bytes, COLOR_0)."""
+    import json
+
+    faces = np.asarray(faces)
+    if face_colors is not None:
+        vertices, faces = vertices[faces].reshape(-1, 3), np.arange(3 * len(faces)).reshape(-1, 3)
+    position = vertices.astype("<f4")
+    parts = [position.tobytes()]
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": len(position), "type": "VEC3",
+                  "min": position.min(axis=0).tolist(), "max": position.max(axis=0).tolist()}]
+    attributes = {"POSITION": 0}
+    if face_colors is not None:
+        rgba = np.full((len(face_colors), 4), 255, np.uint8)
+        rgba[:, :3] = face_colors
+        parts.append(np.repeat(rgba, 3, axis=0).tobytes())
+        accessors.append({"bufferView": 1, "componentType": 5121, "normalized": True, "count": len(position),
+                          "type": "VEC4"})
+        attributes["COLOR_0"] = 1
+    parts.append(faces.astype("<u4").tobytes())
+    accessors.append({"bufferView": len(parts) - 1, "componentType": 5125, "count": faces.size, "type": "SCALAR"})
+    views, offset = [], 0
+    for k, part in enumerate(parts):  # (every part's length a multiple of 4: no padding between them)
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(part),
+                      "target": 34963 if k == len(parts) - 1 else 34962})
+        offset += len(part)
+    doc = {"asset": {"version": "2.0", "generator": "polyfold", **({"copyright": header[0]} if header else {})},
+           "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+           "meshes": [{"primitives": [{"attributes": attributes, "indices": len(parts) - 1, "mode": 4}]}],
+           "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": offset}]}
+    text = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    blob = b"".join(parts)
+    total = 12 + 8 + len(text) + 8 + len(blob)
+    return (b"glTF" + (2).to_bytes(4, "little") + total.to_bytes(4, "little")
+            + len(text).to_bytes(4, "little") + b"JSON" + text + len(blob).to_bytes(4, "little") + b"BIN\0" + blob)
 
 
 # The writers by file suffix: (vertices, faces, face colours (F, 3) uint8 or None, header lines) -> bytes.
-WRITERS = {".obj": _obj, ".ply": _trimesh_writer("ply"), ".glb": _trimesh_writer("glb"),
-           ".off": _trimesh_writer("off"), ".stl": _trimesh_writer("stl")}
+WRITERS = {".obj": _obj, ".ply": _ply, ".glb": _glb, ".off": _off, ".stl": _stl}
 
 
 def mesh_bytes(suffix: str, vertices: np.ndarray, faces: np.ndarray, *, face_colors: np.ndarray | None = None,
