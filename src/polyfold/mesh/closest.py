@@ -12,7 +12,9 @@ import numpy as np
 
 from ..jit import njit
 
-BALL_CANDIDATES = 4_000_000  # candidate triangles held at once by `surface_distances`' last pass (32 MB)
+# Candidate triangles of `surface_distances`' last pass held at once: scipy's ball query gives them as
+# Python lists (about 36 bytes each: 36 MB), so chunks keep the peak small.
+BALL_CANDIDATES = 1_000_000
 
 
 @njit(cache=True)
