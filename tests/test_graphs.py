@@ -32,6 +32,28 @@ def test_components_are_scipys():
         assert np.array_equal(graphs.union_labels(n, u, v), want)
 
 
+def test_components_of_meshes_and_long_paths_are_scipys():
+    """Graphs of large diameter, where labels spread slowest: the dual graph of a 20,480-face
+    sphere with two belts of edges removed (two caps, a band and faces left alone between), and
+    paths of 20,000 nodes in order, reversed and shuffled."""
+    from polyfold.apps.warmup import bumpy_sphere
+    from polyfold.mesh.mesh import Mesh
+
+    mesh = Mesh(*bumpy_sphere(5, 0.02, seed=3))
+    ef = mesh.topology.edge_faces
+    z = mesh.vertices[mesh.topology.edges].mean(axis=1)[:, 2]
+    keep = (np.abs(z - 0.3) > 0.02) & (np.abs(z + 0.3) > 0.02)
+    rng = np.random.default_rng(2)
+    order = rng.permutation(20_000)
+    graphs_ = [(mesh.n_faces, ef[keep, 0], ef[keep, 1])]
+    graphs_ += [(20_000, p[:-1], p[1:]) for p in (np.arange(20_000), np.arange(20_000)[::-1], order)]
+    for n, u, v in graphs_:
+        want_n, want = connected_components(coo_matrix((np.ones(len(u)), (u, v)), shape=(n, n)), directed=False)
+        got_n, got = graphs.connected_components(n, u, v)
+        assert got_n == want_n and np.array_equal(got, want)
+        assert want_n >= 3 if n == mesh.n_faces else want_n == 1
+
+
 def test_breadth_first_predecessors_are_scipys():
     """On the symmetric weighted graph mesh repair builds (G + G.T, weights >= 1), from every kind
     of head: the tree, and the weight read on each tree edge."""

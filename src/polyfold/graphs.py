@@ -35,16 +35,21 @@ def _adjacency(n: int, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.nda
 def connected_components(n: int, u: np.ndarray, v: np.ndarray) -> tuple[int, np.ndarray]:
     """(number of components, label (n,) int64 of each node) of the undirected graph with edges
     u[i]-v[i] (scipy's `connected_components(coo_matrix(...), directed=False)`). numpy only
-    (`polyfold info` loads meshes without numba): every node takes the lowest label across its
-    edges, then follows labels to their end (pointer jumping), until nothing changes; labels end
-    as each component's lowest node, numbered in that order."""
+    (`polyfold info` loads meshes without numba): every node and every label across an edge takes
+    the lowest label across that edge, then every node follows labels to their end (pointer
+    jumping), until nothing changes; labels end as each component's lowest node, numbered in that
+    order."""
     u, v = np.asarray(u, dtype=np.int64), np.asarray(v, dtype=np.int64)
     labels = np.arange(n, dtype=np.int64)
+    ends = np.concatenate([u, v])
     while len(u):
-        low = np.minimum(labels[u], labels[v])
+        lu, lv = labels[u], labels[v]
+        low = np.minimum(lu, lv)
         new = labels.copy()
-        np.minimum.at(new, u, low)
-        np.minimum.at(new, v, low)
+        # The edge's ends and their labels (roots of the label forest, after the jumping) take the
+        # lower label: hooking the roots joins whole trees at once, so a mesh's components take a
+        # few rounds, not one per step of their diameter (an 82k-face sphere: 195 rounds).
+        np.minimum.at(new, np.concatenate([ends, lu, lv]), np.concatenate([low, low, low, low]))
         jumped = new[new]
         while not np.array_equal(jumped, new):
             new, jumped = jumped, jumped[jumped]
