@@ -140,7 +140,7 @@ def _imports_stamp(module: str) -> tuple:
     import re
 
     if _IMPORT_LINE is None:
-        _IMPORT_LINE = re.compile(r"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+\(?([\w, \t]*)|import[ \t]+(polyfold[\w.]*))",
+        _IMPORT_LINE = re.compile(r"^[ \t]*(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+\(?([\w, \t]*)|import[ \t]+([\w.]+))",
                                   re.MULTILINE)
     top = module.split(".")[0]
     top_file = getattr(sys.modules.get(top), "__file__", None)
