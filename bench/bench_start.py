@@ -13,7 +13,8 @@ project's cache is left alone):
   runs (two or more cores: the fold stage's kernels compile in a second process, `warmup.Beside`)
   and on one core (`taskset -c 0`: everything in one process);
 - warm-up: `polyfold warm-up` into an empty cache (what `make setup` adds), then make after it;
-- warm: `--help`, `info`, `make` with the kernels cached (every later run; ahead of time where
+- warm: `--help`, `info` (of the bunny, of the bunny as STL and of a noisy sphere of 5,120
+  faces), `make` with the kernels cached (every later run; ahead of time where
   `polyfold warm-up` built them, `polyfold.jit`), the make again just in time (POLYFOLD_AHEAD=off:
   numba's dispatchers from its cache), and where the warm make's time goes: until its first
   progress line (start-up: imports; it reads the mesh next), until its summary line, and until
@@ -193,8 +194,18 @@ def main() -> None:
     run(["make", str(BUNNY), "-o", str(tmp / "prime"), "-q"])  # the project's cache, as after setup
     warm = (("info bunny-128", ["info", str(BUNNY)]),
             ("make bunny-128 (warm)", ["make", str(BUNNY), "-o", str(tmp / "warm"), "-q"]))
+    # `info` of other inputs: an STL (read by polyfold, not trimesh) and a mesh of 5,120 faces (its
+    # hull compiled: no scipy)
+    from bench_build import _obj_text, noisy_icosphere
+    from polyfold.formats.meshes import load_mesh, write_mesh
+
+    bunny = load_mesh(BUNNY).mesh
+    write_mesh(tmp / "bunny-128.stl", bunny.vertices, bunny.faces)
+    (tmp / "sphere-5120.obj").write_text(_obj_text(*noisy_icosphere(4, 0.02, 1), "bench_start"))
+    infos = (("info bunny-128 as STL", ["info", str(tmp / "bunny-128.stl")]),
+             ("info noisy sphere, 5,120 faces", ["info", str(tmp / "sphere-5120.obj")]))
     ahead = kernels_ahead(OWN)
-    for label, args in (("--help", ["--help"]), *warm):
+    for label, args in (("--help", ["--help"]), warm[0], *infos, warm[1]):
         best = min((run(args) for _ in range(3)), key=lambda r: r[0])
         how = "" if label == "--help" else ("; kernels ahead of time (no numba)" if ahead
                                             else "; no ahead-of-time kernels for this code: run `polyfold warm-up`")
