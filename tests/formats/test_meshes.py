@@ -159,6 +159,23 @@ def test_written_mesh_loads_back(models_dir, tmp_path, suffix):
     assert np.allclose(np.sort(key(back), axis=0), np.sort(key(mesh), axis=0), atol=1e-5)
 
 
+def test_binary_stl_with_its_count_off_is_read_and_said(models_dir: Path, tmp_path: Path) -> None:
+    """A binary STL whose count is 0 (a writer that could not go back to fill it in) or that has
+    bytes after its triangles loads (trimesh refuses both) with a warning saying what was read."""
+    mesh = load_mesh(models_dir / "bunny-128.obj").mesh
+    write_mesh(tmp_path / "ok.stl", mesh.vertices, mesh.faces)
+    data = (tmp_path / "ok.stl").read_bytes()
+    ok = load_mesh(tmp_path / "ok.stl")
+    assert not any("header" in w or "ignored" in w for w in ok.warnings)
+    for name, bad, said in (("zero.stl", data[:80] + bytes(4) + data[84:], "the header says 0 triangles: read the 128"),
+                            ("tail.stl", data + b"\x00" * 37, "ignored 37 bytes after the 128 triangles"),
+                            ("tail2.stl", data + b"x" * 120, "ignored 120 bytes after the 128 triangles")):
+        (tmp_path / name).write_bytes(bad)
+        loaded = load_mesh(tmp_path / name)
+        assert np.array_equal(loaded.mesh.vertices, ok.mesh.vertices) and np.array_equal(loaded.mesh.faces, ok.mesh.faces)
+        assert any(w.startswith(said) for w in loaded.warnings), (name, loaded.warnings)
+
+
 @pytest.mark.parametrize("suffix", [".ply", ".glb", ".off", ".stl"])
 def test_written_mesh_reads_in_trimesh(models_dir, tmp_path, suffix):
     """polyfold's own writers (not trimesh's: its import costs a command about a second), read back

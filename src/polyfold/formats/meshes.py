@@ -285,8 +285,23 @@ def _parse_stl(data: bytes, name: str, path: str = "") -> RawMesh:
     about a second. A triangle soup: every corner a vertex of its own (repair welds them)."""
     global _STL_VERTEX
     _stl_counts(data, name)
-    if len(data) >= 84 and len(data) == 84 + STL_RECORD.itemsize * int.from_bytes(data[80:84], "little"):
-        vertices = np.frombuffer(data, dtype=STL_RECORD, offset=84)["corners"].reshape(-1, 3).astype(np.float64)
+    promised = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    binary = len(data) == 84 + STL_RECORD.itemsize * promised  # (trimesh's rule)
+    warnings: tuple[str, ...] = ()
+    if not binary and len(data) >= 84 and not _ascii_stl(data):
+        # Binary with the count off, which trimesh refuses: a writer that could not go back to fill
+        # the count in leaves 0; some append bytes after the triangles. (Fewer bytes than the count
+        # needs: `_stl_counts` said so.)
+        held, rest = divmod(len(data) - 84, STL_RECORD.itemsize)
+        if promised == 0 and held > 0 and rest == 0:
+            binary, promised = True, held
+            warnings = (f"the header says 0 triangles: read the {held} the file holds",)
+        elif promised > 0:
+            binary = True
+            warnings = (f"ignored {len(data) - 84 - promised * STL_RECORD.itemsize} bytes after the {promised} triangles",)
+    if binary:
+        records = np.frombuffer(data, dtype=STL_RECORD, count=promised, offset=84)
+        vertices = records["corners"].reshape(-1, 3).astype(np.float64)
     else:
         if _STL_VERTEX is None:
             import re
@@ -302,12 +317,18 @@ def _parse_stl(data: bytes, name: str, path: str = "") -> RawMesh:
     if len(vertices) == 0:
         raise mesh_error(name, "no faces could be read (not a valid STL file?)")
     n = len(vertices) // 3
-    return RawMesh(vertices, np.arange(3 * n, dtype=np.int64).reshape(-1, 3), np.arange(n), 0)
+    return RawMesh(vertices, np.arange(3 * n, dtype=np.int64).reshape(-1, 3), np.arange(n), 0, warnings=warnings)
+
+
+def _ascii_stl(data: bytes) -> bool:
+    """Whether an STL file reads as ASCII: "solid" first and a facet soon after (a binary file's
+    80-byte header may begin with "solid" too)."""
+    return data[:5].lower() == b"solid" and b"facet" in data[:1024]
 
 
 def _stl_counts(data: bytes, name: str) -> None:
     """A binary STL whose header promises more triangles than the file holds: MeshError."""
-    if len(data) < 84 or data[:5].lower() == b"solid" and b"facet" in data[:1024]:
+    if len(data) < 84 or _ascii_stl(data):
         return  # (too short for a binary STL, or ASCII: the ASCII reader and "no faces" say it)
     promised = int.from_bytes(data[80:84], "little")
     held = (len(data) - 84) // 50
