@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import PolyfoldError
 from ..mesh.appearance import Appearance
+from ..mesh.geometry import face_normals
 from ..mesh.mesh import Mesh
 from ..mesh.repair import LoadedMesh, RawMesh, check_input, mesh_error, repair
 from .files import atomic_write
@@ -282,23 +283,27 @@ def _parse_stl(data: bytes, name: str, path: str = "") -> RawMesh:
     """An STL file: binary (an 80-byte header, the triangle count, 50-byte records) when its length
     is exactly what its count says, else ASCII (every "vertex x y z" line, three a facet, all
     solids in file order) -- trimesh's rules, read here because importing trimesh costs a command
-    about a second. A triangle soup: every corner a vertex of its own (repair welds them)."""
+    about a second. A binary file whose count is 0 or that has bytes after its triangles, which
+    trimesh refuses, is read with a warning; one shorter than its count is a MeshError. A
+    triangle soup: every corner a vertex of its own (repair welds them)."""
     global _STL_VERTEX
-    _stl_counts(data, name)
-    promised = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
-    binary = len(data) == 84 + STL_RECORD.itemsize * promised  # (trimesh's rule)
+    binary = False
     warnings: tuple[str, ...] = ()
-    if not binary and len(data) >= 84 and not _ascii_stl(data):
-        # Binary with the count off, which trimesh refuses: a writer that could not go back to fill
-        # the count in leaves 0; some append bytes after the triangles. (Fewer bytes than the count
-        # needs: `_stl_counts` said so.)
+    if len(data) >= 84:
+        promised = int.from_bytes(data[80:84], "little")
         held, rest = divmod(len(data) - 84, STL_RECORD.itemsize)
-        if promised == 0 and held > 0 and rest == 0:
-            binary, promised = True, held
-            warnings = (f"the header says 0 triangles: read the {held} the file holds",)
-        elif promised > 0:
-            binary = True
-            warnings = (f"ignored {len(data) - 84 - promised * STL_RECORD.itemsize} bytes after the {promised} triangles",)
+        binary = held == promised and rest == 0  # (trimesh's rule)
+        if not binary and not _ascii_stl(data):
+            if held < promised:
+                raise mesh_error(name, f"file ends early: the header promises {promised} triangles, the file holds {held}")
+            # The count is off: a writer that could not go back to fill it in leaves 0; some
+            # append bytes after the triangles.
+            if promised == 0 and held > 0 and rest == 0:
+                binary, promised = True, held
+                warnings = (f"the header says 0 triangles: read the {held} the file holds",)
+            elif promised > 0:
+                binary = True
+                warnings = (f"ignored {len(data) - 84 - promised * STL_RECORD.itemsize} bytes after the {promised} triangles",)
     if binary:
         records = np.frombuffer(data, dtype=STL_RECORD, count=promised, offset=84)
         vertices = records["corners"].reshape(-1, 3).astype(np.float64)
@@ -324,16 +329,6 @@ def _ascii_stl(data: bytes) -> bool:
     """Whether an STL file reads as ASCII: "solid" first and a facet soon after (a binary file's
     80-byte header may begin with "solid" too)."""
     return data[:5].lower() == b"solid" and b"facet" in data[:1024]
-
-
-def _stl_counts(data: bytes, name: str) -> None:
-    """A binary STL whose header promises more triangles than the file holds: MeshError."""
-    if len(data) < 84 or _ascii_stl(data):
-        return  # (too short for a binary STL, or ASCII: the ASCII reader and "no faces" say it)
-    promised = int.from_bytes(data[80:84], "little")
-    held = (len(data) - 84) // 50
-    if held < promised:
-        raise mesh_error(name, f"file ends early: the header promises {promised} triangles, the file holds {held}")
 
 
 def _ply_counts(data: bytes, name: str) -> None:
@@ -456,12 +451,8 @@ def _off(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None
 def _stl(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray | None, header: list[str]) -> bytes:
     """Binary STL: the first header line in the 80-byte header, unit normals (zero for degenerate
     triangles), no colours (STL has no standard for them)."""
-    corners = vertices[np.asarray(faces)]
-    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    length = np.linalg.norm(normal, axis=1)
-    normal = np.divide(normal, length[:, None], out=np.zeros_like(normal), where=length[:, None] > 0)
-    rows = np.zeros(len(corners), dtype=STL_RECORD)
-    rows["normal"], rows["corners"] = normal, corners
+    rows = np.zeros(len(faces), dtype=STL_RECORD)
+    rows["normal"], rows["corners"] = face_normals(vertices, faces), vertices[np.asarray(faces)]
     title = (header[0] if header else "polyfold").encode("ascii", "replace")[:80].ljust(80, b" ")
     return title + len(rows).to_bytes(4, "little") + rows.tobytes()
 

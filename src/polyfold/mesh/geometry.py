@@ -175,10 +175,11 @@ def concavity(mesh: Mesh, samples_per_face: int = 3, seed: int = 0) -> float:
     flip = r.sum(axis=2) > 1
     r[flip] = 1 - r[flip]
     pts = tri[:, None, 0] + r[..., :1] * (tri[:, None, 1] - tri[:, None, 0]) + r[..., 1:] * (tri[:, None, 2] - tri[:, None, 0])
-    pts = np.concatenate([mesh.vertices[np.unique(mesh.faces)], pts.reshape(-1, 3)])
+    used = mesh.vertices[np.unique(mesh.faces)]
+    pts = np.concatenate([used, pts.reshape(-1, 3)])
     diag = mesh.bbox_diagonal
     compiled = ahead_ready()  # (else numba would compile the kernels: longer than scipy and numpy take)
-    hull = hull_planes(mesh.vertices[np.unique(mesh.faces)], MESH_HULL_COMPILED_POINTS if compiled else 0)
+    hull = hull_planes(used, MESH_HULL_COMPILED_POINTS if compiled else 0)
     if hull is None:
         return 0.0  # flat or degenerate point set: no volume, the surface is its own hull
     eq = np.ascontiguousarray(hull[1], dtype=np.float64)

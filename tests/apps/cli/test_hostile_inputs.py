@@ -40,6 +40,7 @@ CORPUS: dict[str, tuple[bytes, str]] = {
     "short-off.off": (b"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1\n", "file ends early"),
     "truncated.stl": (b"\0" * 80 + struct.pack("<I", 12) + TRI * 2, "promises 12 triangles, the file holds 2"),
     "empty.stl": (b"", "no faces"),
+    "short.stl": (b"x" * 34, "no faces"),  # (34 = 84 - 50: once taken for a binary file of -1 triangles)
     "ascii-broken.stl": (b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\nendloop\nendfacet\nendsolid\n",
                          "no faces"),
     "short-count.ply": (b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
